@@ -1,0 +1,43 @@
+//! Command-line flags, as typed (clap derive).
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+
+/// Plan enveloping grasps for a three-fingered hand and check them in a physics scene.
+///
+/// Exit status: 0 every expectation met (or none could be judged yet), 1 an expectation not met,
+/// 2 bad input.
+#[derive(Debug, Parser)]
+#[command(
+    name = "grasp-sim",
+    version,
+    args_conflicts_with_subcommands = true,
+    subcommand_negates_reqs = true
+)]
+pub struct Cli {
+    /// Scenario files (TOML) to run, in order.
+    #[arg(required = true, value_name = "SCENARIO")]
+    pub scenarios: Vec<PathBuf>,
+
+    /// Print one JSON object per scenario (JSON Lines) instead of the summary.
+    #[arg(long)]
+    pub json: bool,
+
+    /// Plan only; skip the physics check.
+    #[arg(long)]
+    pub no_sim: bool,
+
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+/// Subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Write the thesis objects as binary STL (deterministic: the same bytes every time).
+    GenAssets {
+        /// Output folder.
+        #[arg(long, default_value = "assets/objects")]
+        out: PathBuf,
+    },
+}

@@ -1,0 +1,310 @@
+//! Triangle meshes: loading and validating STL, mass properties, alignment with the principal axis.
+//!
+//! Input: an STL file (binary or ASCII) in some length unit. Output: a welded, validated [`Mesh`]
+//! in millimetres, and from it an [`AlignedObject`] in the planner's frame (thesis 3.2.1): the
+//! principal axis with the smallest moment of inertia along +Z, the lowest point at Z = 0 and the
+//! centroid on the Z axis. The thesis asks the user to pre-align the mesh (its 6.2); grasp-sim does
+//! it and keeps the transform, so every output can also be given in the mesh's original frame.
+//!
+//! Invariants of a [`Mesh`]: every coordinate is finite; every triangle has three distinct vertex
+//! indices and non-zero area; vertices that are bit-identical in the file are one vertex.
+
+mod align;
+mod load;
+mod mass;
+
+pub use align::{align, AlignedObject};
+pub use load::{load_stl, parse_stl, LengthUnit, LoadedMesh};
+pub use mass::{mass_properties, MassProperties};
+
+use nalgebra::{Point3, Vector3};
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+/// Problems with a mesh file that stop grasp-sim from using it.
+///
+/// Every variant carries the file, so its message names it on one line.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    /// The file could not be opened or read.
+    #[error("{path}: cannot read: {message}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said.
+        message: String,
+    },
+    /// The path names a directory.
+    #[error("{path}: is a directory, not an STL file")]
+    IsDirectory {
+        /// The path.
+        path: PathBuf,
+    },
+    /// The file is empty.
+    #[error("{path}: empty file, not an STL file")]
+    Empty {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The bytes are neither ASCII nor binary STL.
+    #[error("{path}: not an STL file: {detail}")]
+    NotStl {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        detail: String,
+    },
+    /// A binary STL file holds fewer bytes than its triangle count needs.
+    #[error("{path}: truncated binary STL: header says {declared} triangles ({expected} bytes), file has {actual} bytes")]
+    Truncated {
+        /// The file.
+        path: PathBuf,
+        /// Triangle count in the header.
+        declared: u32,
+        /// Bytes the count implies.
+        expected: u64,
+        /// Bytes in the file.
+        actual: u64,
+    },
+    /// A binary STL file holds more bytes than its triangle count explains.
+    #[error("{path}: binary STL has {extra} trailing bytes after the {declared} triangles its header declares")]
+    TrailingBytes {
+        /// The file.
+        path: PathBuf,
+        /// Triangle count in the header.
+        declared: u32,
+        /// Bytes past the last triangle.
+        extra: u64,
+    },
+    /// ASCII STL that does not parse.
+    #[error("{path}: malformed ASCII STL: {detail}")]
+    Ascii {
+        /// The file.
+        path: PathBuf,
+        /// The parser's complaint.
+        detail: String,
+    },
+    /// The file has no triangles.
+    #[error("{path}: the mesh has no triangles")]
+    NoTriangles {
+        /// The file.
+        path: PathBuf,
+    },
+    /// A vertex coordinate is NaN or infinite.
+    #[error("{path}: triangle {triangle} has a NaN or infinite coordinate")]
+    NonFinite {
+        /// The file.
+        path: PathBuf,
+        /// Zero-based index of the first offending triangle.
+        triangle: usize,
+    },
+    /// A coordinate is too large to be a physical object.
+    #[error("{path}: triangle {triangle} has a coordinate of {value:e} mm, beyond the {limit:e} mm grasp-sim accepts")]
+    OutOfRange {
+        /// The file.
+        path: PathBuf,
+        /// Zero-based index of the first offending triangle.
+        triangle: usize,
+        /// The coordinate in millimetres.
+        value: f64,
+        /// The limit in millimetres.
+        limit: f64,
+    },
+    /// Every triangle has zero area.
+    #[error("{path}: all {count} triangles are degenerate (zero area)")]
+    AllDegenerate {
+        /// The file.
+        path: PathBuf,
+        /// How many triangles were read.
+        count: usize,
+    },
+    /// The surface encloses no volume, so it has no mass properties or principal axis.
+    #[error("{path}: the surface encloses no volume ({volume_mm3:.3e} mm^3): not a closed solid")]
+    NoVolume {
+        /// The file.
+        path: PathBuf,
+        /// The signed volume found.
+        volume_mm3: f64,
+    },
+}
+
+/// A welded triangle mesh in millimetres.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Vertex positions `[mm]`.
+    pub vertices: Vec<Point3<f64>>,
+    /// Triangles as vertex indices, counter-clockwise seen from outside.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Edge statistics of a mesh: how far it is from a closed, consistently oriented 2-manifold.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Topology {
+    /// Edges used by exactly one triangle.
+    pub boundary_edges: usize,
+    /// Edges used by more than two triangles.
+    pub non_manifold_edges: usize,
+    /// Edges used twice in the same direction (neighbouring triangles wound oppositely).
+    pub misoriented_edges: usize,
+}
+
+impl Topology {
+    /// Returns true if and only if every edge is shared by exactly two triangles wound consistently.
+    pub fn is_closed_manifold(&self) -> bool {
+        self.boundary_edges == 0 && self.non_manifold_edges == 0 && self.misoriented_edges == 0
+    }
+}
+
+impl Mesh {
+    /// Builds a mesh from triangle soup, welding bit-identical vertices.
+    ///
+    /// Vertex order is the order of first appearance, so the result is deterministic.
+    /// Triangles that repeat a vertex are dropped; the count of dropped triangles is returned.
+    pub fn from_triangles(soup: &[[Point3<f64>; 3]]) -> (Mesh, usize) {
+        let mut index: HashMap<[u64; 3], u32> = HashMap::with_capacity(soup.len());
+        let mut vertices = Vec::new();
+        let mut triangles = Vec::with_capacity(soup.len());
+        let mut dropped = 0;
+        for tri in soup {
+            let mut ids = [0u32; 3];
+            for (k, p) in tri.iter().enumerate() {
+                // +0.0 turns -0.0 into 0.0, so the two spellings of zero weld.
+                let key = [
+                    (p.x + 0.0).to_bits(),
+                    (p.y + 0.0).to_bits(),
+                    (p.z + 0.0).to_bits(),
+                ];
+                ids[k] = *index.entry(key).or_insert_with(|| {
+                    vertices.push(Point3::new(p.x + 0.0, p.y + 0.0, p.z + 0.0));
+                    (vertices.len() - 1) as u32
+                });
+            }
+            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
+                dropped += 1;
+            } else {
+                triangles.push(ids);
+            }
+        }
+        (
+            Mesh {
+                vertices,
+                triangles,
+            },
+            dropped,
+        )
+    }
+
+    /// The three corners of triangle `t`.
+    #[inline]
+    pub fn corners(&self, t: usize) -> [Point3<f64>; 3] {
+        let [a, b, c] = self.triangles[t];
+        [
+            self.vertices[a as usize],
+            self.vertices[b as usize],
+            self.vertices[c as usize],
+        ]
+    }
+
+    /// The (unnormalised) normal of triangle `t` from its winding: twice its area in length.
+    #[inline]
+    pub fn area_normal(&self, t: usize) -> Vector3<f64> {
+        let [a, b, c] = self.corners(t);
+        (b - a).cross(&(c - a))
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the vertices `[mm]`.
+    ///
+    /// # Panics
+    /// If the mesh has no vertices (a validated mesh always has some).
+    pub fn bounds(&self) -> (Point3<f64>, Point3<f64>) {
+        let mut lo = self.vertices[0];
+        let mut hi = self.vertices[0];
+        for p in &self.vertices {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        (lo, hi)
+    }
+
+    /// Counts boundary, non-manifold and misoriented edges.
+    pub fn topology(&self) -> Topology {
+        // For each undirected edge: (uses in direction lo->hi, uses in direction hi->lo).
+        let mut edges: HashMap<(u32, u32), (u32, u32)> =
+            HashMap::with_capacity(self.triangles.len() * 2);
+        for tri in &self.triangles {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                let e = edges.entry((a.min(b), a.max(b))).or_insert((0, 0));
+                if a < b {
+                    e.0 += 1;
+                } else {
+                    e.1 += 1;
+                }
+            }
+        }
+        let mut t = Topology::default();
+        for &(fwd, back) in edges.values() {
+            match fwd + back {
+                1 => t.boundary_edges += 1,
+                2 if fwd != 1 => t.misoriented_edges += 1,
+                2 => {}
+                _ => t.non_manifold_edges += 1,
+            }
+        }
+        t
+    }
+
+    /// Applies `f` to every vertex.
+    pub fn map_vertices(&mut self, f: impl Fn(&Point3<f64>) -> Point3<f64>) {
+        for p in &mut self.vertices {
+            *p = f(p);
+        }
+    }
+
+    /// Reverses the winding of every triangle (turns the surface inside out).
+    pub fn flip(&mut self) {
+        for t in &mut self.triangles {
+            t.swap(1, 2);
+        }
+    }
+
+    /// The mesh as binary STL bytes (f32 coordinates, normals from the winding).
+    pub fn to_binary_stl(&self) -> Vec<u8> {
+        let tris = (0..self.triangles.len()).map(|t| {
+            let n = self.area_normal(t).normalize();
+            let c = self.corners(t);
+            let v = |p: Point3<f64>| stl_io::Vertex::new([p.x as f32, p.y as f32, p.z as f32]);
+            stl_io::Triangle {
+                normal: stl_io::Normal::new([n.x as f32, n.y as f32, n.z as f32]),
+                vertices: [v(c[0]), v(c[1]), v(c[2])],
+            }
+        });
+        let mut out = Vec::with_capacity(84 + 50 * self.triangles.len());
+        stl_io::write_stl(&mut out, tris).expect("writing to a Vec cannot fail");
+        out
+    }
+
+    /// The mesh as ASCII STL text (coordinates printed as f32, like the binary form).
+    pub fn to_ascii_stl(&self, name: &str) -> String {
+        use std::fmt::Write;
+        let mut s = format!("solid {name}\n");
+        for t in 0..self.triangles.len() {
+            let n = self.area_normal(t).normalize();
+            let _ = writeln!(
+                s,
+                "  facet normal {:e} {:e} {:e}\n    outer loop",
+                n.x as f32, n.y as f32, n.z as f32
+            );
+            for p in self.corners(t) {
+                let _ = writeln!(
+                    s,
+                    "      vertex {:e} {:e} {:e}",
+                    p.x as f32, p.y as f32, p.z as f32
+                );
+            }
+            s.push_str("    endloop\n  endfacet\n");
+        }
+        let _ = writeln!(s, "endsolid {name}");
+        s
+    }
+}

@@ -1,0 +1,331 @@
+//! Deterministic generators for the thesis's test objects and for geometry test fixtures.
+//!
+//! Every thesis object (chapters 4 and 5) is star-shaped about its axis, so one builder serves
+//! them all: a [`radial_solid`] is a stack of rings, each ring a radius per angle at one height,
+//! closed by flat caps. Sharp steps (the base's top, the horizontal ridge's faces) are two rings at
+//! the same height. The angles always include every 2.5°, so each vertical slice the planner makes
+//! at its 10° AngularStep passes exactly through mesh vertices — the slicer's hardest case.
+//!
+//! Output is a [`Mesh`] in millimetres, aligned already (principal axis +Z, bottom at Z = 0).
+
+use crate::mesh::Mesh;
+use nalgebra::Point3;
+use std::f64::consts::{PI, TAU};
+
+/// Angular samples around the axis: every 2.5°, the finest vertical slicing the planner uses by
+/// default divides this evenly, and the chord error on a 40 mm cylinder is 0.005 mm.
+pub const RING_SEGMENTS: usize = 144;
+
+/// One ring of a radial solid: its height and radius at each of the solid's angles.
+#[derive(Debug, Clone)]
+pub struct Ring {
+    /// Height `[mm]`.
+    pub z: f64,
+    /// Radius at each angle `[mm]`, all positive.
+    pub radii: Vec<f64>,
+}
+
+/// Builds a closed, outward-wound solid from rings over shared `angles` (radians, increasing,
+/// within one turn). Rings must have non-decreasing heights; consecutive rings at one height make
+/// a horizontal step and must differ in radius at every angle.
+///
+/// # Panics
+/// If a ring has the wrong number of radii or fewer than two rings are given.
+pub fn radial_solid(angles: &[f64], rings: &[Ring]) -> Mesh {
+    assert!(rings.len() >= 2, "a radial solid needs two rings");
+    let n = angles.len();
+    let pts: Vec<Vec<Point3<f64>>> = rings
+        .iter()
+        .map(|r| {
+            assert_eq!(r.radii.len(), n, "ring radii must match the angles");
+            angles
+                .iter()
+                .zip(&r.radii)
+                .map(|(&a, &rad)| Point3::new(rad * a.cos(), rad * a.sin(), r.z))
+                .collect()
+        })
+        .collect();
+    let mut soup = Vec::new();
+    let bottom = Point3::new(0.0, 0.0, rings[0].z);
+    let top = Point3::new(0.0, 0.0, rings[rings.len() - 1].z);
+    for k in 0..n {
+        let k1 = (k + 1) % n;
+        soup.push([bottom, pts[0][k1], pts[0][k]]);
+        let last = &pts[pts.len() - 1];
+        soup.push([top, last[k], last[k1]]);
+        for j in 0..pts.len() - 1 {
+            let (a, b) = (&pts[j], &pts[j + 1]);
+            soup.push([a[k], a[k1], b[k1]]);
+            soup.push([a[k], b[k1], b[k]]);
+        }
+    }
+    Mesh::from_triangles(&soup).0
+}
+
+/// `count` angles evenly around a turn, starting at 0.
+pub fn uniform_angles(count: usize) -> Vec<f64> {
+    (0..count).map(|k| TAU * k as f64 / count as f64).collect()
+}
+
+/// Merges extra angles (radians, any turn) into a sorted angle list, dropping near-duplicates.
+pub fn with_angles(mut base: Vec<f64>, extra: &[f64]) -> Vec<f64> {
+    base.extend(extra.iter().map(|a| a.rem_euclid(TAU)));
+    base.sort_by(f64::total_cmp);
+    base.dedup_by(|a, b| (*a - *b).abs() < 1e-9);
+    if base.len() > 1 && (TAU - base[base.len() - 1] + base[0]).abs() < 1e-9 {
+        base.pop();
+    }
+    base
+}
+
+/// A frustum (a cylinder when the diameters are equal) standing on Z = 0 `[mm]`.
+pub fn frustum(bottom_diameter: f64, top_diameter: f64, height: f64) -> Mesh {
+    let angles = uniform_angles(RING_SEGMENTS);
+    let ring = |z: f64, d: f64| Ring {
+        z,
+        radii: vec![d / 2.0; angles.len()],
+    };
+    radial_solid(
+        &angles,
+        &[ring(0.0, bottom_diameter), ring(height, top_diameter)],
+    )
+}
+
+/// A cylinder of diameter `d` and height `h` standing on Z = 0 `[mm]`.
+pub fn cylinder(d: f64, h: f64) -> Mesh {
+    frustum(d, d, h)
+}
+
+/// Radius of an axis-centred rectangle `a × b` (along X × Y) at `angle`.
+fn rectangle_radius(a: f64, b: f64, angle: f64) -> f64 {
+    let (s, c) = angle.sin_cos();
+    let rx = if c.abs() > 1e-15 {
+        a / 2.0 / c.abs()
+    } else {
+        f64::INFINITY
+    };
+    let ry = if s.abs() > 1e-15 {
+        b / 2.0 / s.abs()
+    } else {
+        f64::INFINITY
+    };
+    rx.min(ry)
+}
+
+fn rectangle_corners(a: f64, b: f64) -> [f64; 4] {
+    let c = (b / 2.0).atan2(a / 2.0);
+    [c, PI - c, PI + c, TAU - c]
+}
+
+/// A rectangular prism `a × b × h` (along X, Y, Z) standing on Z = 0, centred on the Z axis.
+///
+/// Its side faces are exact planes (extra vertices on them are collinear), with vertices at
+/// every [`RING_SEGMENTS`] angle like the other objects.
+pub fn prism(a: f64, b: f64, h: f64) -> Mesh {
+    let angles = with_angles(uniform_angles(RING_SEGMENTS), &rectangle_corners(a, b));
+    let radii: Vec<f64> = angles.iter().map(|&t| rectangle_radius(a, b, t)).collect();
+    radial_solid(
+        &angles,
+        &[
+            Ring {
+                z: 0.0,
+                radii: radii.clone(),
+            },
+            Ring { z: h, radii },
+        ],
+    )
+}
+
+/// Dimensions of the rebuilt chapter 4 test object `[mm]` (thesis 4.2–4.3, Fig. 4.1 lost).
+///
+/// From the text: total height 175; a prismatic base whose top edge is ungraspable at Z = 12; a
+/// tapered cylinder narrowing towards the base; a horizontal ridge whose sharp edges are at about
+/// Z = 95 and 107 (the palm-blocked band of Fig. 4.7 starts at 94.5 and ends at 157 = 107 + 50);
+/// an untapered cylinder above; a vertical ridge. Chosen here (not in the text): the diameters,
+/// set so the palm pitch on the taper is about the reported 7.3° and the joint angles fall in the
+/// cup's range; the vertical ridge faces +X (approach angle 0), so it must push the approach
+/// angle away from 0.
+#[derive(Debug, Clone, Copy)]
+pub struct Chapter4Dims {
+    /// Side of the square base.
+    pub base_side: f64,
+    /// Height of the base's top.
+    pub base_top: f64,
+    /// Tapered cylinder diameter at the base's top.
+    pub taper_bottom_diameter: f64,
+    /// Tapered cylinder diameter at the ridge.
+    pub taper_top_diameter: f64,
+    /// Horizontal ridge bottom and top heights.
+    pub ridge_z: (f64, f64),
+    /// Horizontal ridge diameter.
+    pub ridge_diameter: f64,
+    /// Upper (untapered) cylinder diameter.
+    pub upper_diameter: f64,
+    /// Total height.
+    pub height: f64,
+    /// Vertical ridge: angle of its centre from +X (degrees), half-width of its flat top
+    /// (degrees), and how far it stands out from the surface below it.
+    pub rib_angle_deg: f64,
+    /// Half-width of the vertical ridge's flat top `[deg]`.
+    pub rib_half_width_deg: f64,
+    /// Height of the vertical ridge above the surface.
+    pub rib_height: f64,
+}
+
+impl Default for Chapter4Dims {
+    fn default() -> Self {
+        Chapter4Dims {
+            base_side: 90.0,
+            base_top: 12.0,
+            taper_bottom_diameter: 64.0,
+            taper_top_diameter: 86.0,
+            ridge_z: (95.0, 107.0),
+            ridge_diameter: 100.0,
+            upper_diameter: 80.0,
+            height: 175.0,
+            rib_angle_deg: 0.0,
+            rib_half_width_deg: 5.0,
+            rib_height: 8.0,
+        }
+    }
+}
+
+/// The chapter 4 test object rebuilt from the text (see [`Chapter4Dims`]).
+pub fn chapter4(d: &Chapter4Dims) -> Mesh {
+    let rib_c = d.rib_angle_deg.to_radians();
+    let half = d.rib_half_width_deg.to_radians();
+    // The rib's sides slope over 1° so that no two rings coincide at its edges.
+    let foot = half + 1f64.to_radians();
+    let angles = with_angles(
+        uniform_angles(RING_SEGMENTS),
+        &[rib_c - foot, rib_c - half, rib_c + half, rib_c + foot]
+            .into_iter()
+            .chain(rectangle_corners(d.base_side, d.base_side))
+            .collect::<Vec<_>>(),
+    );
+    let rib = |t: f64| -> f64 {
+        let delta = ((t - rib_c + PI).rem_euclid(TAU) - PI).abs();
+        if delta <= half + 1e-12 {
+            d.rib_height
+        } else if delta < foot {
+            d.rib_height * (foot - delta) / (foot - half)
+        } else {
+            0.0
+        }
+    };
+    let round = |z: f64, radius: f64| Ring {
+        z,
+        radii: angles.iter().map(|&t| radius + rib(t)).collect(),
+    };
+    let square = |z: f64| Ring {
+        z,
+        radii: angles
+            .iter()
+            .map(|&t| rectangle_radius(d.base_side, d.base_side, t))
+            .collect(),
+    };
+    radial_solid(
+        &angles,
+        &[
+            square(0.0),
+            square(d.base_top),
+            round(d.base_top, d.taper_bottom_diameter / 2.0),
+            round(d.ridge_z.0, d.taper_top_diameter / 2.0),
+            round(d.ridge_z.0, d.ridge_diameter / 2.0),
+            round(d.ridge_z.1, d.ridge_diameter / 2.0),
+            round(d.ridge_z.1, d.upper_diameter / 2.0),
+            round(d.height, d.upper_diameter / 2.0),
+        ],
+    )
+}
+
+/// A UV sphere of radius `r` centred at the origin, `n` segments around and `n / 2` from pole to
+/// pole. Every vertex lies exactly on the sphere.
+pub fn uv_sphere(r: f64, n: usize) -> Mesh {
+    let stacks = n / 2;
+    let mut soup = Vec::new();
+    let p = |i: usize, k: usize| {
+        let phi = PI * i as f64 / stacks as f64;
+        let th = TAU * (k % n) as f64 / n as f64;
+        Point3::new(
+            r * phi.sin() * th.cos(),
+            r * phi.sin() * th.sin(),
+            r * phi.cos(),
+        )
+    };
+    for i in 0..stacks {
+        for k in 0..n {
+            let (a, b, c, d) = (p(i, k), p(i, k + 1), p(i + 1, k + 1), p(i + 1, k));
+            if i != 0 {
+                soup.push([a, d, b]);
+            }
+            if i != stacks - 1 {
+                soup.push([b, d, c]);
+            }
+        }
+    }
+    // Poles are single points: snap the zero-radius rings so the welding merges them.
+    for t in &mut soup {
+        for q in t.iter_mut() {
+            if q.x.abs() < 1e-12 && q.y.abs() < 1e-12 {
+                *q = Point3::new(0.0, 0.0, q.z.signum() * r);
+            }
+        }
+    }
+    Mesh::from_triangles(&soup).0
+}
+
+/// A tube (a cylinder with a coaxial through-hole) standing on Z = 0 `[mm]`.
+pub fn tube(inner_diameter: f64, outer_diameter: f64, height: f64, n: usize) -> Mesh {
+    let (ri, ro) = (inner_diameter / 2.0, outer_diameter / 2.0);
+    let at = |r: f64, k: usize, z: f64| {
+        let t = TAU * (k % n) as f64 / n as f64;
+        Point3::new(r * t.cos(), r * t.sin(), z)
+    };
+    let mut soup = Vec::new();
+    for k in 0..n {
+        let k1 = k + 1;
+        // Outer wall, outward.
+        soup.push([at(ro, k, 0.0), at(ro, k1, 0.0), at(ro, k1, height)]);
+        soup.push([at(ro, k, 0.0), at(ro, k1, height), at(ro, k, height)]);
+        // Inner wall, facing the axis.
+        soup.push([at(ri, k, 0.0), at(ri, k1, height), at(ri, k1, 0.0)]);
+        soup.push([at(ri, k, 0.0), at(ri, k, height), at(ri, k1, height)]);
+        // Top annulus (+Z) and bottom annulus (−Z).
+        soup.push([at(ri, k, height), at(ro, k, height), at(ro, k1, height)]);
+        soup.push([at(ri, k, height), at(ro, k1, height), at(ri, k1, height)]);
+        soup.push([at(ri, k, 0.0), at(ro, k1, 0.0), at(ro, k, 0.0)]);
+        soup.push([at(ri, k, 0.0), at(ri, k1, 0.0), at(ro, k1, 0.0)]);
+    }
+    Mesh::from_triangles(&soup).0
+}
+
+/// A square pyramid with base side `a` on Z = 0 and apex at height `h` (thesis Fig. 3.3).
+pub fn pyramid(a: f64, h: f64) -> Mesh {
+    let s = a / 2.0;
+    let b = [
+        Point3::new(s, s, 0.0),
+        Point3::new(-s, s, 0.0),
+        Point3::new(-s, -s, 0.0),
+        Point3::new(s, -s, 0.0),
+    ];
+    let apex = Point3::new(0.0, 0.0, h);
+    let mut soup = vec![[b[0], b[2], b[1]], [b[0], b[3], b[2]]];
+    for k in 0..4 {
+        soup.push([b[k], b[(k + 1) % 4], apex]);
+    }
+    Mesh::from_triangles(&soup).0
+}
+
+/// The thesis objects by their asset names, as written by `grasp-sim gen-assets`.
+pub fn thesis_objects() -> Vec<(&'static str, Mesh)> {
+    vec![
+        ("prism", prism(15.0, 30.0, 124.0)),
+        ("cylinder_d10", cylinder(10.0, 124.0)),
+        ("cylinder_d40", cylinder(40.0, 124.0)),
+        ("cylinder_d60", cylinder(60.0, 124.0)),
+        ("cup", frustum(56.0, 80.0, 110.0)),
+        ("cup_inverted", frustum(80.0, 56.0, 110.0)),
+        ("chapter4", chapter4(&Chapter4Dims::default())),
+    ]
+}

@@ -1,0 +1,507 @@
+//! Scenario files (TOML): what to grasp, with which hand, planner and physics settings, and what
+//! outcome to expect (DESIGN.md section 6).
+//!
+//! Paths in a scenario are relative to the scenario file. Every section but `[object]` and
+//! `[hand]` is optional and defaults to the thesis's values. Unknown keys and wrong types are
+//! errors naming the file, the line and the key. Units are in the key names: millimetres, degrees,
+//! kilograms, seconds, newton-metres.
+
+use crate::hand::{Hand, HandError};
+use crate::mesh::LengthUnit;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// Problems with a scenario file.
+#[derive(Debug, thiserror::Error)]
+pub enum ScenarioError {
+    /// The file could not be read.
+    #[error("{path}: cannot read scenario: {message}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        message: String,
+    },
+    /// Bad TOML, an unknown key or a wrong type.
+    #[error("{path}: {message}")]
+    Parse {
+        /// The file.
+        path: PathBuf,
+        /// One line: where, which key, what.
+        message: String,
+    },
+    /// A value out of range, or values that contradict each other.
+    #[error("{path}: `{key}` {problem}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// The dotted key.
+        key: String,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The hand file named by the scenario is bad.
+    #[error(transparent)]
+    Hand(#[from] HandError),
+}
+
+/// A parsed, validated scenario with paths resolved.
+#[derive(Debug, Clone)]
+pub struct Scenario {
+    /// The scenario file.
+    pub path: PathBuf,
+    /// Its name (the file stem when `name` is not given).
+    pub name: String,
+    /// The object.
+    pub object: ObjectSpec,
+    /// The hand, loaded, with the scenario's overrides applied.
+    pub hand: Hand,
+    /// The hand file.
+    pub hand_file: PathBuf,
+    /// Planner parameters.
+    pub planner: PlannerParams,
+    /// Physics check parameters.
+    pub sim: SimParams,
+    /// What the run should show.
+    pub expect: Expect,
+}
+
+/// The object to grasp.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ObjectSpec {
+    /// The STL file, resolved against the scenario's folder.
+    pub mesh: PathBuf,
+    /// The STL's length unit.
+    pub units: LengthUnit,
+    /// How the mass is given.
+    pub mass: MassSpec,
+    /// Coulomb friction coefficient between hand and object (thesis: 0.3).
+    pub friction: f64,
+}
+
+/// The object's mass, from a density or given outright.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MassSpec {
+    /// Uniform density `[kg/m³]`.
+    Density(f64),
+    /// Total mass `[kg]`.
+    Mass(f64),
+}
+
+/// Planner parameters (thesis chapter 3); defaults reproduce the thesis.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlannerParams {
+    /// HeightStep between indexed elevations `[mm]`; must divide the finger gap (3.4.2).
+    pub height_step_mm: f64,
+    /// AngularStep between vertical slices and approach angles `[deg]`; must divide 360.
+    pub angular_step_deg: f64,
+    /// Curvature significance factor Sf_c; Sf_t = 1 − Sf_c (eq. 3.4).
+    pub sf_c: f64,
+    /// Vertical Deviation Range: slopes within ± this count as vertical `[deg]` (3.4.3.1).
+    pub vertical_deviation_deg: f64,
+    /// Segments counted before and after a touch point for the angular trend (3.4.3.1).
+    pub curvature_segments: usize,
+    /// Magnify_Factor: the thesis's largest graspable diameter is this × the smallest (eq. 3.3).
+    pub magnify_factor: f64,
+    /// Joint Angular Deviation for joint 1 between a finger's ALS `[deg]` (Table 3.2).
+    pub joint_deviation_theta1_deg: f64,
+    /// Joint Angular Deviation for joint 2 `[deg]` (Table 3.2).
+    pub joint_deviation_theta2_deg: f64,
+    /// Largest palm pitch tried either way when placing the palm `[deg]` (3.5.2).
+    pub pitch_range_deg: f64,
+}
+
+impl Default for PlannerParams {
+    fn default() -> Self {
+        PlannerParams {
+            height_step_mm: 2.5,
+            angular_step_deg: 10.0,
+            sf_c: 0.6,
+            vertical_deviation_deg: 12.0,
+            curvature_segments: 3,
+            magnify_factor: 9.0,
+            joint_deviation_theta1_deg: 5.0,
+            joint_deviation_theta2_deg: 5.0,
+            pitch_range_deg: 20.0,
+        }
+    }
+}
+
+/// Gravity directions for the hold test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GravityMode {
+    /// −Z of the aligned object frame (the thesis's weight direction).
+    Down,
+    /// ±X, ±Y, ±Z in turn (as DexGraspNet and BODex test).
+    Six,
+}
+
+/// Physics check parameters (DESIGN.md section 5); used by the physics check.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SimParams {
+    /// Gravity direction(s).
+    pub gravity: GravityMode,
+    /// Hold time per gravity direction `[s]`.
+    pub duration_s: f64,
+    /// Physics timestep `[s]`.
+    pub timestep_s: f64,
+    /// Motor targets close this far past the planned joint angles `[deg]`.
+    pub squeeze_deg: f64,
+    /// Joint motor torque limit `[N·m]`.
+    pub torque_limit_nm: f64,
+    /// Largest translation relative to the palm that still counts as `hold` `[mm]`.
+    pub hold_translation_mm: f64,
+    /// Largest rotation relative to the palm that still counts as `hold` `[deg]`.
+    pub hold_rotation_deg: f64,
+}
+
+impl Default for SimParams {
+    fn default() -> Self {
+        SimParams {
+            gravity: GravityMode::Down,
+            duration_s: 2.0,
+            timestep_s: 1.0 / 480.0,
+            squeeze_deg: 10.0,
+            torque_limit_nm: 1.0,
+            hold_translation_mm: 5.0,
+            hold_rotation_deg: 5.0,
+        }
+    }
+}
+
+/// Expected outcome of a scenario.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Outcome {
+    /// Planned, and the object stays within the hold thresholds.
+    Hold,
+    /// Planned, and the object moves beyond the thresholds but stays in the hand.
+    Slip,
+    /// Planned, and the object leaves the hand.
+    Drop,
+    /// The planner finds no kinematically feasible grasp.
+    Ungraspable,
+}
+
+impl Outcome {
+    /// The lower-case name used in TOML and JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Outcome::Hold => "hold",
+            Outcome::Slip => "slip",
+            Outcome::Drop => "drop",
+            Outcome::Ungraspable => "ungraspable",
+        }
+    }
+}
+
+/// What a scenario expects, with optional reference values for the planned grasp.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Expect {
+    /// Expected outcome.
+    pub outcome: Outcome,
+    /// Reference approach angle `[deg]` (matched exactly).
+    pub approach_angle_deg: Option<f64>,
+    /// Reference palm pitch `[deg]`.
+    pub palm_pitch_deg: Option<f64>,
+    /// Reference Finger_1 elevation index.
+    pub elevation_index: Option<i64>,
+    /// Reference joint angles `[θ1, θ2]` per finger, in hand order `[deg]`.
+    pub theta_deg: Option<Vec<[f64; 2]>>,
+    /// Tolerance on the elevation index (DESIGN.md: ±2).
+    #[serde(default = "default_index_tolerance")]
+    pub index_tolerance: i64,
+    /// Tolerance on the palm pitch `[deg]` (DESIGN.md: ±1.5°).
+    #[serde(default = "default_pitch_tolerance")]
+    pub pitch_tolerance_deg: f64,
+    /// Tolerance on joint angles `[deg]` (DESIGN.md: ±3°).
+    #[serde(default = "default_theta_tolerance")]
+    pub theta_tolerance_deg: f64,
+}
+
+fn default_index_tolerance() -> i64 {
+    2
+}
+fn default_pitch_tolerance() -> f64 {
+    1.5
+}
+fn default_theta_tolerance() -> f64 {
+    3.0
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScenario {
+    name: Option<String>,
+    description: Option<String>,
+    object: RawObject,
+    hand: RawHand,
+    #[serde(default)]
+    planner: PlannerParams,
+    #[serde(default)]
+    sim: SimParams,
+    expect: Expect,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawObject {
+    mesh: PathBuf,
+    #[serde(default)]
+    units: LengthUnit,
+    density_kg_m3: Option<f64>,
+    mass_kg: Option<f64>,
+    #[serde(default = "default_friction")]
+    friction: f64,
+}
+
+fn default_friction() -> f64 {
+    0.3
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawHand {
+    file: PathBuf,
+    #[serde(default)]
+    overrides: BTreeMap<String, f64>,
+}
+
+/// Default density when neither density nor mass is given `[kg/m³]` (DexGraspNet, Get a Grip).
+pub const DEFAULT_DENSITY_KG_M3: f64 = 500.0;
+
+impl Scenario {
+    /// Reads, parses and validates a scenario, and loads its hand file.
+    ///
+    /// # Errors
+    /// [`ScenarioError`] naming the scenario (or hand) file and the problem.
+    pub fn load(path: &Path) -> Result<Scenario, ScenarioError> {
+        if path.is_dir() {
+            return Err(ScenarioError::Io {
+                path: path.to_path_buf(),
+                message: "is a directory, not a scenario file".to_string(),
+            });
+        }
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
+            path: path.to_path_buf(),
+            message: io_message(&e),
+        })?;
+        Scenario::parse(&text, path)
+    }
+
+    /// Parses scenario TOML; relative paths resolve against `path`'s folder.
+    ///
+    /// # Errors
+    /// As [`Scenario::load`].
+    pub fn parse(text: &str, path: &Path) -> Result<Scenario, ScenarioError> {
+        let raw: RawScenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
+            path: path.to_path_buf(),
+            message: toml_message(&e, text),
+        })?;
+        let _ = raw.description;
+        let invalid = |key: &str, problem: String| ScenarioError::Invalid {
+            path: path.to_path_buf(),
+            key: key.to_string(),
+            problem,
+        };
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let o = raw.object;
+        let mass = match (o.density_kg_m3, o.mass_kg) {
+            (Some(_), Some(_)) => {
+                return Err(invalid(
+                    "object.mass_kg",
+                    "and `object.density_kg_m3` are both given; give one".to_string(),
+                ))
+            }
+            (Some(d), None) => MassSpec::Density(d),
+            (None, Some(m)) => MassSpec::Mass(m),
+            (None, None) => MassSpec::Density(DEFAULT_DENSITY_KG_M3),
+        };
+        match mass {
+            MassSpec::Density(d) if !(d.is_finite() && d > 0.0) => {
+                return Err(invalid(
+                    "object.density_kg_m3",
+                    format!("must be positive, got {d}"),
+                ))
+            }
+            MassSpec::Mass(m) if !(m.is_finite() && m > 0.0) => {
+                return Err(invalid(
+                    "object.mass_kg",
+                    format!("must be positive, got {m}"),
+                ))
+            }
+            _ => {}
+        }
+        // Coulomb friction between a hand and an object: 0 is frictionless; rubber on rubber
+        // rarely exceeds ~1.5, so 2 bounds any plausible value.
+        if !(o.friction.is_finite() && o.friction > 0.0 && o.friction <= 2.0) {
+            return Err(invalid(
+                "object.friction",
+                format!("must be in (0, 2], got {}", o.friction),
+            ));
+        }
+        let hand_file = dir.join(&raw.hand.file);
+        let overrides: Vec<(String, f64)> = raw.hand.overrides.into_iter().collect();
+        let hand = Hand::load(&hand_file, &overrides).map_err(|e| match e {
+            // The override was written in the scenario: name the scenario.
+            HandError::BadOverride {
+                path: hand,
+                key,
+                problem,
+            } => ScenarioError::Invalid {
+                path: path.to_path_buf(),
+                key: format!("hand.overrides.\"{key}\""),
+                problem: format!("{problem} ({})", hand.display()),
+            },
+            other => other.into(),
+        })?;
+
+        let p = &raw.planner;
+        let step = p.height_step_mm;
+        if !(step.is_finite() && step > 0.0) {
+            return Err(invalid(
+                "planner.height_step_mm",
+                format!("must be positive, got {step}"),
+            ));
+        }
+        let ratio = hand.fingers.gap_mm / step;
+        if (ratio - ratio.round()).abs() > 1e-9 * ratio.max(1.0) {
+            return Err(invalid(
+                "planner.height_step_mm",
+                format!(
+                    "must divide the finger gap of {} mm evenly (thesis 3.4.2), got {step}",
+                    hand.fingers.gap_mm
+                ),
+            ));
+        }
+        let a = p.angular_step_deg;
+        let turns = 360.0 / a;
+        if !(a.is_finite() && a > 0.0 && a <= 360.0 && (turns - turns.round()).abs() < 1e-9) {
+            return Err(invalid(
+                "planner.angular_step_deg",
+                format!("must divide 360 evenly (thesis 3.5), got {a}"),
+            ));
+        }
+        if !(0.0..=1.0).contains(&p.sf_c) {
+            return Err(invalid(
+                "planner.sf_c",
+                format!("must be in [0, 1], got {}", p.sf_c),
+            ));
+        }
+        let friction_cone_deg = o.friction.atan().to_degrees();
+        if !(p.vertical_deviation_deg >= 0.0 && p.vertical_deviation_deg < friction_cone_deg) {
+            return Err(invalid(
+                "planner.vertical_deviation_deg",
+                format!(
+                    "must be in [0, {friction_cone_deg:.1}) (below the friction cone of mu = {}), got {}",
+                    o.friction, p.vertical_deviation_deg
+                ),
+            ));
+        }
+        if p.curvature_segments == 0 {
+            return Err(invalid(
+                "planner.curvature_segments",
+                "must be at least 1".to_string(),
+            ));
+        }
+        for (key, v) in [
+            ("planner.magnify_factor", p.magnify_factor),
+            (
+                "planner.joint_deviation_theta1_deg",
+                p.joint_deviation_theta1_deg,
+            ),
+            (
+                "planner.joint_deviation_theta2_deg",
+                p.joint_deviation_theta2_deg,
+            ),
+            ("planner.pitch_range_deg", p.pitch_range_deg),
+        ] {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(invalid(key, format!("must be zero or positive, got {v}")));
+            }
+        }
+        let s = &raw.sim;
+        for (key, v) in [
+            ("sim.duration_s", s.duration_s),
+            ("sim.timestep_s", s.timestep_s),
+            ("sim.torque_limit_nm", s.torque_limit_nm),
+            ("sim.hold_translation_mm", s.hold_translation_mm),
+            ("sim.hold_rotation_deg", s.hold_rotation_deg),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(invalid(key, format!("must be positive, got {v}")));
+            }
+        }
+        if !s.squeeze_deg.is_finite() || s.squeeze_deg < 0.0 {
+            return Err(invalid(
+                "sim.squeeze_deg",
+                format!("must be zero or positive, got {}", s.squeeze_deg),
+            ));
+        }
+        if let Some(t) = &raw.expect.theta_deg {
+            if t.len() != hand.finger_list.len() {
+                return Err(invalid(
+                    "expect.theta_deg",
+                    format!(
+                        "has {} fingers, the hand has {}",
+                        t.len(),
+                        hand.finger_list.len()
+                    ),
+                ));
+            }
+        }
+        let name = raw.name.unwrap_or_else(|| {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        });
+        Ok(Scenario {
+            path: path.to_path_buf(),
+            name,
+            object: ObjectSpec {
+                mesh: dir.join(o.mesh),
+                units: o.units,
+                mass,
+                friction: o.friction,
+            },
+            hand,
+            hand_file,
+            planner: raw.planner,
+            sim: raw.sim,
+            expect: raw.expect,
+        })
+    }
+}
+
+/// A short, stable description of an I/O error.
+pub(crate) fn io_message(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".to_string(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
+        std::io::ErrorKind::InvalidData => "not UTF-8 text".to_string(),
+        _ => e.to_string(),
+    }
+}
+
+/// One line from a TOML error: `line N: `the line`: message`.
+pub(crate) fn toml_message(e: &toml::de::Error, text: &str) -> String {
+    let message = e.message().replace('\n', " ");
+    match e.span() {
+        Some(span) => {
+            let start = span.start.min(text.len());
+            let line_no = text[..start].matches('\n').count() + 1;
+            let line = text.lines().nth(line_no - 1).unwrap_or("").trim();
+            if line.is_empty() {
+                format!("line {line_no}: {message}")
+            } else {
+                format!("line {line_no} (`{line}`): {message}")
+            }
+        }
+        None => message,
+    }
+}

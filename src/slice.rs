@@ -1,0 +1,365 @@
+//! Plane ∩ mesh: closed contours with projected outward normals (thesis 3.3.1, Fig. 3.2–3.4).
+//!
+//! Input: a [`Mesh`] and a [`Plane`]. Output: a [`Slice`], every contour as an ordered polyline in
+//! the plane's 2D coordinates `(u, v)` `[mm]`, with the outward normal of each segment: the
+//! triangle's normal projected onto the plane and normalised (thesis 3.3.1).
+//!
+//! Robust chaining (why not parry's `intersection_with_local_plane`: the planner also needs each
+//! segment's outward normal and the contour orientation):
+//! - A vertex exactly on the plane counts as above it (symbolic perturbation), so every triangle
+//!   is cut by zero or two of its edges and no case is special. In effect the cut is taken an
+//!   infinitesimal distance on the plane's negative side: a plane lying in a face facing its
+//!   normal (a top cap) gives that face's outline; one lying in a face facing away (a bottom cap)
+//!   gives nothing, as a plane just below the object would.
+//! - A crossing point is identified by its mesh edge, and computed from the edge's vertices in
+//!   index order, so the two triangles sharing an edge produce the bit-identical point.
+//! - A segment is oriented by the triangle's winding, not by geometry, so a zero-length segment
+//!   (a vertex on the plane) still chains; zero-length segments are removed afterwards.
+//!
+//! Orientation: seen from the plane's normal side, an outer boundary runs counter-clockwise
+//! (positive signed area, outward normals on its right) and a hole clockwise.
+
+use crate::mesh::Mesh;
+use nalgebra::{Point2, Point3, Vector2, Vector3};
+use std::collections::{HashMap, HashSet};
+
+/// A cutting plane with an orthonormal in-plane frame.
+///
+/// 2D coordinates are `((p - origin)·u, (p - origin)·v)`; the normal is `u × v`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    /// A point on the plane `[mm]`.
+    pub origin: Point3<f64>,
+    /// First in-plane axis (unit).
+    pub u: Vector3<f64>,
+    /// Second in-plane axis (unit, orthogonal to `u`).
+    pub v: Vector3<f64>,
+}
+
+impl Plane {
+    /// A plane through `origin` spanned by `u` and `v` (orthonormalised: `v` is made orthogonal
+    /// to `u`).
+    ///
+    /// # Panics
+    /// If `u` and `v` are parallel or zero.
+    pub fn new(origin: Point3<f64>, u: Vector3<f64>, v: Vector3<f64>) -> Plane {
+        let u = u.normalize();
+        let v = (v - u * u.dot(&v)).normalize();
+        assert!(
+            u.iter().chain(v.iter()).all(|c| c.is_finite()),
+            "degenerate plane frame"
+        );
+        Plane { origin, u, v }
+    }
+
+    /// The vertical plane through the Z axis at `angle_rad` from +X (thesis 3.4.2, Fig. 3.10).
+    ///
+    /// `u = (cos a, sin a, 0)` points to the slice's right side, `v = +Z` up, so 2D coordinates
+    /// are (signed distance from the axis, elevation).
+    pub fn vertical(angle_rad: f64) -> Plane {
+        let (s, c) = angle_rad.sin_cos();
+        Plane {
+            origin: Point3::origin(),
+            u: Vector3::new(c, s, 0.0),
+            v: Vector3::z(),
+        }
+    }
+
+    /// The horizontal plane at height `z_mm`; 2D coordinates are (x, y).
+    pub fn horizontal(z_mm: f64) -> Plane {
+        Plane {
+            origin: Point3::new(0.0, 0.0, z_mm),
+            u: Vector3::x(),
+            v: Vector3::y(),
+        }
+    }
+
+    /// A finger slice plane (thesis 3.6.2.1): the plane in which a finger line turns about its
+    /// joint axes, through `through`, normal to the palm's up axis after pitching by `pitch_rad`.
+    ///
+    /// The palm approaches along −X; its up axis is `(−sin p, 0, cos p)`, so a negative pitch
+    /// leans the palm's top away from the object (as on the cup, thesis 5.3: −7°). In-plane
+    /// axes: `u` is the pitched +X, `v` is +Y; at zero pitch this is [`Plane::horizontal`].
+    pub fn finger(through: Point3<f64>, pitch_rad: f64) -> Plane {
+        let (s, c) = pitch_rad.sin_cos();
+        Plane {
+            origin: through,
+            u: Vector3::new(c, 0.0, s),
+            v: Vector3::y(),
+        }
+    }
+
+    /// The unit normal `u × v`.
+    pub fn normal(&self) -> Vector3<f64> {
+        self.u.cross(&self.v)
+    }
+
+    /// Signed distance of `p` from the plane along the normal `[mm]`.
+    pub fn distance(&self, p: &Point3<f64>) -> f64 {
+        (p - self.origin).dot(&self.normal())
+    }
+
+    /// The 2D coordinates of `p` (projected onto the plane).
+    pub fn to_2d(&self, p: &Point3<f64>) -> Point2<f64> {
+        let d = p - self.origin;
+        Point2::new(d.dot(&self.u), d.dot(&self.v))
+    }
+
+    /// The 3D point of 2D coordinates `q`.
+    pub fn to_3d(&self, q: &Point2<f64>) -> Point3<f64> {
+        self.origin + self.u * q.x + self.v * q.y
+    }
+}
+
+/// One connected piece of a slice: an ordered polyline with per-segment outward normals.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contour {
+    /// Vertices in order `[mm]`. A closed contour does not repeat its first point.
+    pub points: Vec<Point2<f64>>,
+    /// Outward unit normal of segment `i` (from `points[i]` to `points[i + 1]`, wrapping when
+    /// closed): `points.len()` normals when closed, one fewer when open.
+    pub normals: Vec<Vector2<f64>>,
+    /// True if and only if the contour closes on itself (always, for a closed manifold mesh).
+    pub is_closed: bool,
+}
+
+impl Contour {
+    /// Number of segments.
+    pub fn segment_count(&self) -> usize {
+        self.normals.len()
+    }
+
+    /// Segment `i` as its two endpoints.
+    pub fn segment(&self, i: usize) -> (Point2<f64>, Point2<f64>) {
+        let n = self.points.len();
+        (self.points[i], self.points[(i + 1) % n])
+    }
+
+    /// Shoelace signed area `[mm²]`: positive for a counter-clockwise (outer) boundary, negative
+    /// for a hole; for an open contour, the area closed by the chord.
+    pub fn signed_area(&self) -> f64 {
+        let n = self.points.len();
+        let mut a = 0.0;
+        for i in 0..n {
+            let (p, q) = (self.points[i], self.points[(i + 1) % n]);
+            a += p.x * q.y - q.x * p.y;
+        }
+        0.5 * a
+    }
+
+    /// Returns true if and only if the contour is closed and clockwise: the boundary of a hole.
+    pub fn is_hole(&self) -> bool {
+        self.is_closed && self.signed_area() < 0.0
+    }
+
+    /// Total length `[mm]`.
+    pub fn length(&self) -> f64 {
+        (0..self.segment_count())
+            .map(|i| {
+                let (a, b) = self.segment(i);
+                (b - a).norm()
+            })
+            .sum()
+    }
+}
+
+/// The result of cutting a mesh with a plane.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Slice {
+    /// The cutting plane.
+    pub plane: Plane,
+    /// Every contour, sorted by decreasing absolute area (ties by first point).
+    pub contours: Vec<Contour>,
+    /// Index of the outermost contour: the closed, counter-clockwise contour of largest area;
+    /// `None` when the plane misses the mesh or no contour closes.
+    pub outermost: Option<usize>,
+}
+
+impl Slice {
+    /// Returns true if and only if the plane missed the mesh.
+    pub fn is_empty(&self) -> bool {
+        self.contours.is_empty()
+    }
+}
+
+/// A mesh edge as its two vertex indices, smaller first.
+type Edge = (u32, u32);
+
+/// A cut through one triangle: it enters the triangle across `from` and leaves across `to`.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    from: Edge,
+    to: Edge,
+    triangle: usize,
+}
+
+/// Contour segments shorter than this are merged away `[mm]`.
+const TINY_SEGMENT_MM: f64 = 1e-9;
+
+/// Cuts `mesh` with `plane`.
+pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
+    let n = plane.normal();
+    let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
+    let above = |i: u32| dist[i as usize] >= 0.0;
+
+    let mut segments: Vec<Segment> = Vec::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        let s = [above(tri[0]), above(tri[1]), above(tri[2])];
+        if s[0] == s[1] && s[1] == s[2] {
+            continue;
+        }
+        // The lone vertex: the one whose side differs from both others.
+        let k = if s[1] == s[2] {
+            0
+        } else if s[0] == s[2] {
+            1
+        } else {
+            2
+        };
+        let (a, next, prev) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        let e_next = edge(a, next);
+        let e_prev = edge(prev, a);
+        // Lone vertex above: the segment runs from the edge to `next` to the edge from `prev`;
+        // below, the other way. This makes the direction n × (triangle normal).
+        let (from, to) = if s[k] {
+            (e_next, e_prev)
+        } else {
+            (e_prev, e_next)
+        };
+        segments.push(Segment {
+            from,
+            to,
+            triangle: t,
+        });
+    }
+
+    let point = |e: Edge| -> Point3<f64> {
+        let (i, j) = e;
+        let (di, dj) = (dist[i as usize], dist[j as usize]);
+        let (pi, pj) = (mesh.vertices[i as usize], mesh.vertices[j as usize]);
+        if di == 0.0 {
+            pi
+        } else if dj == 0.0 {
+            pj
+        } else {
+            let t = di / (di - dj);
+            pi + (pj - pi) * t
+        }
+    };
+
+    let mut by_from: HashMap<Edge, usize> = HashMap::with_capacity(segments.len());
+    let mut ends: HashSet<Edge> = HashSet::with_capacity(segments.len());
+    for (i, s) in segments.iter().enumerate() {
+        by_from.entry(s.from).or_insert(i);
+        ends.insert(s.to);
+    }
+
+    // Open chains first (from segments nothing leads into), then the closed loops that remain.
+    let mut used = vec![false; segments.len()];
+    let mut contours = Vec::new();
+    let has_predecessor = |i: usize| ends.contains(&segments[i].from);
+    let starts = (0..segments.len())
+        .filter(|&i| !has_predecessor(i))
+        .chain(0..segments.len());
+    for first in starts {
+        if used[first] {
+            continue;
+        }
+        let mut chain = Vec::new();
+        let mut cur = first;
+        let mut is_closed = false;
+        loop {
+            used[cur] = true;
+            chain.push(cur);
+            match by_from.get(&segments[cur].to) {
+                Some(&nx) if nx == first => {
+                    is_closed = true;
+                    break;
+                }
+                Some(&nx) if !used[nx] => cur = nx,
+                _ => break,
+            }
+        }
+        contours.push(build_contour(
+            &chain, &segments, &point, mesh, plane, &n, is_closed,
+        ));
+    }
+    contours.retain(|c| c.points.len() >= 2 && !c.normals.is_empty());
+    contours.sort_by(|a, b| {
+        b.signed_area()
+            .abs()
+            .total_cmp(&a.signed_area().abs())
+            .then(a.points[0].x.total_cmp(&b.points[0].x))
+            .then(a.points[0].y.total_cmp(&b.points[0].y))
+    });
+    let outermost = contours
+        .iter()
+        .position(|c| c.is_closed && c.signed_area() > 0.0);
+    Slice {
+        plane: *plane,
+        contours,
+        outermost,
+    }
+}
+
+fn edge(a: u32, b: u32) -> Edge {
+    (a.min(b), a.max(b))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn build_contour(
+    chain: &[usize],
+    segments: &[Segment],
+    point: &impl Fn(Edge) -> Point3<f64>,
+    mesh: &Mesh,
+    plane: &Plane,
+    n: &Vector3<f64>,
+    is_closed: bool,
+) -> Contour {
+    let mut points: Vec<Point2<f64>> = Vec::with_capacity(chain.len() + 1);
+    let mut normals: Vec<Vector2<f64>> = Vec::with_capacity(chain.len());
+    for &s in chain {
+        let seg = segments[s];
+        points.push(plane.to_2d(&point(seg.from)));
+        let m = mesh.area_normal(seg.triangle);
+        let m2 = Vector2::new(m.dot(&plane.u), m.dot(&plane.v));
+        normals.push(if m2.norm() > 1e-12 * m.norm() {
+            m2.normalize()
+        } else {
+            // A triangle almost parallel to the plane: its projection says nothing; use the
+            // perpendicular of the travel direction, which is outward by construction.
+            let dir = n.cross(&m);
+            Vector2::new(dir.dot(&plane.v), -dir.dot(&plane.u))
+                .try_normalize(0.0)
+                .unwrap_or_else(Vector2::x)
+        });
+    }
+    if !is_closed {
+        let last = *chain.last().expect("a chain has a segment");
+        points.push(plane.to_2d(&point(segments[last].to)));
+    }
+    // Merge tiny segments: drop segment i and one of its two end points, keeping the indexing
+    // of points and normals aligned (segment i runs from points[i] to the next point).
+    let mut i = 0;
+    while normals.len() > 1 && i < normals.len() {
+        let np = points.len();
+        let j = if is_closed { (i + 1) % np } else { i + 1 };
+        if (points[j] - points[i]).norm() <= TINY_SEGMENT_MM {
+            normals.remove(i);
+            // Removing the start of the contour, or the end of an open one, would shift the
+            // segment numbering; remove the (coincident) other end point instead.
+            if j == 0 || (!is_closed && j == np - 1) {
+                points.remove(i);
+            } else {
+                points.remove(j);
+            }
+        } else {
+            i += 1;
+        }
+    }
+    Contour {
+        points,
+        normals,
+        is_closed,
+    }
+}

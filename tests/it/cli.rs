@@ -1,0 +1,316 @@
+//! The built binary: exit codes, JSON Lines, and bad input (exit 2, one line naming the file).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_grasp-sim"))
+}
+
+fn run_in(dir: &Path, args: &[&str]) -> Output {
+    bin()
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("the binary runs")
+}
+
+/// A temp folder with the thesis hand and a scenario pointing at `mesh.stl` beside it.
+struct Env {
+    dir: tempfile::TempDir,
+}
+
+impl Env {
+    fn new() -> Env {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::copy(
+            crate::root().join("assets/hands/thesis.toml"),
+            dir.path().join("hand.toml"),
+        )
+        .unwrap();
+        Env { dir }
+    }
+    fn path(&self, name: &str) -> PathBuf {
+        self.dir.path().join(name)
+    }
+    fn write(&self, name: &str, bytes: impl AsRef<[u8]>) -> PathBuf {
+        let p = self.path(name);
+        std::fs::write(&p, bytes).unwrap();
+        p
+    }
+    fn scenario(&self, name: &str, body: &str) -> PathBuf {
+        self.write(name, body)
+    }
+    fn basic_scenario(&self, mesh: &str, extra: &str) -> PathBuf {
+        self.scenario(
+            "s.toml",
+            &format!(
+                "name = \"t\"\n[object]\nmesh = \"{mesh}\"\n[hand]\nfile = \"hand.toml\"\n{extra}\n[expect]\noutcome = \"hold\"\n"
+            ),
+        )
+    }
+    fn run(&self, args: &[&str]) -> Output {
+        run_in(self.dir.path(), args)
+    }
+}
+
+fn good_mesh() -> Vec<u8> {
+    grasp_sim::objects::cylinder(40.0, 124.0).to_binary_stl()
+}
+
+/// Asserts exit status 2, nothing on stdout, and exactly one stderr line naming `file` and
+/// containing `needle`.
+fn assert_bad_input(out: &Output, file: &str, needle: &str) {
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {err}");
+    assert!(
+        out.stdout.is_empty(),
+        "stdout not empty: {}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 1, "expected one line, got: {err}");
+    assert!(
+        lines[0].contains(file),
+        "message does not name {file}: {err}"
+    );
+    assert!(lines[0].contains(needle), "message lacks {needle:?}: {err}");
+    assert!(
+        !err.contains("panicked") && !err.contains("RUST_BACKTRACE"),
+        "{err}"
+    );
+}
+
+#[test]
+fn bad_meshes_get_one_line_and_exit_2() {
+    let good = good_mesh();
+    let mut truncated = good.clone();
+    truncated.truncate(84 + 50 * 10 + 7);
+    let mut trailing = good.clone();
+    trailing.extend_from_slice(b"junk");
+    let mut nan = good.clone();
+    nan[84 + 12..84 + 16].copy_from_slice(&f32::NAN.to_le_bytes());
+    let mut inf = good.clone();
+    inf[84 + 50 * 3 + 20..84 + 50 * 3 + 24].copy_from_slice(&f32::INFINITY.to_le_bytes());
+    let mut huge = good.clone();
+    huge[84 + 12..84 + 16].copy_from_slice(&1e30f32.to_le_bytes());
+    let mut zero = vec![0u8; 84];
+    zero[80..84].copy_from_slice(&0u32.to_le_bytes());
+    // Only zero-area triangles: every vertex of each triangle the same point.
+    let mut flat = vec![0u8; 84 + 50 * 2];
+    flat[80..84].copy_from_slice(&2u32.to_le_bytes());
+    let single = grasp_sim::mesh::Mesh {
+        vertices: vec![
+            nalgebra::Point3::new(0.0, 0.0, 0.0),
+            nalgebra::Point3::new(10.0, 0.0, 0.0),
+            nalgebra::Point3::new(0.0, 10.0, 0.0),
+        ],
+        triangles: vec![[0, 1, 2]],
+    }
+    .to_binary_stl();
+    let cases: Vec<(&str, Vec<u8>, &str)> = vec![
+        ("empty.stl", vec![], "empty file"),
+        ("text.stl", b"hello, this is not a mesh at all".to_vec(), "not an STL"),
+        ("truncated.stl", truncated, "truncated"),
+        ("trailing.stl", trailing, "trailing bytes"),
+        ("nan.stl", nan, "NaN or infinite"),
+        ("inf.stl", inf, "NaN or infinite"),
+        ("huge.stl", huge, "beyond"),
+        ("zero.stl", zero, "no triangles"),
+        ("flat.stl", flat, "degenerate"),
+        ("single.stl", single, "encloses no volume"),
+        (
+            "ascii_bad_number.stl",
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 abc\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid x\n".to_vec(),
+            "malformed ASCII",
+        ),
+        (
+            "ascii_missing_field.stl",
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid x\n".to_vec(),
+            "malformed ASCII",
+        ),
+        (
+            "ascii_no_endsolid.stl",
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n".to_vec(),
+            "malformed ASCII",
+        ),
+    ];
+    for (name, bytes, needle) in cases {
+        let env = Env::new();
+        env.write(name, &bytes);
+        let s = env.basic_scenario(name, "");
+        let out = env.run(&[s.to_str().unwrap()]);
+        assert_bad_input(&out, name, needle);
+    }
+}
+
+#[test]
+fn missing_mesh_and_directory_get_exit_2() {
+    let env = Env::new();
+    let s = env.basic_scenario("nowhere.stl", "");
+    assert_bad_input(
+        &env.run(&[s.to_str().unwrap()]),
+        "nowhere.stl",
+        "no such file",
+    );
+    std::fs::create_dir(env.path("adir.stl")).unwrap();
+    let s = env.basic_scenario("adir.stl", "");
+    assert_bad_input(&env.run(&[s.to_str().unwrap()]), "adir.stl", "directory");
+    assert_bad_input(&env.run(&["missing.toml"]), "missing.toml", "no such file");
+}
+
+#[test]
+fn bad_scenarios_name_the_file_and_key() {
+    let cases: Vec<(&str, &str)> = vec![
+        ("name = \"t\"\ncolour = \"red\"\n[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"hold\"\n", "colour"),
+        ("[object]\nmesh = \"m.stl\"\nfriction = \"high\"\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"hold\"\n", "friction"),
+        ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[planner]\nsf_c = true\n[expect]\noutcome = \"hold\"\n", "sf_c"),
+        ("[object]\nmesh = \"m.stl\"\nmass_kg = -1.0\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"hold\"\n", "mass_kg"),
+        ("[object]\nmesh = \"m.stl\"\ndensity_kg_m3 = 0.0\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"hold\"\n", "density_kg_m3"),
+        ("[object]\nmesh = \"m.stl\"\nfriction = 5.0\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"hold\"\n", "friction"),
+        ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[planner]\nheight_step_mm = 3.0\n[expect]\noutcome = \"hold\"\n", "finger gap"),
+        ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[planner]\nangular_step_deg = 7.0\n[expect]\noutcome = \"hold\"\n", "divide 360"),
+        ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"wobble\"\n", "wobble"),
+        ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"nohand.toml\"\n[expect]\noutcome = \"hold\"\n", "nohand.toml"),
+        ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\noverrides = { \"phalanx_9.length_mm\" = 3.0 }\n[expect]\noutcome = \"hold\"\n", "hand.overrides.\"phalanx_9.length_mm\""),
+        ("[object\nmesh = \"m.stl\"\n", "line 1"),
+        ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n", "expect"),
+    ];
+    for (body, needle) in cases {
+        let env = Env::new();
+        env.write("m.stl", good_mesh());
+        let s = env.scenario("bad.toml", body);
+        let out = env.run(&[s.to_str().unwrap()]);
+        let file = if needle == "nohand.toml" {
+            "nohand.toml"
+        } else {
+            "bad.toml"
+        };
+        assert_bad_input(&out, file, needle);
+    }
+}
+
+#[test]
+fn a_bad_scenario_after_a_good_one_prints_nothing() {
+    let env = Env::new();
+    env.write("m.stl", good_mesh());
+    let good = env.basic_scenario("m.stl", "");
+    let bad = env.scenario("bad.toml", "[object]\nmesh = \"gone.stl\"\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"hold\"\n");
+    let out = env.run(&["--json", good.to_str().unwrap(), bad.to_str().unwrap()]);
+    assert_bad_input(&out, "gone.stl", "no such file");
+}
+
+#[test]
+fn json_lines_report_the_object_contract() {
+    let root = crate::root();
+    let out = run_in(
+        &root,
+        &[
+            "--json",
+            "--no-sim",
+            "scenarios/cylinder_d40.toml",
+            "scenarios/cup.toml",
+        ],
+    );
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2);
+    let v: serde_json::Value = serde_json::from_str(lines[0]).unwrap();
+    assert_eq!(v["scenario"], "cylinder_d40");
+    let o = &v["object"];
+    assert_eq!(o["triangles"], 576);
+    let vol = o["volume_mm3"].as_f64().unwrap();
+    let expected = std::f64::consts::PI * 400.0 * 124.0;
+    assert!(((vol - expected) / expected).abs() < 0.005, "volume {vol}");
+    assert!((o["height_mm"].as_f64().unwrap() - 124.0).abs() < 1e-9);
+    let axis: Vec<f64> = o["principal_axis"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert!((axis[2] - 1.0).abs() < 1e-12, "{axis:?}");
+    // Stages not built are reported as not run, not invented.
+    assert_eq!(v["plan"]["status"], "not_run");
+    assert_eq!(v["sim"]["verdict"], "not_run");
+    assert!(v["expect"]["met"].is_null());
+    let w: serde_json::Value = serde_json::from_str(lines[1]).unwrap();
+    assert_eq!(w["scenario"], "cup");
+}
+
+#[test]
+fn the_same_scenario_gives_the_same_json() {
+    let root = crate::root();
+    let strip = |o: Output| {
+        let mut v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+        v["plan"]["timings_ms"] = serde_json::Value::Null;
+        v
+    };
+    let a = strip(run_in(&root, &["--json", "scenarios/chapter4.toml"]));
+    let b = strip(run_in(&root, &["--json", "scenarios/chapter4.toml"]));
+    assert_eq!(a, b);
+}
+
+#[test]
+fn every_bundled_scenario_runs() {
+    let root = crate::root();
+    let mut args = vec!["--no-sim".to_string()];
+    for e in std::fs::read_dir(root.join("scenarios")).unwrap() {
+        args.push(e.unwrap().path().to_string_lossy().into_owned());
+    }
+    assert!(args.len() >= 9, "eight thesis scenarios expected");
+    let out = bin().current_dir(&root).args(&args).output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn an_open_mesh_warns_with_the_boundary_edge_count() {
+    // A cylinder with its top cap removed: 144 boundary edges, still encloses volume.
+    let mut mesh = grasp_sim::objects::cylinder(40.0, 124.0);
+    let top = mesh
+        .vertices
+        .iter()
+        .position(|p| p.x == 0.0 && p.y == 0.0 && p.z == 124.0)
+        .unwrap() as u32;
+    mesh.triangles.retain(|t| !t.contains(&top));
+    let env = Env::new();
+    env.write("open.stl", mesh.to_binary_stl());
+    let s = env.basic_scenario("open.stl", "");
+    let out = env.run(&[s.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(
+        err.contains("open.stl") && err.contains("144 boundary edges"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_binary_file_whose_header_says_solid_is_read_as_binary() {
+    let mut bytes = good_mesh();
+    bytes[..80].fill(b' ');
+    bytes[..11].copy_from_slice(b"solid cad x");
+    let env = Env::new();
+    env.write("solid_header.stl", &bytes);
+    let s = env.basic_scenario("solid_header.stl", "");
+    let out = env.run(&["--json", s.to_str().unwrap()]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["object"]["triangles"], 576);
+}

@@ -1,0 +1,11 @@
+//! Integration tests, one binary so the suite links once.
+
+mod cli;
+mod geometry;
+
+use std::path::PathBuf;
+
+/// The repository root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
