@@ -21,12 +21,16 @@
 pub mod hand;
 pub mod mesh;
 pub mod objects;
+pub mod plan;
 pub mod report;
 pub mod scenario;
 pub mod slice;
 
-use report::{ExpectReport, ObjectReport, PlanReport, PoseReport, RunReport, SimReport};
-use scenario::{MassSpec, Scenario};
+use report::{
+    ExpectReport, GradesReport, IndexScale, ObjectReport, PlanReport, PoseReport, RunReport,
+    SimReport,
+};
+use scenario::{MassSpec, Outcome, Scenario};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -85,9 +89,52 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             quaternion_wxyz: [q.w, q.i, q.j, q.k],
         },
     };
+    let graded = plan::grade_domain(
+        &aligned.mesh,
+        &scenario.hand,
+        &scenario.planner,
+        scenario.object.friction,
+        &mut timings,
+    );
+    let is_ungraspable = graded.sorted_indices.is_empty();
+    let (status, reason) = if is_ungraspable {
+        ("ungraspable", graded.reason.clone())
+    } else {
+        (
+            "not_run",
+            Some(format!(
+                "stages 1-3 left {} candidate palm elevations; palm and finger positioning \
+                 (thesis 3.5-3.6) is not built yet",
+                graded.sorted_indices.len()
+            )),
+        )
+    };
+    let g = &graded.grades;
     let plan = PlanReport {
-        status: "not_run".to_string(),
-        reason: Some("the planner stages are not built yet".to_string()),
+        status: status.to_string(),
+        reason,
+        effective_elevation_mm: graded.domain.effective,
+        indexed_elevations: graded.domain.elevations.len(),
+        index_elevation_mm: IndexScale {
+            first: graded.domain.effective[0],
+            step: graded.domain.height_step_mm,
+        },
+        sorted_indices: graded.sorted_indices.clone(),
+        graspable_diameter_mm: graded.range.used(),
+        graspable_diameter_basis: "kinematic".to_string(),
+        thesis_largest_diameter_mm: graded.range.max_thesis_mm,
+        largest_span_mm: graded.largest_span_mm,
+        effective_diameter_mm: graded
+            .diameters_mm
+            .iter()
+            .map(|d| d.is_finite().then_some(*d))
+            .collect(),
+        grades: GradesReport {
+            curvature: g.curvature.clone(),
+            diameter: g.diameter.clone(),
+            combined: g.combined.clone(),
+            palm: g.palm.clone(),
+        },
         timings_ms: timings,
     };
     let sim = SimReport {
@@ -98,11 +145,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             "the physics check is not built yet".to_string()
         }),
     };
-    let expect = ExpectReport {
-        outcome: scenario.expect.outcome.as_str().to_string(),
-        met: None,
-        details: "nothing to judge: no plan and no physics check yet".to_string(),
-    };
+    let expect = judge(scenario.expect.outcome, is_ungraspable);
     Ok(RunReport {
         scenario: scenario.name.clone(),
         object,
@@ -115,6 +158,32 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             .map(|w| format!("{}: {w}", scenario.object.mesh.display()))
             .collect(),
     })
+}
+
+/// Judges what can be judged without palm and finger positioning: an `ungraspable` verdict of
+/// stages 1-3 is final (positioning only removes candidates); a surviving candidate list decides
+/// nothing yet.
+fn judge(expected: Outcome, is_ungraspable: bool) -> ExpectReport {
+    let (met, details) = match (expected, is_ungraspable) {
+        (Outcome::Ungraspable, true) => {
+            (Some(true), "stages 1-3 found no palm position".to_string())
+        }
+        (_, true) => (
+            Some(false),
+            "stages 1-3 found no palm position, so nothing can be grasped".to_string(),
+        ),
+        (_, false) => (
+            None,
+            "stages 1-3 left candidates; the grasp itself is judged once palm and finger \
+             positioning exist"
+                .to_string(),
+        ),
+    };
+    ExpectReport {
+        outcome: expected.as_str().to_string(),
+        met,
+        details,
+    }
 }
 
 fn ms(t: Instant) -> f64 {

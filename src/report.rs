@@ -60,13 +60,55 @@ pub struct PoseReport {
 /// The `plan` part of the report.
 #[derive(Debug, Clone, Serialize)]
 pub struct PlanReport {
-    /// `feasible`, `ungraspable`, or `not_run` while the planner does not run.
+    /// `feasible`, `ungraspable`, or `not_run` while the positioning stages are not built.
     pub status: String,
     /// Why, when not feasible.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// Effective Elevation `[lo, hi]` `[mm]` (stage 1).
+    pub effective_elevation_mm: [f64; 2],
+    /// Number of Indexed Elevations.
+    pub indexed_elevations: usize,
+    /// Elevation of index 1 and the HeightStep: index i is at `first + (i − 1) × step` `[mm]`.
+    pub index_elevation_mm: IndexScale,
+    /// Candidate Finger_1 indices after stage 3, best first.
+    pub sorted_indices: Vec<usize>,
+    /// The graspable diameter range used `[min, max]` `[mm]`.
+    pub graspable_diameter_mm: [f64; 2],
+    /// Where the largest graspable diameter comes from (`kinematic`).
+    pub graspable_diameter_basis: String,
+    /// The thesis's largest graspable diameter, Magnify_Factor × smallest (eq. 3.3), not used.
+    pub thesis_largest_diameter_mm: f64,
+    /// The Largest Span Height (3.4.4.1) `[mm]`.
+    pub largest_span_mm: f64,
+    /// Effective Diameter per index `[mm]` (null where a slice is missed).
+    pub effective_diameter_mm: Vec<Option<f64>>,
+    /// Per-index grade vectors (null where ungraspable).
+    pub grades: GradesReport,
     /// Per-stage wall times `[ms]`.
     pub timings_ms: std::collections::BTreeMap<String, f64>,
+}
+
+/// Index-to-elevation scale.
+#[derive(Debug, Clone, Serialize)]
+pub struct IndexScale {
+    /// Elevation of index 1 `[mm]`.
+    pub first: f64,
+    /// HeightStep `[mm]`.
+    pub step: f64,
+}
+
+/// Per-index grades, index i at position i − 1; null where ungraspable.
+#[derive(Debug, Clone, Serialize)]
+pub struct GradesReport {
+    /// Curvature pattern grades.
+    pub curvature: Vec<Option<f64>>,
+    /// Effective Diameter grades.
+    pub diameter: Vec<Option<f64>>,
+    /// Combined with the significance factors.
+    pub combined: Vec<Option<f64>>,
+    /// Palm grades at Finger_1's index.
+    pub palm: Vec<Option<f64>>,
 }
 
 /// The `sim` part of the report.
@@ -112,9 +154,48 @@ impl RunReport {
             "  Principal axis (original frame) ({:.4}, {:.4}, {:.4})",
             a[0], a[1], a[2]
         );
-        let plan_line = match &self.plan.reason {
-            Some(r) => format!("{} ({r})", self.plan.status),
-            None => self.plan.status.clone(),
+        let p = &self.plan;
+        let _ = writeln!(
+            s,
+            "  Effective elevation {:.1}..{:.1} mm, {} indexed elevations; graspable diameter {:.1}..{:.1} mm ({}; thesis 9x rule {:.1})",
+            p.effective_elevation_mm[0],
+            p.effective_elevation_mm[1],
+            p.indexed_elevations,
+            p.graspable_diameter_mm[0],
+            p.graspable_diameter_mm[1],
+            p.graspable_diameter_basis,
+            p.thesis_largest_diameter_mm
+        );
+        let head: Vec<String> = p
+            .sorted_indices
+            .iter()
+            .take(8)
+            .map(|&i| {
+                format!(
+                    "{i} (Z {:.1})",
+                    p.index_elevation_mm.first + (i - 1) as f64 * p.index_elevation_mm.step
+                )
+            })
+            .collect();
+        let more = p.sorted_indices.len().saturating_sub(8);
+        let _ = writeln!(
+            s,
+            "  Sorted palm indices ({}): {}{}",
+            p.sorted_indices.len(),
+            if head.is_empty() {
+                "none".to_string()
+            } else {
+                head.join(", ")
+            },
+            if more > 0 {
+                format!(", ... {more} more")
+            } else {
+                String::new()
+            }
+        );
+        let plan_line = match &p.reason {
+            Some(r) => format!("{} ({r})", p.status),
+            None => p.status.clone(),
         };
         let _ = writeln!(s, "  Plan        {plan_line}");
         let sim_line = match &self.sim.reason {

@@ -379,6 +379,21 @@ impl Scenario {
                 ),
             ));
         }
+        // Every finger must sit on an indexed elevation when Finger_1 does (thesis 3.4.4.2).
+        let top = hand.finger_list[0].height_mm;
+        for f in &hand.finger_list[1..] {
+            let k = (top - f.height_mm) / step;
+            if (k - k.round()).abs() > 1e-9 * k.abs().max(1.0) {
+                return Err(invalid(
+                    "planner.height_step_mm",
+                    format!(
+                        "must divide the height difference of finger_1 and {} ({} mm), got {step}",
+                        f.name,
+                        top - f.height_mm
+                    ),
+                ));
+            }
+        }
         let a = p.angular_step_deg;
         let turns = 360.0 / a;
         if !(a.is_finite() && a > 0.0 && a <= 360.0 && (turns - turns.round()).abs() < 1e-9) {

@@ -2,6 +2,7 @@
 
 mod cli;
 mod geometry;
+mod planner;
 
 use std::path::PathBuf;
 

@@ -1,0 +1,194 @@
+//! Significance factors (thesis 3.4.3.3) and stage 3 of search-domain reduction (3.4.4).
+//!
+//! - Elevation grade = Sf_c × curvature + (1 − Sf_c) × diameter (eq. 3.4); an elevation
+//!   ungraspable in either is marked ungraspable in both.
+//! - First palm approach check (3.4.4.1): the Largest Span Height (the largest vertical distance
+//!   between two consecutive ungraspable indexed elevations, the ends of the Effective Elevation
+//!   counting as ungraspable one step beyond) must exceed the distance between the outermost
+//!   fingers' centrelines, or the object is ungraspable.
+//! - Palm grade (3.4.4.2), assigned to Finger_1's index: the mean of the elevation grades at the
+//!   fingers' indices. A palm position is blocked when any index from Finger_1's to the lowest
+//!   finger's is ungraspable or outside the Effective Elevation. (The thesis describes this as a
+//!   scan from the top that moves Finger_1 below each ungraspable elevation and marks the skipped
+//!   positions ungraspable; the set of positions that survive is exactly this one.)
+//! - Sorting (3.4.4.3): by palm grade, best first; equal grades (to 1e-9) from the higher
+//!   elevation to the lower.
+
+use super::diameter::DiameterGrades;
+use super::kinematics::GraspableRange;
+use super::{Domain, Grade};
+use crate::hand::Hand;
+use crate::scenario::PlannerParams;
+
+/// Per-index grade vectors (index i at position i − 1), `None` where ungraspable.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Grades {
+    /// Curvature pattern grades (after marking, stage 2).
+    pub curvature: Vec<Grade>,
+    /// Effective Diameter grades (after marking).
+    pub diameter: Vec<Grade>,
+    /// Combined with the significance factors.
+    pub combined: Vec<Grade>,
+    /// Palm grades at Finger_1's index (stage 3).
+    pub palm: Vec<Grade>,
+}
+
+/// The graded, sorted search domain: the output of stages 1–3.
+#[derive(Debug, Clone)]
+pub struct GradedDomain {
+    /// Stage 1.
+    pub domain: Domain,
+    /// Every grade vector.
+    pub grades: Grades,
+    /// Effective Diameter per index `[mm]`.
+    pub diameters_mm: Vec<f64>,
+    /// The hand's graspable diameter range.
+    pub range: GraspableRange,
+    /// Index offsets of each finger below Finger_1, in hand order (Finger_1's is 0).
+    pub finger_offsets: Vec<i64>,
+    /// The Largest Span Height `[mm]`.
+    pub largest_span_mm: f64,
+    /// Candidate Finger_1 indices, best first.
+    pub sorted_indices: Vec<usize>,
+    /// Why nothing survived, when `sorted_indices` is empty.
+    pub reason: Option<String>,
+}
+
+/// Stage 3: combine, check the palm span, grade palm positions and sort them.
+pub fn rank(
+    domain: Domain,
+    curvature: Vec<Grade>,
+    diameter: DiameterGrades,
+    range: GraspableRange,
+    params: &PlannerParams,
+    hand: &Hand,
+) -> GradedDomain {
+    let n = domain.elevations.len();
+    let step = domain.height_step_mm;
+    let mut curv = curvature;
+    let mut diam = diameter.grades;
+    for i in 0..n {
+        if curv[i].is_none() || diam[i].is_none() {
+            curv[i] = None;
+            diam[i] = None;
+        }
+    }
+    let sf = params.sf_c;
+    let combined: Vec<Grade> = (0..n)
+        .map(|i| Some(sf * curv[i]? + (1.0 - sf) * diam[i]?))
+        .collect();
+
+    let top = hand.finger_list[0].height_mm;
+    let finger_offsets: Vec<i64> = hand
+        .finger_list
+        .iter()
+        .map(|f| ((top - f.height_mm) / step).round() as i64)
+        .collect();
+    let spread = *finger_offsets.iter().max().unwrap_or(&0);
+    let low = *finger_offsets.iter().min().unwrap_or(&0);
+
+    // Largest Span Height between consecutive ungraspable indices (ends count one step out).
+    let mut last_bad: i64 = 0;
+    let mut largest = 0i64;
+    for i in 1..=n as i64 + 1 {
+        if i == n as i64 + 1 || combined[(i - 1) as usize].is_none() {
+            largest = largest.max(i - last_bad);
+            last_bad = i;
+        }
+    }
+    let largest_span_mm = largest as f64 * step;
+    let finger_span_mm = (spread - low) as f64 * step;
+
+    let mut palm: Vec<Grade> = vec![None; n];
+    if largest_span_mm > finger_span_mm {
+        for (i0, slot) in palm.iter_mut().enumerate() {
+            let i = i0 as i64;
+            let (lo, hi) = (i - spread, i - low);
+            if lo < 0 || hi >= n as i64 {
+                continue;
+            }
+            if (lo..=hi).any(|j| combined[j as usize].is_none()) {
+                continue;
+            }
+            let sum: f64 = finger_offsets
+                .iter()
+                .map(|&o| combined[(i - o) as usize].unwrap_or(0.0))
+                .sum();
+            *slot = Some(sum / finger_offsets.len() as f64);
+        }
+    }
+    let mut sorted: Vec<(i64, usize)> = palm
+        .iter()
+        .enumerate()
+        .filter_map(|(i, g)| g.map(|g| ((g * 1e9).round() as i64, i + 1)))
+        .collect();
+    sorted.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.cmp(&a.1)));
+    let sorted_indices: Vec<usize> = sorted.into_iter().map(|(_, i)| i).collect();
+
+    let reason = sorted_indices.is_empty().then(|| {
+        explain(
+            &domain,
+            &diameter.diameters_mm,
+            &curv,
+            &combined,
+            range,
+            largest_span_mm,
+            finger_span_mm,
+        )
+    });
+    GradedDomain {
+        domain,
+        grades: Grades {
+            curvature: curv,
+            diameter: diam,
+            combined,
+            palm,
+        },
+        diameters_mm: diameter.diameters_mm,
+        range,
+        finger_offsets,
+        largest_span_mm,
+        sorted_indices,
+        reason,
+    }
+}
+
+fn explain(
+    domain: &Domain,
+    diameters: &[f64],
+    curvature: &[Grade],
+    combined: &[Grade],
+    range: GraspableRange,
+    span: f64,
+    finger_span: f64,
+) -> String {
+    let n = domain.elevations.len();
+    if n == 0 {
+        return "the effective elevation is empty: the object is shorter than twice the finger offset".to_string();
+    }
+    let [lo, hi] = range.used();
+    let thin = diameters.iter().filter(|&&d| d < lo).count();
+    let thick = diameters.iter().filter(|&&d| d > hi).count();
+    let sharp = curvature.iter().filter(|g| g.is_none()).count();
+    let bad = combined.iter().filter(|g| g.is_none()).count();
+    if thin == n {
+        let max = diameters.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        return format!(
+            "too thin: every indexed elevation's effective diameter (at most {max:.1} mm) is below the smallest graspable diameter {lo:.1} mm"
+        );
+    }
+    if thick == n {
+        let min = diameters.iter().copied().fold(f64::INFINITY, f64::min);
+        return format!(
+            "too thick: every indexed elevation's effective diameter (at least {min:.1} mm) is above the largest graspable diameter {hi:.1} mm"
+        );
+    }
+    if span <= finger_span {
+        return format!(
+            "first palm approach check failed: largest span height {span:.1} mm does not exceed the {finger_span:.1} mm between the outer fingers ({bad} of {n} elevations ungraspable: {thin} too thin, {thick} too thick, {sharp} by curvature)"
+        );
+    }
+    format!(
+        "no palm position has all its fingers on graspable elevations ({bad} of {n} ungraspable: {thin} too thin, {thick} too thick, {sharp} by curvature)"
+    )
+}
