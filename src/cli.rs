@@ -27,6 +27,10 @@ pub struct Cli {
     #[arg(long)]
     pub no_sim: bool,
 
+    /// Collect up to N feasible grasps in search order (reported under `plan.grasps`).
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub candidates: u32,
+
     #[command(subcommand)]
     pub command: Option<Command>,
 }

@@ -30,7 +30,10 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
     if let Some(cli::Command::GenAssets { out }) = cli.command {
         return gen_assets(&out).map(|()| 0);
     }
-    let options = RunOptions { no_sim: cli.no_sim };
+    let options = RunOptions {
+        no_sim: cli.no_sim,
+        candidates: cli.candidates as usize,
+    };
     // Everything is run before anything is printed, so bad input anywhere leaves no partial output.
     let mut reports = Vec::new();
     for path in &cli.scenarios {

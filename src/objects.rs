@@ -320,7 +320,8 @@ pub fn pyramid(a: f64, h: f64) -> Mesh {
 /// The thesis objects by their asset names, as written by `grasp-sim gen-assets`.
 pub fn thesis_objects() -> Vec<(&'static str, Mesh)> {
     vec![
-        ("prism", prism(15.0, 30.0, 124.0)),
+        // Widest side along X, as grasp-sim's alignment puts it (see mesh::align).
+        ("prism", prism(30.0, 15.0, 124.0)),
         ("cylinder_d10", cylinder(10.0, 124.0)),
         ("cylinder_d40", cylinder(40.0, 124.0)),
         ("cylinder_d60", cylinder(60.0, 124.0)),

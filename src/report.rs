@@ -85,8 +85,64 @@ pub struct PlanReport {
     pub effective_diameter_mm: Vec<Option<f64>>,
     /// Per-index grade vectors (null where ungraspable).
     pub grades: GradesReport,
+    /// Candidates (elevation × approach angle) tried by the search.
+    pub candidates_tried: usize,
+    /// How often each constraint rejected a candidate.
+    pub rejections: std::collections::BTreeMap<String, usize>,
+    /// The first feasible grasp (the thesis's Grasp Parameter Set).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grasp: Option<GraspReport>,
+    /// With `--candidates N`: up to N feasible grasps in search order (the first is `grasp`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub grasps: Vec<GraspReport>,
     /// Per-stage wall times `[ms]`.
     pub timings_ms: std::collections::BTreeMap<String, f64>,
+}
+
+/// A feasible grasp.
+#[derive(Debug, Clone, Serialize)]
+pub struct GraspReport {
+    /// Approach angle `[deg]`.
+    pub approach_angle_deg: f64,
+    /// Palm pitch `[deg]`, positive when the palm's top leans towards the object.
+    pub palm_pitch_deg: f64,
+    /// Finger_1's elevation index.
+    pub elevation_index: usize,
+    /// Finger_1's elevation `[mm]` (aligned frame).
+    pub elevation_mm: f64,
+    /// Palm pose in the mesh's original frame: the palm centre on its contact surface, and the
+    /// rotation of the palm frame (x away from the object, y towards finger_1's side, z up).
+    pub palm_pose: PoseReport,
+    /// Palm pose in the aligned object frame.
+    pub palm_pose_aligned: PoseReport,
+    /// Per finger, the centre ALS's angles and all three ALS.
+    pub fingers: Vec<FingerReport>,
+}
+
+/// One finger of a grasp.
+#[derive(Debug, Clone, Serialize)]
+pub struct FingerReport {
+    /// Finger name.
+    pub name: String,
+    /// Joint 1 of the centre ALS `[deg]`.
+    pub theta1_deg: f64,
+    /// Joint 2 of the centre ALS `[deg]`.
+    pub theta2_deg: f64,
+    /// `[θ1, θ2]` of the top, centre and bottom ALS `[deg]`.
+    pub als: AlsReport,
+    /// True if and only if the centre ALS's phalanx 2 touches with its tip.
+    pub tip_contact: bool,
+}
+
+/// The three ALS of a finger.
+#[derive(Debug, Clone, Serialize)]
+pub struct AlsReport {
+    /// Top ALS.
+    pub top: [f64; 2],
+    /// Centre ALS.
+    pub centre: [f64; 2],
+    /// Bottom ALS.
+    pub bottom: [f64; 2],
 }
 
 /// Index-to-elevation scale.
@@ -197,7 +253,42 @@ impl RunReport {
             Some(r) => format!("{} ({r})", p.status),
             None => p.status.clone(),
         };
-        let _ = writeln!(s, "  Plan        {plan_line}");
+        let _ = writeln!(
+            s,
+            "  Plan        {plan_line}; {} candidates tried",
+            p.candidates_tried
+        );
+        if let Some(g) = &p.grasp {
+            let _ = writeln!(s, "  Grasp Parameter Set:");
+            let _ = writeln!(s, "    GraspCondition -> Passed");
+            for f in &g.fingers {
+                let _ = writeln!(
+                    s,
+                    "    {} -> theta1 = {:.1} deg  theta2 = {:.1} deg{}",
+                    capitalise(&f.name),
+                    f.theta1_deg,
+                    f.theta2_deg,
+                    if f.tip_contact { "  (tip contact)" } else { "" }
+                );
+            }
+            let _ = writeln!(
+                s,
+                "    ApproachAngle = {:.0} deg  Palm_Pitch_Angle = {:.1} deg",
+                g.approach_angle_deg, g.palm_pitch_deg
+            );
+            let _ = writeln!(
+                s,
+                "    Finger_1 Approach Elevation index = {}  Z = {:.1} mm",
+                g.elevation_index, g.elevation_mm
+            );
+            let pp = &g.palm_pose;
+            let _ = writeln!(
+                s,
+                "    Palm pose (original frame): position ({:.2}, {:.2}, {:.2}) mm, quaternion wxyz ({:.4}, {:.4}, {:.4}, {:.4})",
+                pp.position_mm[0], pp.position_mm[1], pp.position_mm[2],
+                pp.quaternion_wxyz[0], pp.quaternion_wxyz[1], pp.quaternion_wxyz[2], pp.quaternion_wxyz[3]
+            );
+        }
         let sim_line = match &self.sim.reason {
             Some(r) => format!("{} ({r})", self.sim.verdict),
             None => self.sim.verdict.clone(),
@@ -214,5 +305,13 @@ impl RunReport {
             self.expect.outcome, self.expect.details
         );
         s
+    }
+}
+
+fn capitalise(name: &str) -> String {
+    let mut c = name.chars();
+    match c.next() {
+        Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
+        None => String::new(),
     }
 }

@@ -222,6 +222,8 @@ pub struct Expect {
     /// Tolerance on joint angles `[deg]` (DESIGN.md: ±3°).
     #[serde(default = "default_theta_tolerance")]
     pub theta_tolerance_deg: f64,
+    /// Tolerance on θ2 alone, when it must differ from `theta_tolerance_deg` `[deg]`.
+    pub theta2_tolerance_deg: Option<f64>,
 }
 
 fn default_index_tolerance() -> i64 {

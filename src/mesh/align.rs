@@ -10,10 +10,12 @@
 //! 1. Z is the eigenvector of the smallest moment, signed to point along the original +Z (when it
 //!    is perpendicular to it, along the original +X, then +Y).
 //! 2. If the two remaining moments differ (relative difference above 1e-6), X is the eigenvector of
-//!    the largest moment: the object's thinnest direction, across which the palm sees the
-//!    object's broad side. If they are equal (a body of revolution), X is the original X
-//!    projected onto the plane normal to Z (or the original Y, then Z, when that projection
-//!    vanishes).
+//!    the smaller one: the object's widest direction, so a palm approaching along −X at approach
+//!    angle 0 faces the object's narrow side and the fingers wrap its long side. This reproduces
+//!    the thesis's prism grasp (5.1: approach 0, θ1 = 58°): with the palm on the prism's broad
+//!    face, phalanx 1 passes 30 mm beyond the far face and phalanx 2 cannot reach back to it. If
+//!    the moments are equal (a body of revolution), X is the original X projected onto the plane
+//!    normal to Z (or the original Y, then Z, when that projection vanishes).
 //! 3. X is signed to point along the original +X (then +Y, then +Z); Y = Z × X.
 
 use super::{mass_properties, MassProperties, Mesh};
@@ -68,7 +70,7 @@ pub fn align(mesh: &Mesh) -> AlignedObject {
     let (m1, m2) = (moment(1), moment(2));
     let scale = m1.abs().max(m2.abs()).max(f64::MIN_POSITIVE);
     let x_raw = if (m2 - m1).abs() / scale > DEGENERATE_MOMENTS {
-        axis(2)
+        axis(1)
     } else {
         [Vector3::x(), Vector3::y(), Vector3::z()]
             .iter()

@@ -5,6 +5,8 @@
 //! - [`diameter`]: stage 2 (3.4.3.2) — Effective Diameter grades.
 //! - [`kinematics`]: the hand's graspable diameter range (eq. 3.2 and its largest counterpart).
 //! - [`palm_grade`]: significance factors (3.4.3.3) and stage 3 (3.4.4): palm grades, sorting.
+//! - [`palm`]: palm positioning (3.5); [`finger`]: ALS finger positioning (3.6);
+//!   [`search`]: the walk over the sorted domain (3.7).
 //!
 //! Units: millimetres and degrees at the boundary (parameters, reports), radians inside. The
 //! object is in the aligned frame (principal axis +Z, bottom at Z = 0).
@@ -12,8 +14,12 @@
 pub mod curvature;
 pub mod diameter;
 pub mod domain;
+pub mod finger;
+pub mod geom2;
 pub mod kinematics;
+pub mod palm;
 pub mod palm_grade;
+pub mod search;
 
 pub use curvature::{CurvatureParams, SideGrade};
 pub use domain::{Domain, Touch};

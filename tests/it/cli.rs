@@ -236,10 +236,27 @@ fn json_lines_report_the_object_contract() {
         .map(|x| x.as_f64().unwrap())
         .collect();
     assert!((axis[2] - 1.0).abs() < 1e-12, "{axis:?}");
-    // Stages not built are reported as not run, not invented.
-    assert_eq!(v["plan"]["status"], "not_run");
+    // The plan contract; the physics check is reported as not run, not invented.
+    let p = &v["plan"];
+    assert_eq!(p["status"], "feasible");
+    assert_eq!(p["indexed_elevations"], 45);
+    assert_eq!(p["effective_elevation_mm"][0], 7.0);
+    assert!(p["candidates_tried"].as_u64().unwrap() >= 1);
+    assert_eq!(p["sorted_indices"][0], 43);
+    let g = &p["grasp"];
+    assert_eq!(g["elevation_index"], 43);
+    assert_eq!(g["approach_angle_deg"], 0.0);
+    assert_eq!(g["fingers"].as_array().unwrap().len(), 3);
+    for key in ["theta1_deg", "theta2_deg"] {
+        assert!(g["fingers"][0][key].is_number());
+    }
+    assert_eq!(g["fingers"][0]["als"]["top"].as_array().unwrap().len(), 2);
+    assert_eq!(
+        g["palm_pose"]["quaternion_wxyz"].as_array().unwrap().len(),
+        4
+    );
     assert_eq!(v["sim"]["verdict"], "not_run");
-    assert!(v["expect"]["met"].is_null());
+    assert_eq!(v["expect"]["met"], true);
     let w: serde_json::Value = serde_json::from_str(lines[1]).unwrap();
     assert_eq!(w["scenario"], "cup");
 }

@@ -313,8 +313,8 @@ fn a_rotated_shifted_cylinder_is_aligned_back() {
 
 #[test]
 fn an_aligned_object_stays_as_it_is() {
-    // The prism's thinnest direction (15 mm) is X already; alignment must not turn it.
-    let prism = objects::prism(15.0, 30.0, 124.0);
+    // The prism's widest direction (30 mm) is X already; alignment must not turn it.
+    let prism = objects::prism(30.0, 15.0, 124.0);
     let a = align(&prism);
     assert!(
         a.to_aligned.rotation.angle() < 1e-9,
@@ -327,9 +327,13 @@ fn an_aligned_object_stays_as_it_is() {
     let (lo, hi) = b.mesh.bounds();
     let ext = hi - lo;
     assert!(
-        (ext.x - 15.0).abs() < 1e-6 && (ext.y - 30.0).abs() < 1e-6 && (ext.z - 124.0).abs() < 1e-6,
+        (ext.x - 30.0).abs() < 1e-6 && (ext.y - 15.0).abs() < 1e-6 && (ext.z - 124.0).abs() < 1e-6,
         "{ext:?}"
     );
+    // One with its thin side along X is turned a quarter turn about Z.
+    let c = align(&objects::prism(15.0, 30.0, 124.0));
+    let (lo, hi) = c.mesh.bounds();
+    assert!(((hi - lo).x - 30.0).abs() < 1e-6, "{:?}", hi - lo);
 }
 
 #[test]

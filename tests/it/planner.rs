@@ -7,7 +7,14 @@ use grasp_sim::{run, RunOptions};
 fn plan(name: &str) -> RunReport {
     let path = crate::root().join(format!("scenarios/{name}.toml"));
     let s = Scenario::load(&path).unwrap();
-    run(&s, &RunOptions { no_sim: true }).unwrap()
+    run(
+        &s,
+        &RunOptions {
+            no_sim: true,
+            candidates: 1,
+        },
+    )
+    .unwrap()
 }
 
 fn z_of(r: &RunReport, index: usize) -> f64 {

@@ -1,0 +1,285 @@
+//! Finger positioning with the Articulated Line Segment model (thesis 3.6).
+//!
+//! Each finger is three ALS (top, centre, bottom: its centreline and its two edges, a finger
+//! offset either side), each placed on its own finger slice plane (3.6.2.1). In a plane, in the
+//! palm's 2D frame of [`super::kinematics`] (palm surface x = 0 facing −x, joint 1 at
+//! `(setback, ±lateral)`; a right-side finger is handled as a mirrored left one):
+//!
+//! 1. Gap Space: the palm must not take in the object in this plane (its outline, the palm
+//!    width by the palm offset, is checked); the gap between the palm surface and the object is
+//!    recorded.
+//! 2. Phalanx 1 (3.6.2.2): search domain = contour vertices within reach of its contact surface
+//!    (the disk swept by the surface's far end); for each, the joint-1 angle at which the contact
+//!    line (a finger offset inside the centreline, between the unusable lengths) passes through
+//!    it; the contact is the widest angle — the first point met while closing from open. The
+//!    angle must lie in joint 1's range, and the phalanx body must not take in the object.
+//! 3. Phalanx 2 (3.6.2.3): the same about joint 2, with contour segments cut at the domain's
+//!    border so the end of the contact line can touch (tip contact, Fig. 3.22); beyond the
+//!    contact line the fingertip is thinned (Fig. 3.8) and its outline is checked too.
+//! 4. The three ALS of a finger must agree within the Joint Angular Deviation (Table 3.2).
+
+use super::geom2::ConvexPolygon;
+use super::kinematics::{inward_normal, phalanx1_direction};
+use super::palm::{PalmPlacement, PENETRATION_TOL_MM};
+use crate::hand::{Hand, Side};
+use crate::mesh::Mesh;
+use crate::slice::{slice, Slice};
+use nalgebra::{Point2, Rotation2, Vector2};
+use std::f64::consts::PI;
+
+/// The joint angles of one ALS `[deg]`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AlsAngles {
+    /// Joint 1, interior, relative to the palm.
+    pub theta1_deg: f64,
+    /// Joint 2, interior, relative to phalanx 1.
+    pub theta2_deg: f64,
+    /// True if and only if phalanx 2 touches with the end of its contact line (tip contact).
+    pub is_tip_contact: bool,
+    /// Gap Space between the palm surface and the object in this plane `[mm]`.
+    pub gap_mm: f64,
+}
+
+/// A positioned finger: its three ALS.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FingerPlacement {
+    /// Finger name.
+    pub name: String,
+    /// Top ALS.
+    pub top: AlsAngles,
+    /// Centre ALS (the finger's reported angles).
+    pub centre: AlsAngles,
+    /// Bottom ALS.
+    pub bottom: AlsAngles,
+}
+
+/// Why a finger could not be placed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum FingerRejection {
+    /// The palm takes in the object in a finger plane.
+    PalmPenetration,
+    /// Phalanx 1 meets nothing while closing.
+    Phalanx1NoContact,
+    /// Phalanx 1's contact angle is out of joint 1's range.
+    Theta1OutOfRange,
+    /// Phalanx 1's body takes in the object.
+    Phalanx1Penetration,
+    /// Phalanx 2 meets nothing while closing.
+    Phalanx2NoContact,
+    /// Phalanx 2's contact angle is out of joint 2's range.
+    Theta2OutOfRange,
+    /// Phalanx 2's body or fingertip takes in the object.
+    Phalanx2Penetration,
+    /// The three ALS disagree by more than the Joint Angular Deviation.
+    JointDeviation,
+}
+
+/// Positions finger `k` of `hand` on a placed palm: all three ALS and their agreement.
+pub fn place_finger(
+    mesh: &Mesh,
+    hand: &Hand,
+    palm: &PalmPlacement,
+    k: usize,
+    deviation_deg: [f64; 2],
+) -> Result<FingerPlacement, FingerRejection> {
+    let f = &hand.finger_list[k];
+    let o = hand.fingers.offset_mm;
+    let mirror = match f.side {
+        Side::Left => 1.0,
+        Side::Right => -1.0,
+    };
+    let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
+        let s = slice(mesh, &palm.finger_plane(f.height_mm + dz));
+        place_als(&s, hand, mirror)
+    };
+    let centre = als(0.0)?;
+    let top = als(o)?;
+    let bottom = als(-o)?;
+    for other in [&top, &bottom] {
+        if (other.theta1_deg - centre.theta1_deg).abs() > deviation_deg[0]
+            || (other.theta2_deg - centre.theta2_deg).abs() > deviation_deg[1]
+        {
+            return Err(FingerRejection::JointDeviation);
+        }
+    }
+    Ok(FingerPlacement {
+        name: f.name.clone(),
+        top,
+        centre,
+        bottom,
+    })
+}
+
+/// Places one ALS on its finger slice plane. `mirror` is +1 for a left finger (joint at +y) and
+/// −1 for a right one (the contour is mirrored so the finger is handled as a left one).
+pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, FingerRejection> {
+    let o = hand.fingers.offset_mm;
+    let segments: Vec<(Point2<f64>, Point2<f64>)> = s
+        .contours
+        .iter()
+        .flat_map(|c| {
+            (0..c.segment_count()).map(move |i| {
+                let (a, b) = c.segment(i);
+                (
+                    Point2::new(a.x, mirror * a.y),
+                    Point2::new(b.x, mirror * b.y),
+                )
+            })
+        })
+        .collect();
+
+    // Gap Space and the palm's outline in this plane.
+    let hw = hand.palm.half_width_mm;
+    let palm = ConvexPolygon::new(vec![
+        Point2::new(0.0, -hw),
+        Point2::new(hand.palm.offset_mm, -hw),
+        Point2::new(hand.palm.offset_mm, hw),
+        Point2::new(0.0, hw),
+    ]);
+    if segments
+        .iter()
+        .any(|(a, b)| palm.is_penetrated_by(*a, *b, PENETRATION_TOL_MM))
+    {
+        return Err(FingerRejection::PalmPenetration);
+    }
+    let gap_mm = -segments
+        .iter()
+        .flat_map(|(a, _)| [*a])
+        .filter(|p| p.y.abs() <= hw)
+        .map(|p| p.x)
+        .fold(f64::NEG_INFINITY, f64::max);
+
+    // Phalanx 1.
+    let p1 = &hand.phalanx_1;
+    let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
+    let usable1 = (
+        p1.unusable_proximal_mm,
+        p1.length_mm - p1.unusable_distal_mm,
+    );
+    let reach1 = usable1.1.hypot(o);
+    let straight1 = phalanx1_direction(PI);
+    let domain1: Vec<Point2<f64>> = segments
+        .iter()
+        .map(|(a, _)| *a)
+        .filter(|p| (p - j1).norm() <= reach1)
+        .collect();
+    let (bend1, _) = first_contact(&domain1, j1, straight1, usable1, o)
+        .ok_or(FingerRejection::Phalanx1NoContact)?;
+    let theta1 = 180.0 - bend1.to_degrees();
+    let [lo1, hi1] = hand.joints.theta1_range_deg;
+    if !(lo1..=hi1).contains(&theta1) {
+        return Err(FingerRejection::Theta1OutOfRange);
+    }
+    let d1 = Rotation2::new(bend1) * straight1;
+    let body1 = ConvexPolygon::strip(j1, d1, p1.length_mm, -o, o);
+    if segments
+        .iter()
+        .any(|(a, b)| body1.is_penetrated_by(*a, *b, PENETRATION_TOL_MM))
+    {
+        return Err(FingerRejection::Phalanx1Penetration);
+    }
+
+    // Phalanx 2, with segments cut at its domain's border.
+    let p2 = &hand.phalanx_2;
+    let j2 = j1 + d1 * p1.length_mm;
+    let usable2 = (
+        p2.unusable_proximal_mm,
+        p2.length_mm - p2.unusable_distal_mm,
+    );
+    let reach2 = usable2.1.hypot(o);
+    let mut domain2: Vec<Point2<f64>> = Vec::new();
+    for (a, b) in &segments {
+        if (a - j2).norm() <= reach2 {
+            domain2.push(*a);
+        }
+        domain2.extend(circle_crossings(*a, *b, j2, reach2));
+    }
+    let (bend2, along2) =
+        first_contact(&domain2, j2, d1, usable2, o).ok_or(FingerRejection::Phalanx2NoContact)?;
+    let theta2 = 180.0 - bend2.to_degrees();
+    let [lo2, hi2] = hand.joints.theta2_range_deg;
+    if !(lo2..=hi2).contains(&theta2) {
+        return Err(FingerRejection::Theta2OutOfRange);
+    }
+    let e = Rotation2::new(bend2) * d1;
+    let n_e = inward_normal(&e);
+    let body2 = ConvexPolygon::strip(j2, e, usable2.1, -o, o);
+    // The thinned tip (Fig. 3.8): from the end of the contact line to the tip's front corner.
+    let tip_front = hand.fingers.tip_thickness_mm - o;
+    let tip = ConvexPolygon::new(vec![
+        j2 + e * usable2.1 - n_e * o,
+        j2 + e * p2.length_mm - n_e * o,
+        j2 + e * p2.length_mm + n_e * tip_front,
+        j2 + e * usable2.1 + n_e * o,
+    ]);
+    let hits = |poly: &ConvexPolygon| {
+        segments
+            .iter()
+            .any(|(a, b)| poly.is_penetrated_by(*a, *b, PENETRATION_TOL_MM))
+    };
+    if hits(&body2) || (p2.length_mm > usable2.1 && hits(&tip)) {
+        return Err(FingerRejection::Phalanx2Penetration);
+    }
+    let is_tip_contact = along2 >= usable2.1 - 1e-6;
+    Ok(AlsAngles {
+        theta1_deg: theta1,
+        theta2_deg: theta2,
+        is_tip_contact,
+        gap_mm,
+    })
+}
+
+/// The smallest bend from `straight` (radians, counter-clockwise, in [0, π]) at which the
+/// contact line of a link pivoting at `pivot` (offset `o` to the inside, between `usable.0` and
+/// `usable.1` along the link) passes through one of `points`, with the contact's position along
+/// the link. `None` when none is met.
+fn first_contact(
+    points: &[Point2<f64>],
+    pivot: Point2<f64>,
+    straight: Vector2<f64>,
+    usable: (f64, f64),
+    o: f64,
+) -> Option<(f64, f64)> {
+    let n0 = inward_normal(&straight);
+    let mut best: Option<(f64, f64)> = None;
+    for p in points {
+        let q = p - pivot;
+        let (qd, qn) = (q.dot(&straight), q.dot(&n0));
+        let r = q.norm();
+        if r < o {
+            continue;
+        }
+        // q·n(φ) = −qd sin φ + qn cos φ = r cos(φ + γ), with r cos γ = qn, r sin γ = qd.
+        let gamma = qd.atan2(qn);
+        let delta = (o / r).clamp(-1.0, 1.0).acos();
+        for root in [-gamma + delta, -gamma - delta] {
+            let phi = root.rem_euclid(2.0 * PI);
+            if phi > PI + 1e-12 {
+                continue;
+            }
+            // Position along the link: q·e(φ).
+            let t = qd * phi.cos() + qn * phi.sin();
+            if t >= usable.0 - 1e-9 && t <= usable.1 + 1e-9 && best.is_none_or(|b| phi < b.0) {
+                best = Some((phi, t));
+            }
+        }
+    }
+    best
+}
+
+/// Points where segment a–b crosses the circle of radius r about c.
+fn circle_crossings(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>, r: f64) -> Vec<Point2<f64>> {
+    let d = b - a;
+    let f = a - c;
+    let (qa, qb, qc) = (d.dot(&d), 2.0 * f.dot(&d), f.dot(&f) - r * r);
+    let disc = qb * qb - 4.0 * qa * qc;
+    if qa == 0.0 || disc < 0.0 {
+        return Vec::new();
+    }
+    let s = disc.sqrt();
+    [(-qb - s) / (2.0 * qa), (-qb + s) / (2.0 * qa)]
+        .into_iter()
+        .filter(|t| (0.0..=1.0).contains(t))
+        .map(|t| a + d * t)
+        .collect()
+}

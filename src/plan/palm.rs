@@ -1,0 +1,204 @@
+//! Palm positioning (thesis 3.5): palm domain, placing the palm onto the object, pitch, and the
+//! penetration check in the vertical plane.
+//!
+//! The palm approaches along −u, where u = (cos a, sin a, 0) for approach angle a: the thesis turns
+//! the object by the approach angle and always approaches along −X; turning the approach instead
+//! is the same thing seen from the object. The analysis runs in the vertical slice at angle a,
+//! whose right side (s > 0) faces the palm.
+//!
+//! - Palm range: the palm's vertical extent at zero pitch, from the lowest finger's centreline
+//!   minus the palm margin to Finger_1's plus the margin, with Finger_1 at the candidate
+//!   elevation. Palm domain (3.5.1): the right-side contour points in that range, with the points
+//!   where contour segments cross its top and bottom (so a long segment is not missed).
+//! - First contact: the palm line moved towards the object touches the domain point with the
+//!   largest s.
+//! - Pitch (3.5.2): the palm turns about the first contact until it meets a second one, in the
+//!   other half of the palm (the half rule of the thesis); at the midpoint, the second-outermost
+//!   point decides. No second point within the pitch range: the palm stays upright on one
+//!   contact if none is closer than the range allows, and the candidate is rejected if the only
+//!   second contacts need more pitch than allowed.
+//! - Pitch sign: positive when the palm's top leans towards the object (thesis 5.4: +6.5° on
+//!   the inverted cup; 5.3: −7° on the cup).
+//! - Penetration (3.5.3): the palm outline (contact line and palm offset behind it) must not
+//!   take in any piece of the slice contour.
+
+use super::geom2::ConvexPolygon;
+use crate::hand::Hand;
+use crate::mesh::Mesh;
+use crate::slice::{slice, Plane, Slice};
+use nalgebra::{Point2, Point3, Vector2, Vector3};
+
+/// Tolerance for penetration tests `[mm]`: well under a facet's chord error for the bundled
+/// meshes (0.005 mm for D40) doubled, and far under any finger dimension.
+pub const PENETRATION_TOL_MM: f64 = 0.05;
+
+/// A placed palm.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PalmPlacement {
+    /// Approach angle `[rad]`.
+    pub approach_rad: f64,
+    /// Pitch `[rad]`, positive when the top leans towards the object.
+    pub pitch_rad: f64,
+    /// The palm centre on its contact surface (aligned frame) `[mm]`.
+    pub origin: Point3<f64>,
+    /// Palm frame axes in the aligned frame: x away from the object (the contact surface's
+    /// back), y sideways (the "left" fingers' side), z up (parallel to the joint axes).
+    pub axes: [Vector3<f64>; 3],
+    /// Contact points in the vertical slice `(s, z)` `[mm]`.
+    pub contacts: Vec<Point2<f64>>,
+    /// The vertical slice at the approach angle.
+    pub slice: Slice,
+}
+
+/// Why a palm placement failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum PalmRejection {
+    /// No contour point in the palm range on the approach side.
+    NoContact,
+    /// The only second contacts need more pitch than the pitch range.
+    PitchOutOfRange,
+    /// The palm outline takes in part of the object in the vertical plane.
+    Penetration,
+}
+
+/// Places the palm with Finger_1 at elevation `z1` and approach angle `approach_rad`.
+pub fn place_palm(
+    mesh: &Mesh,
+    hand: &Hand,
+    z1: f64,
+    approach_rad: f64,
+    pitch_range_rad: f64,
+) -> Result<PalmPlacement, PalmRejection> {
+    let plane = Plane::vertical(approach_rad);
+    let vslice = slice(mesh, &plane);
+    let h1 = hand.finger_list[0].height_mm;
+    let (h_lo, h_hi) = hand.finger_height_span();
+    let m = hand.palm.margin_mm;
+    let centre_z = z1 - h1;
+    let (z_lo, z_hi) = (centre_z + h_lo - m, centre_z + h_hi + m);
+
+    // Palm domain: right-side points in range, plus crossings of the range's ends.
+    let mut domain: Vec<Point2<f64>> = Vec::new();
+    for c in &vslice.contours {
+        for (i, p) in c.points.iter().enumerate() {
+            if p.x > 0.0 && p.y >= z_lo && p.y <= z_hi {
+                domain.push(*p);
+            }
+            if i < c.segment_count() {
+                let (a, b) = c.segment(i);
+                for z in [z_lo, z_hi] {
+                    if (a.y - z) * (b.y - z) < 0.0 {
+                        let t = (z - a.y) / (b.y - a.y);
+                        let q = a + (b - a) * t;
+                        if q.x > 0.0 {
+                            domain.push(q);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let first = *domain
+        .iter()
+        .max_by(|a, b| a.x.total_cmp(&b.x).then(b.y.total_cmp(&a.y)))
+        .ok_or(PalmRejection::NoContact)?;
+
+    // The rotation about `first` that brings the palm line onto point p (≥ 0 when p is not
+    // outside the line).
+    let angle_to = |p: &Point2<f64>| (first.x - p.x).atan2((first.y - p.y).abs());
+    let eps = 1e-9;
+    let (second, pitch) = if (first.y - centre_z).abs() <= eps {
+        // Midpoint: the second-outermost point, either half.
+        let second = domain
+            .iter()
+            .filter(|p| (**p - first).norm() > eps)
+            .max_by(|a, b| a.x.total_cmp(&b.x).then(b.y.total_cmp(&a.y)));
+        match second {
+            Some(p) => {
+                let phi = angle_to(p);
+                (Some(*p), if p.y < centre_z { -phi } else { phi })
+            }
+            None => (None, 0.0),
+        }
+    } else {
+        let top_first = first.y > centre_z;
+        let other: Vec<&Point2<f64>> = domain
+            .iter()
+            .filter(|p| {
+                if top_first {
+                    p.y < centre_z
+                } else {
+                    p.y > centre_z
+                }
+            })
+            .collect();
+        let best = other
+            .iter()
+            .map(|p| (angle_to(p), **p))
+            .min_by(|a, b| a.0.total_cmp(&b.0).then(a.1.y.total_cmp(&b.1.y)));
+        match best {
+            // Top contact first: the bottom swings in, the top leans away (negative pitch).
+            Some((phi, p)) => (Some(p), if top_first { -phi } else { phi }),
+            None => (None, 0.0),
+        }
+    };
+    let (second, pitch) = if pitch.abs() > pitch_range_rad + 1e-12 {
+        if second.is_some() && domain.len() > 1 {
+            return Err(PalmRejection::PitchOutOfRange);
+        }
+        (None, 0.0)
+    } else {
+        (second, pitch)
+    };
+
+    // Up axis of the palm in the slice, and its outward normal (away from the object).
+    let up = Vector2::new(-pitch.sin(), pitch.cos());
+    let back = Vector2::new(pitch.cos(), pitch.sin());
+    // Finger_1's point on the contact line at elevation z1, then the palm centre.
+    let t = (z1 - first.y) / up.y;
+    let p1 = first + up * t;
+    let centre = p1 - up * h1;
+    let outline = ConvexPolygon::new(vec![
+        centre + up * (h_lo - m),
+        centre + up * (h_hi + m),
+        centre + up * (h_hi + m) + back * hand.palm.offset_mm,
+        centre + up * (h_lo - m) + back * hand.palm.offset_mm,
+    ]);
+    for c in &vslice.contours {
+        for i in 0..c.segment_count() {
+            let (a, b) = c.segment(i);
+            if outline.is_penetrated_by(a, b, PENETRATION_TOL_MM) {
+                return Err(PalmRejection::Penetration);
+            }
+        }
+    }
+
+    let u = plane.u;
+    let z = Vector3::z();
+    let x_p = u * pitch.cos() + z * pitch.sin();
+    let z_p = -u * pitch.sin() + z * pitch.cos();
+    let y_p = z_p.cross(&x_p);
+    let mut contacts = vec![first];
+    contacts.extend(second);
+    Ok(PalmPlacement {
+        approach_rad,
+        pitch_rad: pitch,
+        origin: plane.to_3d(&centre),
+        axes: [x_p, y_p, z_p],
+        contacts,
+        slice: vslice,
+    })
+}
+
+impl PalmPlacement {
+    /// The finger slice plane at `height` above the palm centre along the palm's up axis
+    /// (thesis 3.6.2.1): 2D coordinates are (x away from the object, y sideways), with the palm
+    /// contact surface at x = 0, as in [`super::kinematics`].
+    pub fn finger_plane(&self, height: f64) -> Plane {
+        Plane {
+            origin: self.origin + self.axes[2] * height,
+            u: self.axes[0],
+            v: self.axes[1],
+        }
+    }
+}
