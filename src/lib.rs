@@ -24,6 +24,7 @@ pub mod objects;
 pub mod plan;
 pub mod report;
 pub mod scenario;
+pub mod sim;
 pub mod slice;
 
 use report::{
@@ -50,6 +51,11 @@ pub enum Error {
 pub struct RunOptions {
     /// Skip the physics check.
     pub no_sim: bool,
+    /// Run the physics check. It is experimental until its verdicts converge with the timestep
+    /// (issue 5), so it runs only when asked for.
+    pub sim: bool,
+    /// Find the payload margin by bisection (several more physics runs).
+    pub payload: bool,
     /// How many feasible grasps to collect, in search order (the thesis stops at 1).
     pub candidates: usize,
 }
@@ -58,6 +64,8 @@ impl Default for RunOptions {
     fn default() -> Self {
         RunOptions {
             no_sim: false,
+            sim: false,
+            payload: false,
             candidates: 1,
         }
     }
@@ -186,15 +194,15 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         },
         timings_ms: timings,
     };
-    let sim = SimReport {
-        verdict: "not_run".to_string(),
-        reason: Some(if options.no_sim {
-            "--no-sim".to_string()
-        } else {
-            "the physics check is not built yet".to_string()
-        }),
-    };
-    let expect = judge(&scenario.expect, &plan);
+    let sim = run_sim(
+        scenario,
+        options,
+        &aligned,
+        &graded,
+        found.grasps.first(),
+        mass_kg,
+    )?;
+    let expect = judge(&scenario.expect, &plan, &sim);
     Ok(RunReport {
         scenario: scenario.name.clone(),
         object,
@@ -205,6 +213,108 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             .warnings()
             .into_iter()
             .map(|w| format!("{}: {w}", scenario.object.mesh.display()))
+            .collect(),
+    })
+}
+
+/// Runs the physics check on the first grasp, or on `override_angles`.
+fn run_sim(
+    scenario: &Scenario,
+    options: &RunOptions,
+    aligned: &mesh::AlignedObject,
+    graded: &plan::GradedDomain,
+    grasp: Option<&plan::search::Grasp>,
+    mass_kg: f64,
+) -> Result<SimReport, Error> {
+    let not_run = |reason: &str| SimReport {
+        verdict: "not_run".to_string(),
+        reason: Some(reason.to_string()),
+        ..SimReport::default()
+    };
+    if options.no_sim {
+        return Ok(not_run("--no-sim"));
+    }
+    if !options.sim {
+        return Ok(not_run(
+            "the physics check is experimental (its verdicts do not yet converge with the \
+             timestep); run it with --sim",
+        ));
+    }
+    let p = &scenario.sim;
+    let (pose, source) = match (&p.override_angles, grasp) {
+        (Some(angles), _) => {
+            let n = graded.domain.elevations.len();
+            if n == 0 {
+                return Ok(not_run(
+                    "override_angles: the object has no indexed elevation",
+                ));
+            }
+            let index = p.override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
+            let z1 = graded.domain.elevations[index - 1];
+            match plan::palm::place_palm(&aligned.mesh, &scenario.hand, z1, 0.0, 0.0) {
+                Ok(palm) => (
+                    sim::SimHand {
+                        origin_mm: palm.origin,
+                        axes: palm.axes,
+                        theta_deg: angles.clone(),
+                    },
+                    "override_angles",
+                ),
+                Err(e) => {
+                    return Ok(not_run(&format!(
+                        "override_angles: palm placement failed: {e:?}"
+                    )))
+                }
+            }
+        }
+        (None, Some(g)) => (
+            sim::SimHand {
+                origin_mm: g.palm.origin,
+                axes: g.palm.axes,
+                theta_deg: g
+                    .fingers
+                    .iter()
+                    .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
+                    .collect(),
+            },
+            "planner",
+        ),
+        (None, None) => return Ok(not_run("no feasible grasp to check")),
+    };
+    let shape = sim::ObjectShape::from_mesh(&aligned.mesh, aligned.original.volume_mm3);
+    let friction = scenario.object.friction;
+    let out = sim::check(&scenario.hand, &pose, &shape, mass_kg, friction, p);
+    let payload_margin = (options.payload && out.verdict == sim::Verdict::Hold)
+        .then(|| sim::payload_margin(&scenario.hand, &pose, &shape, mass_kg, friction, p));
+    Ok(SimReport {
+        verdict: out.verdict.as_str().to_string(),
+        reason: None,
+        translation_mm: Some(out.translation_mm),
+        rotation_deg: Some(out.rotation_deg),
+        simulated_s: Some(out.simulated_s),
+        steps: Some(out.steps),
+        wall_ms: Some(out.wall_ms),
+        collider: Some(format!("{} ({} parts)", shape.kind, shape.parts)),
+        mass_kg: Some(mass_kg),
+        grasp_source: Some(source.to_string()),
+        payload_margin: if options.payload {
+            Some(payload_margin.unwrap_or(0.0))
+        } else {
+            None
+        },
+        directions: out
+            .directions
+            .iter()
+            .map(|d| report::SimDirectionReport {
+                gravity: d.gravity,
+                verdict: d.verdict.as_str().to_string(),
+                translation_mm: d.translation_mm,
+                rotation_deg: d.rotation_deg,
+                closing_translation_mm: d.closing_translation_mm,
+                joint_error_deg: d.joint_error_deg,
+                joint_errors_deg: d.joint_errors_deg.clone(),
+                in_contact: d.in_contact,
+            })
             .collect(),
     })
 }
@@ -252,11 +362,18 @@ fn grasp_report(g: &plan::search::Grasp, aligned: &mesh::AlignedObject) -> repor
     }
 }
 
-/// Judges the planning part of `[expect]` (the physics check does not exist yet, so a `hold`,
-/// `slip` or `drop` outcome is judged as "a feasible grasp, matching the reference values").
-fn judge(expect: &scenario::Expect, plan: &PlanReport) -> ExpectReport {
+/// Judges `[expect]`: the planning part (status and reference values), then, when the physics
+/// check ran, its verdict against the expected outcome.
+fn judge(expect: &scenario::Expect, plan: &PlanReport, sim: &SimReport) -> ExpectReport {
     let outcome = expect.outcome.as_str().to_string();
-    let feasible = plan.status == "feasible";
+    if sim.grasp_source.as_deref() == Some("override_angles") {
+        let met = sim.verdict == outcome;
+        return ExpectReport {
+            outcome,
+            met: Some(met),
+            details: format!("sim-only (override_angles): verdict {}", sim.verdict),
+        };
+    }
     let (met, details) = match (expect.outcome, &plan.grasp) {
         (Outcome::Ungraspable, None) => (true, "planner: ungraspable, as expected".to_string()),
         (Outcome::Ungraspable, Some(_)) => (
@@ -308,22 +425,31 @@ fn judge(expect: &scenario::Expect, plan: &PlanReport) -> ExpectReport {
                     }
                 }
             }
-            if misses.is_empty() {
-                (
-                    true,
-                    "planning part met (feasible, reference values within tolerance); the \
-                     physics check is not built yet"
-                        .to_string(),
-                )
-            } else {
+            if !misses.is_empty() {
                 (
                     false,
                     format!("planning part not met: {}", misses.join("; ")),
                 )
+            } else if sim.verdict == "not_run" {
+                (
+                    true,
+                    "planning part met (feasible, reference values within tolerance); physics \
+                     check not run"
+                        .to_string(),
+                )
+            } else if sim.verdict == outcome {
+                (
+                    true,
+                    format!("planning part met; physics check: {}", sim.verdict),
+                )
+            } else {
+                (
+                    false,
+                    format!("physics check: {}, expected {outcome}", sim.verdict),
+                )
             }
         }
     };
-    let _ = feasible;
     ExpectReport {
         outcome,
         met: Some(met),

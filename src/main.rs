@@ -32,6 +32,8 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
     }
     let options = RunOptions {
         no_sim: cli.no_sim,
+        sim: cli.sim,
+        payload: cli.payload,
         candidates: cli.candidates as usize,
     };
     // Everything is run before anything is printed, so bad input anywhere leaves no partial output.

@@ -168,13 +168,64 @@ pub struct GradesReport {
 }
 
 /// The `sim` part of the report.
-#[derive(Debug, Clone, Serialize)]
+#[derive(Debug, Clone, Serialize, Default)]
 pub struct SimReport {
     /// `hold`, `slip`, `drop` or `not_run`.
     pub verdict: String,
     /// Why it did not run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
+    /// Object translation relative to the palm during the hold, worst direction `[mm]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub translation_mm: Option<f64>,
+    /// Object rotation relative to the palm during the hold, worst direction `[deg]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub rotation_deg: Option<f64>,
+    /// Simulated time over all gravity directions `[s]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub simulated_s: Option<f64>,
+    /// Physics steps over all gravity directions.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub steps: Option<usize>,
+    /// Wall time of the check `[ms]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub wall_ms: Option<f64>,
+    /// The object's collider: `convex_hull` or `convex_decomposition`, and its part count.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collider: Option<String>,
+    /// Object mass simulated `[kg]`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mass_kg: Option<f64>,
+    /// `override_angles` when the grasp came from the scenario, `planner` otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub grasp_source: Option<String>,
+    /// Largest mass multiplier (up to 64) at which the grasp still holds (`--payload`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub payload_margin: Option<f64>,
+    /// Per gravity direction.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub directions: Vec<SimDirectionReport>,
+}
+
+/// The hold test for one gravity direction.
+#[derive(Debug, Clone, Serialize)]
+pub struct SimDirectionReport {
+    /// Gravity direction, unit, aligned object frame.
+    pub gravity: [f64; 3],
+    /// `hold`, `slip` or `drop`.
+    pub verdict: String,
+    /// Translation relative to the palm during the hold `[mm]`.
+    pub translation_mm: f64,
+    /// Rotation relative to the palm during the hold `[deg]`.
+    pub rotation_deg: f64,
+    /// Translation relative to the palm while the fingers closed `[mm]`.
+    pub closing_translation_mm: f64,
+    /// Largest joint bend error after closing against the plan `[deg]`.
+    pub joint_error_deg: f64,
+    /// Per finger, both joints' bend error after closing `[deg]`.
+    pub joint_errors_deg: Vec<[f64; 2]>,
+    /// True if and only if the object touches the hand at the end.
+    pub in_contact: bool,
 }
 
 /// The `expect` part of the report.
@@ -289,9 +340,21 @@ impl RunReport {
                 pp.quaternion_wxyz[0], pp.quaternion_wxyz[1], pp.quaternion_wxyz[2], pp.quaternion_wxyz[3]
             );
         }
-        let sim_line = match &self.sim.reason {
-            Some(r) => format!("{} ({r})", self.sim.verdict),
-            None => self.sim.verdict.clone(),
+        let sim_line = match (&self.sim.reason, self.sim.translation_mm) {
+            (Some(r), _) => format!("{} ({r})", self.sim.verdict),
+            (None, Some(t)) => format!(
+                "{}: moved {:.2} mm and {:.2} deg relative to the palm while held; {} steps, {:.0} ms{}",
+                self.sim.verdict,
+                t,
+                self.sim.rotation_deg.unwrap_or(0.0),
+                self.sim.steps.unwrap_or(0),
+                self.sim.wall_ms.unwrap_or(0.0),
+                match self.sim.payload_margin {
+                    Some(m) => format!("; payload margin {m:.2}x"),
+                    None => String::new(),
+                }
+            ),
+            (None, None) => self.sim.verdict.clone(),
         };
         let _ = writeln!(s, "  Sim         {sim_line}");
         let met = match self.expect.met {

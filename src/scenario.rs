@@ -157,6 +157,25 @@ pub struct SimParams {
     pub hold_translation_mm: f64,
     /// Largest rotation relative to the palm that still counts as `hold` `[deg]`.
     pub hold_rotation_deg: f64,
+    /// Time the fingers get to close before gravity is turned on `[s]`.
+    pub close_duration_s: f64,
+    /// Constraint solver iterations per step.
+    pub solver_iterations: usize,
+    /// Joint motor stiffness `[N·m/rad]`: torque per radian short of the target, up to the limit.
+    pub motor_stiffness_nm_per_rad: f64,
+    /// Joint motor damping `[N·m·s/rad]`.
+    pub motor_damping_nms_per_rad: f64,
+    /// Density of the phalanges `[kg/m³]` (the hand file gives no masses).
+    pub finger_density_kg_m3: f64,
+    /// Natural frequency of contacts `[Hz]`: their stiffness relative to the bodies' masses.
+    pub contact_stiffness_hz: f64,
+    /// The fingers start this much more open than planned at each joint `[deg]`.
+    pub open_margin_deg: f64,
+    /// Skip the planner and close the fingers to these `[θ1, θ2]` per finger `[deg]`, with the
+    /// palm upright at Finger_1's `override_index` (a sim-only scenario).
+    pub override_angles: Option<Vec<[f64; 2]>>,
+    /// Finger_1's elevation index for `override_angles` (default: the middle of the domain).
+    pub override_index: Option<usize>,
 }
 
 impl Default for SimParams {
@@ -169,6 +188,15 @@ impl Default for SimParams {
             torque_limit_nm: 1.0,
             hold_translation_mm: 5.0,
             hold_rotation_deg: 5.0,
+            close_duration_s: 0.5,
+            solver_iterations: 8,
+            motor_stiffness_nm_per_rad: 20.0,
+            motor_damping_nms_per_rad: 0.2,
+            finger_density_kg_m3: 1000.0,
+            contact_stiffness_hz: 1000.0,
+            open_margin_deg: 20.0,
+            override_angles: None,
+            override_index: None,
         }
     }
 }
@@ -449,9 +477,62 @@ impl Scenario {
             ("sim.torque_limit_nm", s.torque_limit_nm),
             ("sim.hold_translation_mm", s.hold_translation_mm),
             ("sim.hold_rotation_deg", s.hold_rotation_deg),
+            ("sim.close_duration_s", s.close_duration_s),
+            (
+                "sim.motor_stiffness_nm_per_rad",
+                s.motor_stiffness_nm_per_rad,
+            ),
+            ("sim.finger_density_kg_m3", s.finger_density_kg_m3),
+            ("sim.contact_stiffness_hz", s.contact_stiffness_hz),
+            ("sim.open_margin_deg", s.open_margin_deg),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(invalid(key, format!("must be positive, got {v}")));
+            }
+        }
+        if !(1..=100).contains(&s.solver_iterations) {
+            return Err(invalid(
+                "sim.solver_iterations",
+                format!("must be in 1..=100, got {}", s.solver_iterations),
+            ));
+        }
+        if !(s.motor_damping_nms_per_rad.is_finite() && s.motor_damping_nms_per_rad >= 0.0) {
+            return Err(invalid(
+                "sim.motor_damping_nms_per_rad",
+                format!(
+                    "must be zero or positive, got {}",
+                    s.motor_damping_nms_per_rad
+                ),
+            ));
+        }
+        if s.timestep_s > 0.05 || s.timestep_s * 10.0 > s.duration_s {
+            return Err(invalid(
+                "sim.timestep_s",
+                format!(
+                    "must be at most 0.05 s and a tenth of duration_s, got {}",
+                    s.timestep_s
+                ),
+            ));
+        }
+        if let Some(a) = &s.override_angles {
+            if a.len() != hand.finger_list.len() {
+                return Err(invalid(
+                    "sim.override_angles",
+                    format!(
+                        "has {} fingers, the hand has {}",
+                        a.len(),
+                        hand.finger_list.len()
+                    ),
+                ));
+            }
+            if a.iter()
+                .flatten()
+                .any(|v| !(v.is_finite() && *v > 0.0 && *v <= 180.0))
+            {
+                return Err(invalid(
+                    "sim.override_angles",
+                    "angles must be in (0, 180] degrees".to_string(),
+                ));
             }
         }
         if !s.squeeze_deg.is_finite() || s.squeeze_deg < 0.0 {

@@ -3,6 +3,7 @@
 mod cli;
 mod geometry;
 mod planner;
+mod sim;
 mod thesis_table;
 
 use std::path::PathBuf;

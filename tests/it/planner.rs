@@ -11,7 +11,7 @@ fn plan(name: &str) -> RunReport {
         &s,
         &RunOptions {
             no_sim: true,
-            candidates: 1,
+            ..RunOptions::default()
         },
     )
     .unwrap()

@@ -11,7 +11,7 @@ fn plan(name: &str) -> RunReport {
         &Scenario::load(&path).unwrap(),
         &RunOptions {
             no_sim: true,
-            candidates: 1,
+            ..RunOptions::default()
         },
     )
     .unwrap()
@@ -193,7 +193,7 @@ fn the_palm_pose_is_given_in_the_original_frame() {
         &Scenario::load(&s).unwrap(),
         &RunOptions {
             no_sim: true,
-            candidates: 1,
+            ..RunOptions::default()
         },
     )
     .unwrap();

@@ -1,0 +1,31 @@
+//! The physics check (DESIGN.md section 5, beyond the thesis, which stops at kinematics: its 6.2):
+//! does the planned grasp hold the object under gravity?
+//!
+//! Units: SI (metres, kilograms, seconds, newton-metres) inside rapier; the interface takes the
+//! planner's millimetres and degrees and [`convert`] converts once. The scene is built in the
+//! aligned object frame, where the thesis's weight acts along −Z.
+//!
+//! Scene ([`scene`]): the palm is a kinematic box held at the planned pose; each phalanx is a
+//! dynamic box (finger width and thickness 2 × finger offset; phalanx 2's thinned tip as a thinner
+//! box); joints are revolute on the finger joint axes with the hand's limits, as multibody
+//! (reduced-coordinate) joints: a 10 g phalanx pressing a 0.2 kg object is a mass ratio that
+//! makes impulse joints stretch and drift under load, while a multibody chain cannot come
+//! apart. Each joint has a force-based position motor (stiffness, damping) whose torque is capped
+//! by the torque limit, driving towards the planned angle closed further by the squeeze
+//! overshoot, so the torque limit, not the target, bounds the grip. The object is a dynamic body
+//! with the scenario's mass and friction; its collider is the convex hull of the aligned mesh when
+//! the mesh is convex (hull volume within 2 % of the mesh's), a convex decomposition otherwise (a
+//! bare triangle mesh has no inside and lets fingers sink in).
+//!
+//! Protocol ([`protocol`]): fingers start open (θ = 135°, the joint limit), gravity off; the
+//! motors close for `close_duration_s`; gravity turns on (`down`: −Z; `six`: ±X, ±Y, ±Z in turn,
+//! each in a fresh scene, as DexGraspNet and BODex test) for `duration_s`. The object's motion
+//! relative to the palm during the hold gives the verdict: `hold` within the thresholds, `slip`
+//! beyond them while still touching the hand, `drop` when it has left the hand.
+
+pub mod convert;
+pub mod protocol;
+pub mod scene;
+
+pub use protocol::{check, payload_margin, DirectionOutcome, SimOutcome, Verdict};
+pub use scene::{ObjectShape, SimHand};
