@@ -13,8 +13,8 @@
 //! units, converted once at its boundary.
 //!
 //! Math types: the planner uses nalgebra (f64). rapier3d 0.36 and parry3d 0.31 use glam types
-//! (`Vec3`, `Pose3`, f32 by default); the conversion between the two will live in one small
-//! module of the physics check (`sim::convert`), the only place that knows both.
+//! (`Vec3`, `Pose3`, f32 by default); the conversion between the two lives in [`sim::convert`],
+//! the only module that knows both.
 
 #![warn(missing_docs)]
 
