@@ -27,13 +27,7 @@ pub struct Cli {
     #[arg(long)]
     pub no_sim: bool,
 
-    /// Run the experimental physics check (rapier3d) on the planned grasp: close the fingers,
-    /// turn gravity on, and report hold, slip or drop. Its verdicts do not yet converge with the
-    /// timestep, so they are not judged against `[expect]` unless this flag is given.
-    #[arg(long, conflicts_with = "no_sim")]
-    pub sim: bool,
-
-    /// With --sim, also find the payload margin: the largest mass multiplier (up to 64) that still holds.
+    /// Also find the payload margin: the largest mass multiplier (up to 64) that still holds.
     #[arg(long)]
     pub payload: bool,
 

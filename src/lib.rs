@@ -51,9 +51,6 @@ pub enum Error {
 pub struct RunOptions {
     /// Skip the physics check.
     pub no_sim: bool,
-    /// Run the physics check. It is experimental until its verdicts converge with the timestep
-    /// (issue 5), so it runs only when asked for.
-    pub sim: bool,
     /// Find the payload margin by bisection (several more physics runs).
     pub payload: bool,
     /// How many feasible grasps to collect, in search order (the thesis stops at 1).
@@ -64,7 +61,6 @@ impl Default for RunOptions {
     fn default() -> Self {
         RunOptions {
             no_sim: false,
-            sim: false,
             payload: false,
             candidates: 1,
         }
@@ -234,12 +230,6 @@ fn run_sim(
     if options.no_sim {
         return Ok(not_run("--no-sim"));
     }
-    if !options.sim {
-        return Ok(not_run(
-            "the physics check is experimental (its verdicts do not yet converge with the \
-             timestep); run it with --sim",
-        ));
-    }
     let p = &scenario.sim;
     let (pose, source) = match (&p.override_angles, grasp) {
         (Some(angles), _) => {
@@ -310,6 +300,8 @@ fn run_sim(
                 verdict: d.verdict.as_str().to_string(),
                 translation_mm: d.translation_mm,
                 rotation_deg: d.rotation_deg,
+                full_rotation_deg: d.full_rotation_deg,
+                tilt_deg: d.tilt_deg,
                 closing_translation_mm: d.closing_translation_mm,
                 joint_error_deg: d.joint_error_deg,
                 joint_errors_deg: d.joint_errors_deg.clone(),

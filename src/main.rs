@@ -32,7 +32,6 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
     }
     let options = RunOptions {
         no_sim: cli.no_sim,
-        sim: cli.sim,
         payload: cli.payload,
         candidates: cli.candidates as usize,
     };

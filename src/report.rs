@@ -216,8 +216,13 @@ pub struct SimDirectionReport {
     pub verdict: String,
     /// Translation relative to the palm during the hold `[mm]`.
     pub translation_mm: f64,
-    /// Rotation relative to the palm during the hold `[deg]`.
+    /// Rotation relative to the palm during the hold, as judged (the axis's tilt for a body of
+    /// revolution, the full rotation otherwise) `[deg]`.
     pub rotation_deg: f64,
+    /// The full rotation relative to the palm `[deg]`.
+    pub full_rotation_deg: f64,
+    /// The tilt of the object's principal axis relative to the palm `[deg]`.
+    pub tilt_deg: f64,
     /// Translation relative to the palm while the fingers closed `[mm]`.
     pub closing_translation_mm: f64,
     /// Largest joint bend error after closing against the plan `[deg]`.

@@ -149,18 +149,26 @@ pub struct SimParams {
     pub duration_s: f64,
     /// Physics timestep `[s]`.
     pub timestep_s: f64,
-    /// Motor targets close this far past the planned joint angles `[deg]`.
+    /// Joint 1's motor target closes this far past its planned angle `[deg]`.
     pub squeeze_deg: f64,
+    /// Joint 2's motor target closes this far past its planned angle `[deg]`.
+    pub squeeze2_deg: f64,
     /// Joint motor torque limit `[N·m]`.
     pub torque_limit_nm: f64,
+    /// Torque a stalled joint 1 holds once joint 2 closes (a worm drive's lock) `[N·m]`.
+    pub joint1_lock_torque_nm: f64,
     /// Largest translation relative to the palm that still counts as `hold` `[mm]`.
     pub hold_translation_mm: f64,
     /// Largest rotation relative to the palm that still counts as `hold` `[deg]`.
     pub hold_rotation_deg: f64,
     /// Time the fingers get to close before gravity is turned on `[s]`.
     pub close_duration_s: f64,
-    /// Constraint solver iterations per step.
+    /// Constraint solver iterations (substeps) per step.
     pub solver_iterations: usize,
+    /// PGS sweeps per solver iteration.
+    pub pgs_iterations: usize,
+    /// Stabilisation (position correction) sweeps per solver iteration.
+    pub stabilization_iterations: usize,
     /// Joint motor stiffness `[N·m/rad]`: torque per radian short of the target, up to the limit.
     pub motor_stiffness_nm_per_rad: f64,
     /// Joint motor damping `[N·m·s/rad]`.
@@ -183,13 +191,17 @@ impl Default for SimParams {
         SimParams {
             gravity: GravityMode::Down,
             duration_s: 2.0,
-            timestep_s: 1.0 / 480.0,
+            timestep_s: 1.0 / 960.0,
             squeeze_deg: 10.0,
+            squeeze2_deg: 10.0,
             torque_limit_nm: 1.0,
+            joint1_lock_torque_nm: 10.0,
             hold_translation_mm: 5.0,
             hold_rotation_deg: 5.0,
             close_duration_s: 0.5,
             solver_iterations: 8,
+            pgs_iterations: 8,
+            stabilization_iterations: 2,
             motor_stiffness_nm_per_rad: 20.0,
             motor_damping_nms_per_rad: 0.2,
             finger_density_kg_m3: 1000.0,
@@ -475,6 +487,7 @@ impl Scenario {
             ("sim.duration_s", s.duration_s),
             ("sim.timestep_s", s.timestep_s),
             ("sim.torque_limit_nm", s.torque_limit_nm),
+            ("sim.joint1_lock_torque_nm", s.joint1_lock_torque_nm),
             ("sim.hold_translation_mm", s.hold_translation_mm),
             ("sim.hold_rotation_deg", s.hold_rotation_deg),
             ("sim.close_duration_s", s.close_duration_s),
@@ -490,11 +503,14 @@ impl Scenario {
                 return Err(invalid(key, format!("must be positive, got {v}")));
             }
         }
-        if !(1..=100).contains(&s.solver_iterations) {
-            return Err(invalid(
-                "sim.solver_iterations",
-                format!("must be in 1..=100, got {}", s.solver_iterations),
-            ));
+        for (key, v) in [
+            ("sim.solver_iterations", s.solver_iterations),
+            ("sim.pgs_iterations", s.pgs_iterations),
+            ("sim.stabilization_iterations", s.stabilization_iterations),
+        ] {
+            if !(1..=100).contains(&v) {
+                return Err(invalid(key, format!("must be in 1..=100, got {v}")));
+            }
         }
         if !(s.motor_damping_nms_per_rad.is_finite() && s.motor_damping_nms_per_rad >= 0.0) {
             return Err(invalid(
@@ -535,11 +551,13 @@ impl Scenario {
                 ));
             }
         }
-        if !s.squeeze_deg.is_finite() || s.squeeze_deg < 0.0 {
-            return Err(invalid(
-                "sim.squeeze_deg",
-                format!("must be zero or positive, got {}", s.squeeze_deg),
-            ));
+        for (key, v) in [
+            ("sim.squeeze_deg", s.squeeze_deg),
+            ("sim.squeeze2_deg", s.squeeze2_deg),
+        ] {
+            if !v.is_finite() || v < 0.0 {
+                return Err(invalid(key, format!("must be zero or positive, got {v}")));
+            }
         }
         if let Some(t) = &raw.expect.theta_deg {
             if t.len() != hand.finger_list.len() {

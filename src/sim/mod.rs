@@ -17,8 +17,10 @@
 //! the mesh is convex (hull volume within 2 % of the mesh's), a convex decomposition otherwise (a
 //! bare triangle mesh has no inside and lets fingers sink in).
 //!
-//! Protocol ([`protocol`]): fingers start open (θ = 135°, the joint limit), gravity off; the
-//! motors close for `close_duration_s`; gravity turns on (`down`: −Z; `six`: ±X, ±Y, ±Z in turn,
+//! Protocol ([`protocol`]): fingers start open (each joint `open_margin_deg` short of its plan),
+//! gravity off; the motors close for `close_duration_s`, joint 1 first and joint 2 from halfway
+//! (thesis 3.6.2 fixes phalanx 1 before phalanx 2; closing both at once lets phalanx 2's tip,
+//! which sweeps the larger arc, reach the object first and hold phalanx 1 off it); gravity turns on (`down`: −Z; `six`: ±X, ±Y, ±Z in turn,
 //! each in a fresh scene, as DexGraspNet and BODex test) for `duration_s`. The object's motion
 //! relative to the palm during the hold gives the verdict: `hold` within the thresholds, `slip`
 //! beyond them while still touching the hand, `drop` when it has left the hand.

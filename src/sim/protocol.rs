@@ -39,8 +39,13 @@ pub struct DirectionOutcome {
     pub verdict: Verdict,
     /// Object translation relative to the palm during the hold `[mm]`.
     pub translation_mm: f64,
-    /// Object rotation relative to the palm during the hold `[deg]`.
+    /// Object rotation relative to the palm during the hold, as judged: the tilt of the
+    /// principal axis for a body of revolution, the full rotation otherwise `[deg]`.
     pub rotation_deg: f64,
+    /// The full rotation relative to the palm `[deg]`.
+    pub full_rotation_deg: f64,
+    /// The tilt of the object's principal axis (aligned Z) relative to the palm `[deg]`.
+    pub tilt_deg: f64,
     /// Object translation relative to the palm while the fingers closed `[mm]`.
     pub closing_translation_mm: f64,
     /// Largest difference between a joint's bend after closing and its planned bend `[deg]`
@@ -75,6 +80,11 @@ pub struct SimOutcome {
 const G: f64 = 9.81;
 
 /// Runs the hold test for every gravity direction of `params.gravity`.
+///
+/// The rotation judged is the full rotation relative to the palm, except for an object that is
+/// (inertially) a body of revolution about its principal axis (`object.is_revolution`): a spin
+/// about that axis leaves it occupying the same space in the hand, so only the tilt of the axis
+/// counts.
 pub fn check(
     hand: &Hand,
     pose: &SimHand,
@@ -99,7 +109,7 @@ pub fn check(
     let mut steps = 0;
     for g in directions {
         let mut scene = build(hand, pose, object, mass_kg, friction, params);
-        let (o, n) = run_one(&mut scene, g, params);
+        let (o, n) = run_one(&mut scene, g, params, object.is_revolution);
         outcomes.push(o);
         steps += n;
     }
@@ -138,12 +148,17 @@ fn run_one(
     scene: &mut Scene,
     gravity: Vector3<f64>,
     params: &SimParams,
+    is_revolution: bool,
 ) -> (DirectionOutcome, usize) {
     let dt = params.timestep_s;
     let close_steps = (params.close_duration_s / dt).round() as usize;
     let hold_steps = (params.duration_s / dt).round() as usize;
     let (p0, q0) = relative(scene);
-    for _ in 0..close_steps {
+    // Joint 1 closes first; joint 2 follows halfway through the closing time.
+    for i in 0..close_steps {
+        if i == close_steps / 2 {
+            scene.release_joint2();
+        }
         scene.world.step();
     }
     let (pc, qc) = relative(scene);
@@ -161,6 +176,7 @@ fn run_one(
     let (pe, qe) = relative(scene);
     let translation_mm = (pe - pc).norm();
     let rotation_deg = qc.angle_to(&qe).to_degrees();
+    let tilt_deg = (qc * Vector3::z()).angle(&(qe * Vector3::z())).to_degrees();
     let in_contact = scene
         .world
         .narrow_phase
@@ -170,8 +186,13 @@ fn run_one(
                 && (scene.hand_colliders.contains(&pair.collider1)
                     || scene.hand_colliders.contains(&pair.collider2))
         });
+    let judged_rotation = if is_revolution {
+        tilt_deg
+    } else {
+        rotation_deg
+    };
     let verdict = if translation_mm <= params.hold_translation_mm
-        && rotation_deg <= params.hold_rotation_deg
+        && judged_rotation <= params.hold_rotation_deg
     {
         Verdict::Hold
     } else if in_contact {
@@ -185,7 +206,9 @@ fn run_one(
             gravity: [gravity.x, gravity.y, gravity.z],
             verdict,
             translation_mm,
-            rotation_deg,
+            rotation_deg: judged_rotation,
+            full_rotation_deg: rotation_deg,
+            tilt_deg,
             closing_translation_mm: (pc - p0).norm(),
             joint_error_deg,
             joint_errors_deg,

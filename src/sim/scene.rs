@@ -28,12 +28,18 @@ pub struct ObjectShape {
     pub kind: &'static str,
     /// Number of convex parts.
     pub parts: usize,
+    /// True if and only if the object is inertially a body of revolution about its principal
+    /// axis (aligned Z): its two transverse principal moments agree within 0.1 %.
+    pub is_revolution: bool,
 }
 
 impl ObjectShape {
     /// The convex hull of `mesh` (aligned, millimetres) if the mesh is convex (hull volume within
     /// 2 % of `volume_mm3`), a convex decomposition otherwise.
     pub fn from_mesh(mesh: &Mesh, volume_mm3: f64) -> ObjectShape {
+        let props = crate::mesh::mass_properties(mesh);
+        let (ixx, iyy) = (props.inertia[(0, 0)], props.inertia[(1, 1)]);
+        let is_revolution = (ixx - iyy).abs() <= 1e-3 * ixx.abs().max(iyy.abs());
         let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
         if let Some(hull) = SharedShape::convex_hull(&points) {
             let hull_mm3 = f64::from(hull.mass_properties(1.0).mass()) * 1e9;
@@ -42,6 +48,7 @@ impl ObjectShape {
                     shape: hull,
                     kind: "convex_hull",
                     parts: 1,
+                    is_revolution,
                 };
             }
         }
@@ -56,6 +63,7 @@ impl ObjectShape {
             shape,
             kind: "convex_decomposition",
             parts,
+            is_revolution,
         }
     }
 }
@@ -75,6 +83,44 @@ pub struct Scene {
     /// Phalanx bodies per finger and the bend each joint should reach `[rad]`: (body1, body2,
     /// planned bend 1, planned bend 2).
     pub fingers: Vec<(RigidBodyHandle, RigidBodyHandle, f64, f64)>,
+    /// Joint 2 of each finger and its motor target once released `[rad]` (held open until then).
+    pub joint2: Vec<(MultibodyJointHandle, f32)>,
+    /// Joint 1 of each finger.
+    pub joint1: Vec<MultibodyJointHandle>,
+    /// Motor stiffness and damping.
+    motor_gains: (f32, f32),
+    /// Torque that holds a locked joint 1 `[N·m]`.
+    lock_torque: f32,
+}
+
+impl Scene {
+    /// Locks joint 1 where it stopped and lets joint 2 close to its target: thesis 3.6.2 fixes
+    /// phalanx 1 before phalanx 2, and a Barrett finger (TorqueSwitch) closes joint 1 until it
+    /// stalls, after which its worm drive, which cannot be back-driven, holds it while joint 2
+    /// closes. Without the lock, joint 2's reaction torque lifts phalanx 1 off the object.
+    pub fn release_joint2(&mut self) {
+        let (k, d) = self.motor_gains;
+        for &h in &self.joint1 {
+            if let Some((mb, id)) = self.world.multibody_joints.get_mut(h) {
+                if let Some(link) = mb.link_mut(id) {
+                    let angle = link.joint.coords()[3];
+                    link.joint
+                        .data
+                        .set_motor_position(JointAxis::AngX, angle, k * 10.0, d)
+                        .set_motor_max_force(JointAxis::AngX, self.lock_torque);
+                }
+            }
+        }
+        for &(h, target) in &self.joint2 {
+            if let Some((mb, id)) = self.world.multibody_joints.get_mut(h) {
+                if let Some(link) = mb.link_mut(id) {
+                    link.joint
+                        .data
+                        .set_motor_position(JointAxis::AngX, target, k, d);
+                }
+            }
+        }
+    }
 }
 
 /// Bend from straight of a joint at interior angle `theta_deg` `[rad]`.
@@ -99,7 +145,12 @@ pub fn build(
     // distance 2e-2 × unit); at the default of 1 m they would be 5 mm and 20 mm, a sizeable part
     // of a 40 mm object. 1 cm makes them 0.05 mm and 0.2 mm (pinned by a test).
     ip.length_unit = 0.01;
+    // A grasp is a closed loop of stiff contacts and joints (palm, phalanges, object): rapier's
+    // default of one PGS sweep per substep leaves the object creeping under the squeeze (the
+    // convergence study in docs/SIM.md); more sweeps per substep settle it.
     ip.num_solver_iterations = params.solver_iterations;
+    ip.num_internal_pgs_iterations = params.pgs_iterations;
+    ip.num_internal_stabilization_iterations = params.stabilization_iterations;
     // Contact softness is a natural frequency relative to the bodies' effective mass. rapier's
     // default (30 Hz; 60 Hz against fixed bodies) is a spring of about 430 N/m against a 12 g
     // phalanx: a 1 N·m finger squeezing at 30 mm (33 N) would sink centimetres into the object.
@@ -157,9 +208,12 @@ pub fn build(
         bend(hand.joints.theta2_range_deg[0]) as f32,
     ];
     let squeeze = params.squeeze_deg.to_radians();
+    let squeeze2 = params.squeeze2_deg.to_radians();
     let motor = |target: f64, limits: [f32; 2]| (target as f32).clamp(limits[0], limits[1]);
     let mut fingers = Vec::new();
     let mut opening = Vec::new();
+    let mut joint2_handles = Vec::new();
+    let mut joint1_handles = Vec::new();
     for (f, [t1, t2]) in hand.finger_list.iter().zip(&pose.theta_deg) {
         let s: f32 = match f.side {
             Side::Left => 1.0,
@@ -207,7 +261,9 @@ pub fn build(
             )
             .motor_max_force(params.torque_limit_nm as f32)
             .contacts_enabled(false);
-        world.multibody_joints.insert(palm, b1, joint1, true);
+        if let Some(h) = world.multibody_joints.insert(palm, b1, joint1, true) {
+            joint1_handles.push(h);
+        }
 
         let r2 = r1 * turn(open2);
         let j2 = j1 + r1 * Vector3::new(0.0, f64::from(s) * l1, 0.0);
@@ -244,19 +300,22 @@ pub fn build(
                 ),
             );
         }
+        // Joint 2 is held at its open angle until released (see `Scene::release_joint2`).
         let joint2 = RevoluteJointBuilder::new(axis)
             .local_anchor1(Vector::new(0.0, s * mm(l1), 0.0))
             .local_anchor2(Vector::ZERO)
             .limits(limits2)
             .motor_model(MotorModel::ForceBased)
             .motor_position(
-                motor(bend(*t2) + squeeze, limits2),
+                open2 as f32,
                 params.motor_stiffness_nm_per_rad as f32,
                 params.motor_damping_nms_per_rad as f32,
             )
             .motor_max_force(params.torque_limit_nm as f32)
             .contacts_enabled(false);
-        world.multibody_joints.insert(b1, b2, joint2, true);
+        if let Some(h) = world.multibody_joints.insert(b1, b2, joint2, true) {
+            joint2_handles.push((h, motor(bend(*t2) + squeeze2, limits2)));
+        }
         fingers.push((b1, b2, bend(*t1), bend(*t2)));
         opening.push((b1, open1, b2, open2));
     }
@@ -297,5 +356,12 @@ pub fn build(
         object_collider,
         hand_colliders,
         fingers,
+        joint2: joint2_handles,
+        joint1: joint1_handles,
+        lock_torque: params.joint1_lock_torque_nm as f32,
+        motor_gains: (
+            params.motor_stiffness_nm_per_rad as f32,
+            params.motor_damping_nms_per_rad as f32,
+        ),
     }
 }
