@@ -104,22 +104,14 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             quaternion_wxyz: [q.w, q.i, q.j, q.k],
         },
     };
-    let graded = plan::grade_domain(
+    let (graded, found) = plan::plan(
         &aligned.mesh,
         &scenario.hand,
         &scenario.planner,
         scenario.object.friction,
+        options.candidates,
         &mut timings,
     );
-    let t = Instant::now();
-    let found = plan::search::search(
-        &aligned.mesh,
-        &scenario.hand,
-        &graded,
-        &scenario.planner,
-        options.candidates.max(1),
-    );
-    timings.insert("search".to_string(), ms(t));
     let grasps: Vec<report::GraspReport> = found
         .grasps
         .iter()

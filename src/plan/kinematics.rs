@@ -119,8 +119,10 @@ fn first_touch_bend(
         let t = ((c - a).dot(&ab) / ab.norm_squared()).clamp(0.0, 1.0);
         (a + ab * t - c).norm() - r
     };
-    // Scan in 0.5° steps for the first touch, then bisect to 1e-9 rad.
-    let step = 0.5f64.to_radians();
+    // Scan in 2° steps for the first touch, then bisect to 1e-9 rad. (A touch window narrower
+    // than 2° of bend would be missed; the gap is a smooth function of the bend, and for a
+    // circle it closes over tens of degrees.)
+    let step = 2f64.to_radians();
     let mut lo = 0.0;
     if gap(lo) <= 0.0 {
         return Some(0.0);
@@ -182,7 +184,7 @@ pub fn circle_contact_angles(hand: &Hand, r: f64) -> Option<[f64; 2]> {
 }
 
 /// Largest graspable diameter from the kinematics `[mm]`: the largest circle resting on the palm
-/// centre whose contact angles both lie in the joint ranges (scanned in 0.5 mm of radius, then
+/// centre whose contact angles both lie in the joint ranges (scanned in 2 mm of radius, then
 /// bisected to 0.01 mm). Returns 0 if no circle is graspable.
 pub fn largest_graspable_diameter(hand: &Hand) -> f64 {
     let in_range = |r: f64| -> bool {
@@ -205,12 +207,12 @@ pub fn largest_graspable_diameter(hand: &Hand) -> f64 {
         } else if last_ok.is_some() {
             break;
         }
-        r += 0.5;
+        r += 2.0;
     }
     let Some(mut lo) = last_ok else {
         return 0.0;
     };
-    let mut hi = lo + 0.5;
+    let mut hi = lo + 2.0;
     while hi - lo > 0.005 {
         let mid = 0.5 * (lo + hi);
         if in_range(mid) {

@@ -61,6 +61,23 @@ pub fn grade_domain(
     graded
 }
 
+/// The whole kinematic planner on an aligned object: stages 1–3, then the search for up to
+/// `max_grasps` feasible grasps (thesis chapter 3).
+pub fn plan(
+    mesh: &Mesh,
+    hand: &Hand,
+    params: &PlannerParams,
+    friction: f64,
+    max_grasps: usize,
+    timings: &mut BTreeMap<String, f64>,
+) -> (GradedDomain, search::SearchResult) {
+    let graded = grade_domain(mesh, hand, params, friction, timings);
+    let t = Instant::now();
+    let found = search::search(mesh, hand, &graded, params, max_grasps.max(1));
+    timings.insert("search".to_string(), ms(t));
+    (graded, found)
+}
+
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1000.0
 }

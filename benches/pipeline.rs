@@ -1,0 +1,136 @@
+//! Benchmarks of each stage (BENCHMARKS.md records the figures and the command).
+//!
+//!     cargo bench --bench pipeline
+//!
+//! - `slice/*`: one horizontal and one vertical slice of UV spheres of about 10k and 100k
+//!   triangles.
+//! - `plan/*`: the whole kinematic planner (align, stages 1–3, search) on each thesis object.
+//! - `plan_scaling/*`: the planner on the cup as AngularStep and HeightStep change.
+//! - `sim/*`: the physics check of the planned D40 grasp, `down` and `six`.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
+use grasp_sim::hand::Hand;
+use grasp_sim::mesh::{align, mass_properties};
+use grasp_sim::objects;
+use grasp_sim::plan::plan;
+use grasp_sim::scenario::{GravityMode, PlannerParams, SimParams};
+use grasp_sim::sim::{check, ObjectShape, SimHand};
+use grasp_sim::slice::{slice, Plane};
+use std::collections::BTreeMap;
+use std::hint::black_box;
+use std::path::Path;
+
+fn thesis_hand() -> Hand {
+    Hand::load(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/hands/thesis.toml"),
+        &[],
+    )
+    .unwrap()
+}
+
+fn bench_slice(c: &mut Criterion) {
+    let mut g = c.benchmark_group("slice");
+    for n in [100usize, 316] {
+        let sphere = objects::uv_sphere(50.0, n);
+        let tris = sphere.triangles.len();
+        g.bench_with_input(BenchmarkId::new("horizontal", tris), &sphere, |b, m| {
+            b.iter(|| slice(black_box(m), &Plane::horizontal(10.0)))
+        });
+        g.bench_with_input(BenchmarkId::new("vertical", tris), &sphere, |b, m| {
+            b.iter(|| slice(black_box(m), &Plane::vertical(0.3)))
+        });
+    }
+    g.finish();
+}
+
+fn bench_plan(c: &mut Criterion) {
+    let hand = thesis_hand();
+    let params = PlannerParams::default();
+    let mut g = c.benchmark_group("plan");
+    for (name, mesh) in objects::thesis_objects() {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let a = align(black_box(&mesh));
+                let mut t = BTreeMap::new();
+                plan(&a.mesh, &hand, &params, 0.3, 1, &mut t)
+            })
+        });
+    }
+    g.finish();
+
+    let cup = align(&objects::frustum(56.0, 80.0, 110.0)).mesh;
+    let mut g = c.benchmark_group("plan_scaling");
+    for step in [5.0, 10.0, 20.0] {
+        let p = PlannerParams {
+            angular_step_deg: step,
+            ..PlannerParams::default()
+        };
+        g.bench_with_input(BenchmarkId::new("angular_step_deg", step), &p, |b, p| {
+            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut BTreeMap::new()))
+        });
+    }
+    for step in [1.25, 2.5, 5.0] {
+        let p = PlannerParams {
+            height_step_mm: step,
+            ..PlannerParams::default()
+        };
+        g.bench_with_input(BenchmarkId::new("height_step_mm", step), &p, |b, p| {
+            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut BTreeMap::new()))
+        });
+    }
+    g.finish();
+}
+
+fn bench_kinematics(c: &mut Criterion) {
+    let hand = thesis_hand();
+    c.bench_function("kinematics/graspable_range", |b| {
+        b.iter(|| grasp_sim::plan::kinematics::graspable_range(black_box(&hand)))
+    });
+}
+
+fn bench_sim(c: &mut Criterion) {
+    let hand = thesis_hand();
+    let mesh = objects::cylinder(40.0, 124.0);
+    let a = align(&mesh);
+    let (_, found) = plan(
+        &a.mesh,
+        &hand,
+        &PlannerParams::default(),
+        0.3,
+        1,
+        &mut BTreeMap::new(),
+    );
+    let g0 = &found.grasps[0];
+    let pose = SimHand {
+        origin_mm: g0.palm.origin,
+        axes: g0.palm.axes,
+        theta_deg: g0
+            .fingers
+            .iter()
+            .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
+            .collect(),
+    };
+    let shape = ObjectShape::from_mesh(&a.mesh, mass_properties(&a.mesh).volume_mm3);
+    let mass = 500.0 * mass_properties(&a.mesh).volume_mm3 * 1e-9;
+    let mut g = c.benchmark_group("sim");
+    g.sample_size(10);
+    for (name, gravity) in [("down", GravityMode::Down), ("six", GravityMode::Six)] {
+        let params = SimParams {
+            gravity,
+            ..SimParams::default()
+        };
+        g.bench_function(name, |b| {
+            b.iter(|| check(&hand, &pose, &shape, mass, 0.3, &params))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    bench_slice,
+    bench_kinematics,
+    bench_plan,
+    bench_sim
+);
+criterion_main!(benches);
