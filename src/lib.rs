@@ -284,22 +284,7 @@ fn run_sim(
         } else {
             None
         },
-        directions: out
-            .directions
-            .iter()
-            .map(|d| report::SimDirectionReport {
-                gravity: d.gravity,
-                verdict: d.verdict.as_str().to_string(),
-                translation_mm: d.translation_mm,
-                rotation_deg: d.rotation_deg,
-                full_rotation_deg: d.full_rotation_deg,
-                tilt_deg: d.tilt_deg,
-                closing_translation_mm: d.closing_translation_mm,
-                joint_error_deg: d.joint_error_deg,
-                joint_errors_deg: d.joint_errors_deg.clone(),
-                in_contact: d.in_contact,
-            })
-            .collect(),
+        directions: out.directions,
     })
 }
 

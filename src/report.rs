@@ -204,33 +204,7 @@ pub struct SimReport {
     pub payload_margin: Option<f64>,
     /// Per gravity direction.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub directions: Vec<SimDirectionReport>,
-}
-
-/// The hold test for one gravity direction.
-#[derive(Debug, Clone, Serialize)]
-pub struct SimDirectionReport {
-    /// Gravity direction, unit, aligned object frame.
-    pub gravity: [f64; 3],
-    /// `hold`, `slip` or `drop`.
-    pub verdict: String,
-    /// Translation relative to the palm during the hold `[mm]`.
-    pub translation_mm: f64,
-    /// Rotation relative to the palm during the hold, as judged (the axis's tilt for a body of
-    /// revolution, the full rotation otherwise) `[deg]`.
-    pub rotation_deg: f64,
-    /// The full rotation relative to the palm `[deg]`.
-    pub full_rotation_deg: f64,
-    /// The tilt of the object's principal axis relative to the palm `[deg]`.
-    pub tilt_deg: f64,
-    /// Translation relative to the palm while the fingers closed `[mm]`.
-    pub closing_translation_mm: f64,
-    /// Largest joint bend error after closing against the plan `[deg]`.
-    pub joint_error_deg: f64,
-    /// Per finger, both joints' bend error after closing `[deg]`.
-    pub joint_errors_deg: Vec<[f64; 2]>,
-    /// True if and only if the object touches the hand at the end.
-    pub in_contact: bool,
+    pub directions: Vec<crate::sim::DirectionOutcome>,
 }
 
 /// The `expect` part of the report.

@@ -9,7 +9,8 @@ use rapier3d::prelude::*;
 use std::time::Instant;
 
 /// The verdict of the hold test.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Verdict {
     /// The object stayed within the thresholds.
     Hold,
@@ -30,8 +31,8 @@ impl Verdict {
     }
 }
 
-/// The result for one gravity direction.
-#[derive(Debug, Clone, PartialEq)]
+/// The result for one gravity direction (reported as is in the JSON's `sim.directions`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct DirectionOutcome {
     /// Gravity direction (unit, aligned frame).
     pub gravity: [f64; 3],
