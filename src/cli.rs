@@ -31,6 +31,15 @@ pub struct Cli {
     #[arg(long)]
     pub payload: bool,
 
+    /// Write each planned grasp as an MJCF scene for MuJoCo into DIR/<scenario>/ (scene.xml,
+    /// the object's STL, protocol.json for scripts/mujoco_replay.py).
+    #[arg(long, value_name = "DIR")]
+    pub export_mjcf: Option<PathBuf>,
+
+    /// Write the hand as URDF into DIR/<scenario>/hand.urdf.
+    #[arg(long, value_name = "DIR")]
+    pub export_urdf: Option<PathBuf>,
+
     /// Collect up to N feasible grasps in search order (reported under `plan.grasps`).
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub candidates: u32,

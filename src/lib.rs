@@ -18,6 +18,7 @@
 
 #![warn(missing_docs)]
 
+pub mod export;
 pub mod hand;
 pub mod mesh;
 pub mod objects;
@@ -44,10 +45,13 @@ pub enum Error {
     /// A bad mesh file.
     #[error(transparent)]
     Mesh(#[from] mesh::MeshError),
+    /// An export could not be written.
+    #[error(transparent)]
+    Export(#[from] export::ExportError),
 }
 
 /// How to run a scenario.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone)]
 pub struct RunOptions {
     /// Skip the physics check.
     pub no_sim: bool,
@@ -55,6 +59,10 @@ pub struct RunOptions {
     pub payload: bool,
     /// How many feasible grasps to collect, in search order (the thesis stops at 1).
     pub candidates: usize,
+    /// Write the planned grasp as an MJCF scene into this folder (a subfolder per scenario).
+    pub export_mjcf: Option<std::path::PathBuf>,
+    /// Write the hand as URDF into this folder (a subfolder per scenario).
+    pub export_urdf: Option<std::path::PathBuf>,
 }
 
 impl Default for RunOptions {
@@ -63,6 +71,8 @@ impl Default for RunOptions {
             no_sim: false,
             payload: false,
             candidates: 1,
+            export_mjcf: None,
+            export_urdf: None,
         }
     }
 }
@@ -219,7 +229,10 @@ fn run_sim(
         reason: Some(reason.to_string()),
         ..SimReport::default()
     };
-    if options.no_sim {
+    if let Some(dir) = &options.export_urdf {
+        export::write_urdf(&dir.join(&scenario.name), &scenario.hand, &scenario.sim)?;
+    }
+    if options.no_sim && options.export_mjcf.is_none() {
         return Ok(not_run("--no-sim"));
     }
     let p = &scenario.sim;
@@ -265,6 +278,24 @@ fn run_sim(
     };
     let shape = sim::ObjectShape::from_mesh(&aligned.mesh, aligned.original.volume_mm3);
     let friction = scenario.object.friction;
+    if let Some(dir) = &options.export_mjcf {
+        export::write_mjcf(
+            &dir.join(&scenario.name),
+            &export::ExportInput {
+                name: &scenario.name,
+                hand: &scenario.hand,
+                pose: &pose,
+                object: aligned,
+                shape: &shape,
+                mass_kg,
+                friction,
+                sim: p,
+            },
+        )?;
+    }
+    if options.no_sim {
+        return Ok(not_run("--no-sim"));
+    }
     let out = sim::check(&scenario.hand, &pose, &shape, mass_kg, friction, p);
     let payload_margin = (options.payload && out.verdict == sim::Verdict::Hold)
         .then(|| sim::payload_margin(&scenario.hand, &pose, &shape, mass_kg, friction, p));

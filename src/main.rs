@@ -34,6 +34,8 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         no_sim: cli.no_sim,
         payload: cli.payload,
         candidates: cli.candidates as usize,
+        export_mjcf: cli.export_mjcf,
+        export_urdf: cli.export_urdf,
     };
     // Everything is run before anything is printed, so bad input anywhere leaves no partial output.
     let mut reports = Vec::new();

@@ -1,6 +1,7 @@
 //! Integration tests, one binary so the suite links once.
 
 mod cli;
+mod export;
 mod geometry;
 mod planner;
 mod sim;

@@ -1,0 +1,114 @@
+#!/usr/bin/env python3
+"""Replay a grasp exported by `grasp-sim --export-mjcf DIR` in MuJoCo, with grasp-sim's protocol.
+
+    python3 scripts/mujoco_replay.py DIR/<scenario> [DIR/<scenario> ...]
+
+Prints one JSON object per scene: the verdict (hold / slip / drop) with the same thresholds as
+grasp-sim's rapier check, the object's translation and rotation relative to the palm during the
+hold, and whether it still touches the hand. Protocol (docs/SIM.md), read from protocol.json:
+fingers start at the `open` keyframe; gravity off; joint 1 closes towards its target (planned
+bend plus squeeze) while joint 2 is held open; halfway through the closing time joint 1 locks
+where it stopped (a TorqueSwitch) and joint 2 closes; then gravity on for the hold.
+Needs `pip install mujoco`.
+"""
+import json
+import math
+import pathlib
+import sys
+
+import mujoco
+import numpy as np
+
+
+def quat_angle_deg(q1, q2):
+    d = abs(float(np.dot(q1, q2)))
+    return math.degrees(2.0 * math.acos(min(1.0, d)))
+
+
+def relative_pose(m, d, palm, obj):
+    """The object's body frame in the palm's frame: (position in mm, rotation matrix)."""
+    rp = d.xmat[palm].reshape(3, 3)
+    ro = d.xmat[obj].reshape(3, 3)
+    p = rp.T @ (d.xpos[obj] - d.xpos[palm])
+    return p * 1000.0, rp.T @ ro
+
+
+def replay(scene_dir):
+    scene_dir = pathlib.Path(scene_dir)
+    proto = json.loads((scene_dir / "protocol.json").read_text())
+    m = mujoco.MjModel.from_xml_path(str(scene_dir / "scene.xml"))
+    d = mujoco.MjData(m)
+    mujoco.mj_resetDataKeyframe(m, d, m.key("open").id)
+    n = len(proto["fingers"])
+    target = proto["target_bend_rad"]
+    opened = proto["open_bend_rad"]
+    for k in range(n):
+        d.ctrl[2 * k] = target[2 * k]
+        d.ctrl[2 * k + 1] = opened[2 * k + 1]
+    gravity = m.opt.gravity.copy()
+    m.opt.gravity[:] = 0.0
+    dt = m.opt.timestep
+    close_steps = round(proto["close_duration_s"] / dt)
+    hold_steps = round(proto["duration_s"] / dt)
+    kp = proto["motor_stiffness_nm_per_rad"]
+    lock = proto["joint1_lock_torque_nm"]
+    palm = m.body("palm").id
+    obj = m.body("object").id
+    for i in range(close_steps):
+        if i == close_steps // 2:
+            for k in range(n):
+                a = 2 * k
+                joint = m.actuator_trnid[a, 0]
+                d.ctrl[a] = d.qpos[m.jnt_qposadr[joint]]
+                m.actuator_gainprm[a, 0] = 10.0 * kp
+                m.actuator_biasprm[a, 1] = -10.0 * kp
+                m.actuator_forcerange[a] = [-lock, lock]
+                d.ctrl[a + 1] = target[a + 1]
+        mujoco.mj_step(m, d)
+    pc, rc = relative_pose(m, d, palm, obj)
+    m.opt.gravity[:] = gravity
+    for _ in range(hold_steps):
+        mujoco.mj_step(m, d)
+    pe, re = relative_pose(m, d, palm, obj)
+    translation = float(np.linalg.norm(pe - pc))
+    qc = np.zeros(4)
+    qe = np.zeros(4)
+    mujoco.mju_mat2Quat(qc, rc.flatten())
+    mujoco.mju_mat2Quat(qe, re.flatten())
+    full_rotation = quat_angle_deg(qc, qe)
+    tilt = math.degrees(math.acos(max(-1.0, min(1.0, float(rc[:, 2] @ re[:, 2])))))
+    rotation = tilt if proto["is_revolution"] else full_rotation
+    hand_bodies = {palm} | {m.body(f"{f}_phalanx_{j}").id for f in proto["fingers"] for j in (1, 2)}
+    in_contact = False
+    for c in d.contact[: d.ncon]:
+        b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
+        if (b1 == obj and b2 in hand_bodies) or (b2 == obj and b1 in hand_bodies):
+            in_contact = True
+    if translation <= proto["hold_translation_mm"] and rotation <= proto["hold_rotation_deg"]:
+        verdict = "hold"
+    elif in_contact:
+        verdict = "slip"
+    else:
+        verdict = "drop"
+    return {
+        "scenario": proto["scenario"],
+        "engine": f"mujoco {mujoco.__version__}",
+        "verdict": verdict,
+        "translation_mm": translation,
+        "rotation_deg": rotation,
+        "full_rotation_deg": full_rotation,
+        "in_contact": in_contact,
+    }
+
+
+def main(argv):
+    if len(argv) < 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    for scene_dir in argv[1:]:
+        print(json.dumps(replay(scene_dir)))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

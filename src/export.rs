@@ -1,0 +1,466 @@
+//! Exporting a planned grasp for other tools: an MJCF scene for MuJoCo and a URDF of the hand.
+//!
+//! Units: metres, kilograms, radians (MuJoCo's and URDF's). Frames: the aligned object frame of
+//! grasp-sim (principal axis +Z, gravity along −Z). Every joint's angle is the thesis's bend
+//! (180° − θ) about `(0, 0, side)` in its parent's frame, exactly as in the rapier scene
+//! (`crate::sim`), so a joint value read in either engine means the same thing.
+//!
+//! The MJCF scene: the palm welded to the world at the planned pose (a body without joints);
+//! per finger two phalanx bodies with hinge joints (the hand's limits) and position actuators with
+//! the rapier check's gains and torque limit (`forcerange`); the object as a free body with its
+//! mesh (the convex decomposition's parts when the check used one) and an explicit inertial from
+//! grasp-sim's mass properties; keyframes `open` (where the check starts) and `planned` (the
+//! planned joint angles); gravity as in the scenario. `protocol.json` beside it carries what the
+//! replay script needs to run the same protocol (scripts/mujoco_replay.py).
+
+use crate::hand::{Hand, Side};
+use crate::mesh::{AlignedObject, Mesh};
+use crate::scenario::{GravityMode, SimParams};
+use crate::sim::{ObjectShape, SimHand};
+use nalgebra::{Point3, Rotation3, UnitQuaternion, Vector3};
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// Problems writing an export.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: cannot write: {message}")]
+pub struct ExportError {
+    /// The file or folder.
+    pub path: PathBuf,
+    /// Why.
+    pub message: String,
+}
+
+/// Everything an export needs about the grasp.
+pub struct ExportInput<'a> {
+    /// Scenario name (the MJCF model name).
+    pub name: &'a str,
+    /// The hand.
+    pub hand: &'a Hand,
+    /// Palm pose and planned joint angles.
+    pub pose: &'a SimHand,
+    /// The aligned object.
+    pub object: &'a AlignedObject,
+    /// Its collision shape, as the rapier check built it.
+    pub shape: &'a ObjectShape,
+    /// Object mass `[kg]`.
+    pub mass_kg: f64,
+    /// Friction coefficient.
+    pub friction: f64,
+    /// The physics check's parameters.
+    pub sim: &'a SimParams,
+}
+
+const MM: f64 = 1e-3;
+
+/// MuJoCo's timestep in the exported scene `[s]` (see [`write_mjcf`]).
+pub const MUJOCO_TIMESTEP_S: f64 = 2e-4;
+
+fn v3(v: &Vector3<f64>) -> String {
+    format!("{:.9} {:.9} {:.9}", v.x, v.y, v.z)
+}
+
+fn quat(q: &UnitQuaternion<f64>) -> String {
+    format!("{:.12} {:.12} {:.12} {:.12}", q.w, q.i, q.j, q.k)
+}
+
+fn side_sign(side: Side) -> f64 {
+    match side {
+        Side::Left => 1.0,
+        Side::Right => -1.0,
+    }
+}
+
+fn bend(theta_deg: f64) -> f64 {
+    (180.0 - theta_deg).to_radians()
+}
+
+/// Writes `scene.xml`, the object's mesh file(s) and `protocol.json` into `dir`.
+///
+/// # Errors
+/// [`ExportError`] naming the file that could not be written.
+pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
+    let err = |path: &Path, e: std::io::Error| ExportError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
+    let hand = input.hand;
+    let sim = input.sim;
+    let [x, y, z] = input.pose.axes;
+    let r_palm = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
+        nalgebra::Matrix3::from_columns(&[x, y, z]),
+    ));
+    let o = hand.fingers.offset_mm;
+    let (l1, l2) = (hand.phalanx_1.length_mm, hand.phalanx_2.length_mm);
+    let l2c = l2 - hand.phalanx_2.unusable_distal_mm;
+    let (h_lo, h_hi) = hand.finger_height_span();
+    let m = hand.palm.margin_mm;
+    let mu = input.friction;
+    let finger_density = sim.finger_density_kg_m3;
+    let lim = |r: [f64; 2]| (bend(r[1]), bend(r[0]));
+    let (lo1, hi1) = lim(hand.joints.theta1_range_deg);
+    let (lo2, hi2) = lim(hand.joints.theta2_range_deg);
+
+    // Object meshes: one hull, or the decomposition's parts, in metres.
+    let mut meshes: Vec<(String, Mesh)> = Vec::new();
+    match input.shape.shape.as_compound() {
+        Some(compound) => {
+            for (k, (_, part)) in compound.shapes().iter().enumerate() {
+                if let Some(poly) = part.as_convex_polyhedron() {
+                    let points: Vec<Point3<f64>> = poly
+                        .points()
+                        .iter()
+                        .map(|p| Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
+                        .collect();
+                    let soup: Vec<[Point3<f64>; 3]> = poly
+                        .to_trimesh()
+                        .1
+                        .iter()
+                        .map(|t| {
+                            [
+                                points[t[0] as usize],
+                                points[t[1] as usize],
+                                points[t[2] as usize],
+                            ]
+                        })
+                        .collect();
+                    meshes.push((format!("object_part_{k}"), Mesh::from_triangles(&soup).0));
+                }
+            }
+        }
+        None => {
+            let mut mesh = input.object.mesh.clone();
+            mesh.map_vertices(|p| p * MM);
+            meshes.push(("object".to_string(), mesh));
+        }
+    }
+    for (name, mesh) in &meshes {
+        let path = dir.join(format!("{name}.stl"));
+        std::fs::write(&path, mesh.to_binary_stl()).map_err(|e| err(&path, e))?;
+    }
+
+    let mut s = String::new();
+    let g = match sim.gravity {
+        GravityMode::Down | GravityMode::Six => "0 0 -9.81",
+    };
+    let _ = writeln!(s, "<mujoco model=\"grasp-sim {}\">", input.name);
+    let _ = writeln!(s, "  <compiler angle=\"radian\" autolimits=\"true\"/>");
+    // MuJoCo integrates actuator stiffness explicitly: a 20–200 N·m/rad servo on a phalanx of
+    // about 1.5e-5 kg·m² (natural frequency 1,100–3,700 rad/s) is unstable at rapier's 1 ms
+    // step, so the scene uses MuJoCo's `implicitfast` integrator and a 0.2 ms step (ω·dt < 1).
+    let _ = writeln!(
+        s,
+        "  <option timestep=\"{MUJOCO_TIMESTEP_S}\" integrator=\"implicitfast\" gravity=\"{g}\" cone=\"elliptic\" impratio=\"10\"/>"
+    );
+    let _ = writeln!(s, "  <default>");
+    let _ = writeln!(
+        s,
+        "    <geom friction=\"{mu} 0 0\" condim=\"3\" solref=\"{:.6} 1\"/>",
+        2.0 * MUJOCO_TIMESTEP_S
+    );
+    let _ = writeln!(s, "  </default>");
+    let _ = writeln!(s, "  <asset>");
+    for (name, _) in &meshes {
+        let _ = writeln!(s, "    <mesh name=\"{name}\" file=\"{name}.stl\"/>");
+    }
+    let _ = writeln!(s, "  </asset>");
+    let _ = writeln!(s, "  <worldbody>");
+    let palm_pos = input.pose.origin_mm.coords * MM;
+    let _ = writeln!(
+        s,
+        "    <body name=\"palm\" pos=\"{}\" quat=\"{}\">",
+        v3(&palm_pos),
+        quat(&r_palm)
+    );
+    let _ = writeln!(
+        s,
+        "      <geom name=\"palm\" type=\"box\" size=\"{}\" pos=\"{}\"/>",
+        v3(&(Vector3::new(
+            hand.palm.offset_mm / 2.0,
+            hand.palm.half_width_mm,
+            (h_hi - h_lo) / 2.0 + m
+        ) * MM)),
+        v3(&(Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (h_hi + h_lo) / 2.0) * MM))
+    );
+    for f in &hand.finger_list {
+        let sd = side_sign(f.side);
+        let n = &f.name;
+        let anchor = Vector3::new(
+            hand.joints.setback_mm,
+            sd * hand.joints.lateral_mm,
+            f.height_mm,
+        ) * MM;
+        let _ = writeln!(
+            s,
+            "      <body name=\"{n}_phalanx_1\" pos=\"{}\">",
+            v3(&anchor)
+        );
+        let _ = writeln!(
+            s,
+            "        <joint name=\"{n}_joint_1\" type=\"hinge\" axis=\"0 0 {sd}\" range=\"{lo1:.9} {hi1:.9}\" damping=\"0\"/>"
+        );
+        let _ = writeln!(
+            s,
+            "        <geom name=\"{n}_phalanx_1\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
+            v3(&(Vector3::new(o, l1 / 2.0, o) * MM)),
+            v3(&(Vector3::new(0.0, sd * l1 / 2.0, 0.0) * MM))
+        );
+        let _ = writeln!(
+            s,
+            "        <body name=\"{n}_phalanx_2\" pos=\"{}\">",
+            v3(&(Vector3::new(0.0, sd * l1, 0.0) * MM))
+        );
+        let _ = writeln!(
+            s,
+            "          <joint name=\"{n}_joint_2\" type=\"hinge\" axis=\"0 0 {sd}\" range=\"{lo2:.9} {hi2:.9}\" damping=\"0\"/>"
+        );
+        let _ = writeln!(
+            s,
+            "          <geom name=\"{n}_phalanx_2\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
+            v3(&(Vector3::new(o, l2c / 2.0, o) * MM)),
+            v3(&(Vector3::new(0.0, sd * l2c / 2.0, 0.0) * MM))
+        );
+        if l2 > l2c + 1e-9 {
+            let t = hand.fingers.tip_thickness_mm;
+            let _ = writeln!(
+                s,
+                "          <geom name=\"{n}_tip\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
+                v3(&(Vector3::new(t / 2.0, (l2 - l2c) / 2.0, o) * MM)),
+                v3(&(Vector3::new(o - t / 2.0, sd * (l2 + l2c) / 2.0, 0.0) * MM))
+            );
+        }
+        let _ = writeln!(s, "        </body>");
+        let _ = writeln!(s, "      </body>");
+    }
+    let _ = writeln!(s, "    </body>");
+    // The object: free, at the origin of the aligned frame, with grasp-sim's inertia.
+    let props = crate::mesh::mass_properties(&input.object.mesh);
+    let density_kg_mm3 = input.mass_kg / props.volume_mm3;
+    let inertia = props.inertia * density_kg_mm3 * MM * MM;
+    let c = props.centroid.coords * MM;
+    let _ = writeln!(s, "    <body name=\"object\" pos=\"0 0 0\">");
+    let _ = writeln!(s, "      <freejoint name=\"object\"/>");
+    let _ = writeln!(
+        s,
+        "      <inertial pos=\"{}\" mass=\"{:.9}\" fullinertia=\"{:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}\"/>",
+        v3(&c),
+        input.mass_kg,
+        inertia[(0, 0)],
+        inertia[(1, 1)],
+        inertia[(2, 2)],
+        inertia[(0, 1)],
+        inertia[(0, 2)],
+        inertia[(1, 2)]
+    );
+    for (name, _) in &meshes {
+        let _ = writeln!(
+            s,
+            "      <geom name=\"{name}\" type=\"mesh\" mesh=\"{name}\" mass=\"0\"/>"
+        );
+    }
+    let _ = writeln!(s, "    </body>");
+    let _ = writeln!(s, "  </worldbody>");
+    // As in the rapier check (one multibody, self-contacts off), the hand's bodies never collide
+    // with each other; MuJoCo only filters parent-child pairs, and not those of a body welded to
+    // the world such as the palm, so every pair is listed.
+    let mut hand_bodies = vec!["palm".to_string()];
+    for f in &hand.finger_list {
+        hand_bodies.push(format!("{}_phalanx_1", f.name));
+        hand_bodies.push(format!("{}_phalanx_2", f.name));
+    }
+    let _ = writeln!(s, "  <contact>");
+    for (i, a) in hand_bodies.iter().enumerate() {
+        for b in &hand_bodies[i + 1..] {
+            let _ = writeln!(s, "    <exclude body1=\"{a}\" body2=\"{b}\"/>");
+        }
+    }
+    let _ = writeln!(s, "  </contact>");
+    let _ = writeln!(s, "  <actuator>");
+    let (kp, kv, tau) = (
+        sim.motor_stiffness_nm_per_rad,
+        sim.motor_damping_nms_per_rad,
+        sim.torque_limit_nm,
+    );
+    for f in &hand.finger_list {
+        for (j, (lo, hi)) in [(1, (lo1, hi1)), (2, (lo2, hi2))] {
+            let _ = writeln!(
+                s,
+                "    <position name=\"{n}_joint_{j}\" joint=\"{n}_joint_{j}\" kp=\"{kp}\" kv=\"{kv}\" forcerange=\"{:.6} {tau:.6}\" ctrlrange=\"{lo:.9} {hi:.9}\"/>",
+                -tau,
+                n = f.name
+            );
+        }
+    }
+    let _ = writeln!(s, "  </actuator>");
+
+    // Keyframes: joint values are bends; the object's free joint is at rest at the origin.
+    let margin = sim.open_margin_deg.to_radians();
+    let mut open = Vec::new();
+    let mut planned = Vec::new();
+    let mut ctrl = Vec::new();
+    for [t1, t2] in &input.pose.theta_deg {
+        let (b1, b2) = (bend(*t1), bend(*t2));
+        open.push((b1 - margin).max(lo1));
+        open.push((b2 - margin).max(lo2));
+        planned.push(b1);
+        planned.push(b2);
+        ctrl.push((b1 + sim.squeeze_deg.to_radians()).clamp(lo1, hi1));
+        ctrl.push((b2 + sim.squeeze2_deg.to_radians()).clamp(lo2, hi2));
+    }
+    let join = |v: &[f64]| {
+        v.iter()
+            .map(|x| format!("{x:.9}"))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    let _ = writeln!(s, "  <keyframe>");
+    let _ = writeln!(
+        s,
+        "    <key name=\"open\" qpos=\"{} 0 0 0 1 0 0 0\" ctrl=\"{}\"/>",
+        join(&open),
+        join(&open)
+    );
+    let _ = writeln!(
+        s,
+        "    <key name=\"planned\" qpos=\"{} 0 0 0 1 0 0 0\" ctrl=\"{}\"/>",
+        join(&planned),
+        join(&ctrl)
+    );
+    let _ = writeln!(s, "  </keyframe>");
+    let _ = writeln!(s, "</mujoco>");
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, s).map_err(|e| err(&path, e))?;
+
+    let protocol = serde_json::json!({
+        "scenario": input.name,
+        "fingers": hand.finger_list.iter().map(|f| f.name.clone()).collect::<Vec<_>>(),
+        "planned_bend_rad": planned,
+        "open_bend_rad": open,
+        "target_bend_rad": ctrl,
+        "close_duration_s": sim.close_duration_s,
+        "duration_s": sim.duration_s,
+        "joint1_lock_torque_nm": sim.joint1_lock_torque_nm,
+        "motor_stiffness_nm_per_rad": kp,
+        "hold_translation_mm": sim.hold_translation_mm,
+        "hold_rotation_deg": sim.hold_rotation_deg,
+        "gravity": match sim.gravity { GravityMode::Down => "down", GravityMode::Six => "six" },
+        "is_revolution": input.shape.is_revolution,
+        "mass_kg": input.mass_kg,
+        "friction": mu,
+    });
+    let path = dir.join("protocol.json");
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(&protocol).unwrap_or_default(),
+    )
+    .map_err(|e| err(&path, e))?;
+    Ok(())
+}
+
+/// Writes the hand (palm and six phalanges, revolute joints with limits and effort) as
+/// `hand.urdf` into `dir`, in the palm frame, joints at their zero (straight) bend.
+///
+/// # Errors
+/// [`ExportError`] naming the file that could not be written.
+pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), ExportError> {
+    let err = |path: &Path, e: std::io::Error| ExportError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
+    let o = hand.fingers.offset_mm * MM;
+    let (l1, l2) = (hand.phalanx_1.length_mm * MM, hand.phalanx_2.length_mm * MM);
+    let (h_lo, h_hi) = hand.finger_height_span();
+    let m = hand.palm.margin_mm;
+    let rho = sim.finger_density_kg_m3;
+    let mut s = String::new();
+    let _ = writeln!(s, "<?xml version=\"1.0\"?>");
+    let _ = writeln!(s, "<robot name=\"{}\">", hand.name);
+    let boxed = |s: &mut String, name: &str, size: Vector3<f64>, at: Vector3<f64>| {
+        let mass = rho * size.x * size.y * size.z;
+        let (ixx, iyy, izz) = (
+            mass * (size.y * size.y + size.z * size.z) / 12.0,
+            mass * (size.x * size.x + size.z * size.z) / 12.0,
+            mass * (size.x * size.x + size.y * size.y) / 12.0,
+        );
+        let geometry = format!(
+            "<origin xyz=\"{}\"/><geometry><box size=\"{}\"/></geometry>",
+            v3(&at),
+            v3(&size)
+        );
+        let _ = writeln!(s, "  <link name=\"{name}\">");
+        let _ = writeln!(
+            s,
+            "    <inertial><origin xyz=\"{}\"/><mass value=\"{mass:.9}\"/><inertia ixx=\"{ixx:.6e}\" ixy=\"0\" ixz=\"0\" iyy=\"{iyy:.6e}\" iyz=\"0\" izz=\"{izz:.6e}\"/></inertial>",
+            v3(&at)
+        );
+        let _ = writeln!(s, "    <visual>{geometry}</visual>");
+        let _ = writeln!(s, "    <collision>{geometry}</collision>");
+        let _ = writeln!(s, "  </link>");
+    };
+    boxed(
+        &mut s,
+        "palm",
+        Vector3::new(
+            hand.palm.offset_mm,
+            2.0 * hand.palm.half_width_mm,
+            h_hi - h_lo + 2.0 * m,
+        ) * MM,
+        Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (h_hi + h_lo) / 2.0) * MM,
+    );
+    let lim = |r: [f64; 2]| (bend(r[1]), bend(r[0]));
+    for f in &hand.finger_list {
+        let sd = side_sign(f.side);
+        let n = &f.name;
+        boxed(
+            &mut s,
+            &format!("{n}_phalanx_1"),
+            Vector3::new(2.0 * o, l1, 2.0 * o),
+            Vector3::new(0.0, sd * l1 / 2.0, 0.0),
+        );
+        boxed(
+            &mut s,
+            &format!("{n}_phalanx_2"),
+            Vector3::new(2.0 * o, l2, 2.0 * o),
+            Vector3::new(0.0, sd * l2 / 2.0, 0.0),
+        );
+        for (j, parent, child, origin, range) in [
+            (
+                1,
+                "palm".to_string(),
+                format!("{n}_phalanx_1"),
+                Vector3::new(
+                    hand.joints.setback_mm,
+                    sd * hand.joints.lateral_mm,
+                    f.height_mm,
+                ) * MM,
+                lim(hand.joints.theta1_range_deg),
+            ),
+            (
+                2,
+                format!("{n}_phalanx_1"),
+                format!("{n}_phalanx_2"),
+                Vector3::new(0.0, sd * l1, 0.0),
+                lim(hand.joints.theta2_range_deg),
+            ),
+        ] {
+            let _ = writeln!(s, "  <joint name=\"{n}_joint_{j}\" type=\"revolute\">");
+            let _ = writeln!(
+                s,
+                "    <parent link=\"{parent}\"/><child link=\"{child}\"/>"
+            );
+            let _ = writeln!(s, "    <origin xyz=\"{}\" rpy=\"0 0 0\"/>", v3(&origin));
+            let _ = writeln!(s, "    <axis xyz=\"0 0 {sd}\"/>");
+            let _ = writeln!(
+                s,
+                "    <limit lower=\"{:.9}\" upper=\"{:.9}\" effort=\"{}\" velocity=\"10\"/>",
+                range.0, range.1, sim.torque_limit_nm
+            );
+            let _ = writeln!(s, "  </joint>");
+        }
+    }
+    let _ = writeln!(s, "</robot>");
+    let path = dir.join("hand.urdf");
+    std::fs::write(&path, s).map_err(|e| err(&path, e))
+}

@@ -1,0 +1,152 @@
+//! MJCF and URDF export: well-formed XML with the expected bodies, joints and actuators.
+
+use std::process::Command;
+
+fn export(scenario: &str) -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_grasp-sim"))
+        .current_dir(crate::root())
+        .args(["--json", "--no-sim", "--export-mjcf"])
+        .arg(dir.path())
+        .arg("--export-urdf")
+        .arg(dir.path())
+        .arg(format!("scenarios/{scenario}.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    dir
+}
+
+fn names<'a>(doc: &'a roxmltree::Document, tag: &str) -> Vec<&'a str> {
+    doc.descendants()
+        .filter(|n| n.has_tag_name(tag))
+        .filter_map(|n| n.attribute("name"))
+        .collect()
+}
+
+#[test]
+fn mjcf_has_the_hand_the_object_and_the_actuators() {
+    let dir = export("cylinder_d40");
+    let scene = dir.path().join("cylinder_d40");
+    let text = std::fs::read_to_string(scene.join("scene.xml")).unwrap();
+    let doc = roxmltree::Document::parse(&text).expect("well-formed MJCF");
+    let bodies = names(&doc, "body");
+    let mut expected = vec!["palm".to_string(), "object".to_string()];
+    for f in ["finger_1", "finger_2", "finger_3"] {
+        expected.push(format!("{f}_phalanx_1"));
+        expected.push(format!("{f}_phalanx_2"));
+    }
+    for e in &expected {
+        assert!(bodies.contains(&e.as_str()), "body {e} missing: {bodies:?}");
+    }
+    let joints: Vec<_> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("joint"))
+        .collect();
+    assert_eq!(joints.len(), 6);
+    for j in &joints {
+        assert_eq!(j.attribute("type"), Some("hinge"));
+        let r: Vec<f64> = j
+            .attribute("range")
+            .unwrap()
+            .split(' ')
+            .map(|v| v.parse().unwrap())
+            .collect();
+        // Bends of 45°..135° (θ of 135°..45°).
+        assert!(
+            (r[0] - 45f64.to_radians()).abs() < 1e-6 && (r[1] - 135f64.to_radians()).abs() < 1e-6
+        );
+    }
+    assert_eq!(
+        doc.descendants()
+            .filter(|n| n.has_tag_name("freejoint"))
+            .count(),
+        1
+    );
+    let actuators: Vec<_> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("position"))
+        .collect();
+    assert_eq!(actuators.len(), 6);
+    for a in &actuators {
+        assert_eq!(
+            a.attribute("forcerange"),
+            Some("-1.000000 1.000000"),
+            "the torque limit"
+        );
+        assert_eq!(a.attribute("kp"), Some("20"));
+    }
+    let keys = names(&doc, "key");
+    assert_eq!(keys, ["open", "planned"]);
+    // The planned keyframe holds the planned joint angles as bends: θ1 = 72.1° is 107.9°.
+    let planned = doc
+        .descendants()
+        .find(|n| n.attribute("name") == Some("planned"))
+        .unwrap();
+    let q: Vec<f64> = planned
+        .attribute("qpos")
+        .unwrap()
+        .split(' ')
+        .map(|v| v.parse().unwrap())
+        .collect();
+    assert_eq!(q.len(), 6 + 7);
+    assert!(
+        (q[0].to_degrees() - (180.0 - 72.1)).abs() < 0.2,
+        "bend {}",
+        q[0].to_degrees()
+    );
+    // The object's mass and the mesh file beside the scene.
+    let inertial = doc
+        .descendants()
+        .find(|n| n.has_tag_name("inertial"))
+        .unwrap();
+    let mass: f64 = inertial.attribute("mass").unwrap().parse().unwrap();
+    assert!((mass - 0.0779).abs() < 1e-3, "mass {mass}");
+    assert!(scene.join("object.stl").is_file());
+    let protocol: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(scene.join("protocol.json")).unwrap())
+            .unwrap();
+    assert_eq!(protocol["is_revolution"], true);
+    assert_eq!(protocol["hold_translation_mm"], 5.0);
+}
+
+#[test]
+fn a_non_convex_object_is_exported_as_its_convex_parts() {
+    let dir = export("chapter4");
+    let scene = dir.path().join("chapter4");
+    let text = std::fs::read_to_string(scene.join("scene.xml")).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    let parts = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("mesh") && n.attribute("file").is_some())
+        .count();
+    assert!(parts > 1, "{parts} parts");
+    for k in 0..parts {
+        assert!(scene.join(format!("object_part_{k}.stl")).is_file());
+    }
+}
+
+#[test]
+fn urdf_has_links_joints_limits_and_effort() {
+    let dir = export("cup");
+    let text = std::fs::read_to_string(dir.path().join("cup/hand.urdf")).unwrap();
+    let doc = roxmltree::Document::parse(&text).expect("well-formed URDF");
+    assert_eq!(names(&doc, "link").len(), 7);
+    let joints: Vec<_> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("joint"))
+        .collect();
+    assert_eq!(joints.len(), 6);
+    for j in joints {
+        assert_eq!(j.attribute("type"), Some("revolute"));
+        let limit = j.children().find(|n| n.has_tag_name("limit")).unwrap();
+        assert_eq!(limit.attribute("effort"), Some("1"));
+        let lo: f64 = limit.attribute("lower").unwrap().parse().unwrap();
+        assert!((lo - 45f64.to_radians()).abs() < 1e-6);
+    }
+}
