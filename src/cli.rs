@@ -51,6 +51,31 @@ pub struct Cli {
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
+    /// Run many objects: every scenario and STL in the given folders, or the files given; one
+    /// JSON line per object, in input order, and a summary on stderr.
+    Batch {
+        /// Folders, scenario files (.toml) or meshes (.stl).
+        #[arg(required = true, value_name = "DIR | SCENARIO")]
+        inputs: Vec<PathBuf>,
+        /// Scenario used for bare STL files (default: the thesis hand and defaults).
+        #[arg(long, value_name = "SCENARIO")]
+        template: Option<PathBuf>,
+        /// Write the JSON lines to this file instead of stdout (written whole, or not at all).
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+        /// Worker threads (default: all cores).
+        #[arg(long, value_name = "N")]
+        jobs: Option<usize>,
+        /// Run only the K-th of N contiguous blocks of the inputs (e.g. a Slurm array task).
+        #[arg(long, value_name = "K/N")]
+        shard: Option<String>,
+        /// Plan only.
+        #[arg(long)]
+        no_sim: bool,
+        /// Also find each grasp's payload margin.
+        #[arg(long)]
+        payload: bool,
+    },
     /// Write the thesis objects as binary STL (deterministic: the same bytes every time).
     GenAssets {
         /// Output folder.

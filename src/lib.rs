@@ -18,6 +18,7 @@
 
 #![warn(missing_docs)]
 
+pub mod batch;
 pub mod export;
 pub mod hand;
 pub mod mesh;

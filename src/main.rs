@@ -27,8 +27,32 @@ fn main() -> ExitCode {
 }
 
 fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
-    if let Some(cli::Command::GenAssets { out }) = cli.command {
-        return gen_assets(&out).map(|()| 0);
+    match cli.command {
+        Some(cli::Command::GenAssets { out }) => return gen_assets(&out).map(|()| 0),
+        Some(cli::Command::Batch {
+            inputs,
+            template,
+            out,
+            jobs,
+            shard,
+            no_sim,
+            payload,
+        }) => {
+            let options = RunOptions {
+                no_sim,
+                payload,
+                ..RunOptions::default()
+            };
+            return batch(
+                &inputs,
+                template.as_deref(),
+                out.as_deref(),
+                jobs,
+                shard.as_deref(),
+                &options,
+            );
+        }
+        None => {}
     }
     let options = RunOptions {
         no_sim: cli.no_sim,
@@ -58,6 +82,102 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         all_met &= report.expect.met != Some(false);
     }
     Ok(if all_met { 0 } else { 1 })
+}
+
+fn default_jobs() -> usize {
+    std::thread::available_parallelism().map_or(1, |n| n.get())
+}
+
+fn batch(
+    inputs: &[std::path::PathBuf],
+    template: Option<&std::path::Path>,
+    out: Option<&std::path::Path>,
+    jobs: Option<usize>,
+    shard: Option<&str>,
+    options: &RunOptions,
+) -> anyhow::Result<u8> {
+    use grasp_sim::batch;
+    use std::io::IsTerminal;
+    let template = match template {
+        Some(p) => Scenario::load(p)?,
+        None => batch::default_template(),
+    };
+    let mut items = batch::expand(inputs)?;
+    if let Some(s) = shard {
+        let (k, n) = batch::parse_shard(s).map_err(|m| anyhow::anyhow!("--shard: {m}"))?;
+        items = batch::shard(&items, k, n);
+    }
+    let jobs = jobs.unwrap_or_else(default_jobs).max(1);
+    let total = items.len();
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new(total as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    });
+    let done = std::sync::atomic::AtomicUsize::new(0);
+    let progress = |item: &batch::Item, r: &batch::ItemResult| {
+        let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        let what = match r {
+            Ok(rep) => format!("{} {}", rep.plan.status, rep.sim.verdict),
+            Err(_) => "error".to_string(),
+        };
+        match &bar {
+            Some(b) => {
+                b.set_message(format!("{}: {what}", item.path().display()));
+                b.inc(1);
+            }
+            None => eprintln!("[{k}/{total}] {}: {what}", item.path().display()),
+        }
+    };
+    let t0 = std::time::Instant::now();
+    let results = batch::run_all(&items, &template, options, jobs, &progress);
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let mut text = String::new();
+    let mut errors = 0;
+    for (item, r) in items.iter().zip(&results) {
+        let line = match r {
+            Ok(rep) => serde_json::to_string(rep)?,
+            Err(e) => {
+                errors += 1;
+                eprintln!("grasp-sim: error: {e}");
+                serde_json::json!({"scenario": item.path().display().to_string(), "error": e})
+                    .to_string()
+            }
+        };
+        text.push_str(&line);
+        text.push('\n');
+    }
+    match out {
+        Some(path) => write_atomically(path, text.as_bytes())?,
+        None => std::io::stdout().lock().write_all(text.as_bytes())?,
+    }
+    eprintln!(
+        "{}",
+        batch::summary(&results, t0.elapsed().as_secs_f64(), jobs)
+    );
+    Ok(if errors > 0 { 2 } else { 0 })
+}
+
+/// Writes `bytes` to `path` through a temporary file beside it, so a reader never sees half a
+/// file.
+fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp"));
+    std::fs::write(&tmp, bytes)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .with_context(|| format!("{}: cannot write", path.display()))
 }
 
 fn gen_assets(out: &std::path::Path) -> anyhow::Result<()> {

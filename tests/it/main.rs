@@ -1,5 +1,6 @@
 //! Integration tests, one binary so the suite links once.
 
+mod batch;
 mod cli;
 mod export;
 mod geometry;
