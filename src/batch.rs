@@ -36,7 +36,8 @@ impl Item {
     }
 }
 
-/// Expands inputs into items, in a deterministic order.
+/// Expands inputs into items, in a deterministic order. A folder gives its scenarios (`*.toml`)
+/// when it has any (they name their own meshes), its meshes (`*.stl`) otherwise.
 ///
 /// # Errors
 /// [`ScenarioError::Io`] for an input that does not exist or is neither a folder, a `.toml` nor
@@ -54,6 +55,9 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
                 .filter(|p| p.is_file())
                 .filter_map(classify)
                 .collect();
+            if found.iter().any(|i| matches!(i, Item::Scenario(_))) {
+                found.retain(|i| matches!(i, Item::Scenario(_)));
+            }
             found.sort_by(|a, b| a.path().cmp(b.path()));
             items.extend(found);
         } else if input.is_file() {

@@ -76,6 +76,31 @@ pub enum Command {
         #[arg(long)]
         payload: bool,
     },
+    /// Sweep planner parameters over a grid and rank the settings by simulated outcomes (hold
+    /// rate, then mean payload margin, then mean translation); writes tune.csv, tune.json and
+    /// score_<param>.svg into --out.
+    Tune {
+        /// Folders, scenario files (.toml) or meshes (.stl).
+        #[arg(required = true, value_name = "DIR | SCENARIO")]
+        inputs: Vec<PathBuf>,
+        /// NAME=START:END:STEP, repeatable (sf_c, height_step_mm, angular_step_deg,
+        /// vertical_deviation_deg, joint_deviation_deg, joint_deviation_theta1_deg,
+        /// joint_deviation_theta2_deg, pitch_range_deg).
+        #[arg(long = "param", required = true, value_name = "NAME=START:END:STEP")]
+        params: Vec<String>,
+        /// Output folder.
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Plan up to N grasps per object and keep the best by simulation.
+        #[arg(long, value_name = "N", default_value_t = 1)]
+        candidates: usize,
+        /// Scenario used for bare STL files (default: the thesis hand and defaults).
+        #[arg(long, value_name = "SCENARIO")]
+        template: Option<PathBuf>,
+        /// Worker threads (default: all cores).
+        #[arg(long, value_name = "N")]
+        jobs: Option<usize>,
+    },
     /// Write the thesis objects as binary STL (deterministic: the same bytes every time).
     GenAssets {
         /// Output folder.

@@ -28,6 +28,7 @@ pub mod report;
 pub mod scenario;
 pub mod sim;
 pub mod slice;
+pub mod tune;
 
 use report::{
     ExpectReport, GradesReport, IndexScale, ObjectReport, PlanReport, PoseReport, RunReport,

@@ -330,3 +330,107 @@ pub fn thesis_objects() -> Vec<(&'static str, Mesh)> {
         ("chapter4", chapter4(&Chapter4Dims::default())),
     ]
 }
+
+/// A solid of revolution through `(z, diameter)` profile points, bottom to top `[mm]`
+/// (consecutive points at one height make a horizontal step).
+pub fn revolved(profile: &[(f64, f64)]) -> Mesh {
+    let angles = uniform_angles(RING_SEGMENTS);
+    let rings: Vec<Ring> = profile
+        .iter()
+        .map(|&(z, d)| Ring {
+            z,
+            radii: vec![d / 2.0; angles.len()],
+        })
+        .collect();
+    radial_solid(&angles, &rings)
+}
+
+/// A smooth bulge: `(z, diameter)` samples of `d0 + (d1 − d0)·sin(π·t)` over `[z0, z1]`.
+fn bulge(z0: f64, z1: f64, d0: f64, d1: f64, n: usize) -> Vec<(f64, f64)> {
+    (0..=n)
+        .map(|k| {
+            let t = k as f64 / n as f64;
+            (z0 + t * (z1 - z0), d0 + (d1 - d0) * (PI * t).sin())
+        })
+        .collect()
+}
+
+/// The tuning set (issue 6): objects that separate planner settings — necks and shoulders,
+/// bulges, tapers both ways, ridges and grooves, knobs, and sizes near both ends of the thesis
+/// hand's graspable range (17.4–117.4 mm). Written by `grasp-sim gen-assets` into
+/// `assets/objects/train/`, each with a scenario.
+pub fn training_objects() -> Vec<(&'static str, Mesh)> {
+    let mut vase = vec![(0.0, 50.0)];
+    vase.extend(bulge(0.0, 130.0, 50.0, 80.0, 16).into_iter().skip(1));
+    vase.push((150.0, 56.0));
+    let box_angles = with_angles(
+        uniform_angles(RING_SEGMENTS),
+        &rectangle_corners(40.0, 40.0),
+    );
+    let square = |z: f64, side: f64| Ring {
+        z,
+        radii: box_angles
+            .iter()
+            .map(|&t| rectangle_radius(side, side, t))
+            .collect(),
+    };
+    vec![
+        (
+            "bottle",
+            revolved(&[
+                (0.0, 60.0),
+                (115.0, 60.0),
+                (135.0, 30.0),
+                (145.0, 26.0),
+                (180.0, 26.0),
+            ]),
+        ),
+        ("vase", revolved(&vase)),
+        (
+            "tapered_box",
+            radial_solid(&box_angles, &[square(0.0, 40.0), square(120.0, 60.0)]),
+        ),
+        (
+            "ridged_cylinder",
+            revolved(&[
+                (0.0, 45.0),
+                (40.0, 45.0),
+                (40.0, 55.0),
+                (44.0, 55.0),
+                (44.0, 45.0),
+                (80.0, 45.0),
+                (80.0, 55.0),
+                (84.0, 55.0),
+                (84.0, 45.0),
+                (140.0, 45.0),
+            ]),
+        ),
+        (
+            "grooved_cylinder",
+            revolved(&[
+                (0.0, 50.0),
+                (50.0, 50.0),
+                (50.0, 42.0),
+                (56.0, 42.0),
+                (56.0, 50.0),
+                (90.0, 50.0),
+                (90.0, 42.0),
+                (96.0, 42.0),
+                (96.0, 50.0),
+                (140.0, 50.0),
+            ]),
+        ),
+        (
+            "knob",
+            revolved(&[
+                (0.0, 20.0),
+                (60.0, 20.0),
+                (60.0, 44.0),
+                (100.0, 50.0),
+                (120.0, 40.0),
+            ]),
+        ),
+        ("thin_rod", cylinder(19.0, 120.0)),
+        ("wide_drum", cylinder(110.0, 100.0)),
+    ]
+}

@@ -403,85 +403,8 @@ impl Scenario {
             other => other.into(),
         })?;
 
-        let p = &raw.planner;
-        let step = p.height_step_mm;
-        if !(step.is_finite() && step > 0.0) {
-            return Err(invalid(
-                "planner.height_step_mm",
-                format!("must be positive, got {step}"),
-            ));
-        }
-        let ratio = hand.fingers.gap_mm / step;
-        if (ratio - ratio.round()).abs() > 1e-9 * ratio.max(1.0) {
-            return Err(invalid(
-                "planner.height_step_mm",
-                format!(
-                    "must divide the finger gap of {} mm evenly (thesis 3.4.2), got {step}",
-                    hand.fingers.gap_mm
-                ),
-            ));
-        }
-        // Every finger must sit on an indexed elevation when Finger_1 does (thesis 3.4.4.2).
-        let top = hand.finger_list[0].height_mm;
-        for f in &hand.finger_list[1..] {
-            let k = (top - f.height_mm) / step;
-            if (k - k.round()).abs() > 1e-9 * k.abs().max(1.0) {
-                return Err(invalid(
-                    "planner.height_step_mm",
-                    format!(
-                        "must divide the height difference of finger_1 and {} ({} mm), got {step}",
-                        f.name,
-                        top - f.height_mm
-                    ),
-                ));
-            }
-        }
-        let a = p.angular_step_deg;
-        let turns = 360.0 / a;
-        if !(a.is_finite() && a > 0.0 && a <= 360.0 && (turns - turns.round()).abs() < 1e-9) {
-            return Err(invalid(
-                "planner.angular_step_deg",
-                format!("must divide 360 evenly (thesis 3.5), got {a}"),
-            ));
-        }
-        if !(0.0..=1.0).contains(&p.sf_c) {
-            return Err(invalid(
-                "planner.sf_c",
-                format!("must be in [0, 1], got {}", p.sf_c),
-            ));
-        }
-        let friction_cone_deg = o.friction.atan().to_degrees();
-        if !(p.vertical_deviation_deg >= 0.0 && p.vertical_deviation_deg < friction_cone_deg) {
-            return Err(invalid(
-                "planner.vertical_deviation_deg",
-                format!(
-                    "must be in [0, {friction_cone_deg:.1}) (below the friction cone of mu = {}), got {}",
-                    o.friction, p.vertical_deviation_deg
-                ),
-            ));
-        }
-        if p.curvature_segments == 0 {
-            return Err(invalid(
-                "planner.curvature_segments",
-                "must be at least 1".to_string(),
-            ));
-        }
-        for (key, v) in [
-            ("planner.magnify_factor", p.magnify_factor),
-            (
-                "planner.joint_deviation_theta1_deg",
-                p.joint_deviation_theta1_deg,
-            ),
-            (
-                "planner.joint_deviation_theta2_deg",
-                p.joint_deviation_theta2_deg,
-            ),
-            ("planner.pitch_range_deg", p.pitch_range_deg),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(invalid(key, format!("must be zero or positive, got {v}")));
-            }
-        }
+        validate_planner(&raw.planner, &hand, o.friction)
+            .map_err(|(key, problem)| invalid(key, problem))?;
         let s = &raw.sim;
         for (key, v) in [
             ("sim.duration_s", s.duration_s),
@@ -592,6 +515,95 @@ impl Scenario {
             expect: raw.expect,
         })
     }
+}
+
+/// Checks planner parameters against the hand and the friction: the key and the problem of the
+/// first one out of range (a scenario reports it with its file, the tuner skips the setting).
+///
+/// # Errors
+/// `(key, problem)`.
+pub fn validate_planner(
+    params: &PlannerParams,
+    hand: &Hand,
+    friction: f64,
+) -> Result<(), (&'static str, String)> {
+    let p = params;
+    let step = p.height_step_mm;
+    if !(step.is_finite() && step > 0.0) {
+        return Err((
+            "planner.height_step_mm",
+            format!("must be positive, got {step}"),
+        ));
+    }
+    let ratio = hand.fingers.gap_mm / step;
+    if (ratio - ratio.round()).abs() > 1e-9 * ratio.max(1.0) {
+        return Err((
+            "planner.height_step_mm",
+            format!(
+                "must divide the finger gap of {} mm evenly (thesis 3.4.2), got {step}",
+                hand.fingers.gap_mm
+            ),
+        ));
+    }
+    // Every finger must sit on an indexed elevation when Finger_1 does (thesis 3.4.4.2).
+    let top = hand.finger_list[0].height_mm;
+    for f in &hand.finger_list[1..] {
+        let k = (top - f.height_mm) / step;
+        if (k - k.round()).abs() > 1e-9 * k.abs().max(1.0) {
+            return Err((
+                "planner.height_step_mm",
+                format!(
+                    "must divide the height difference of finger_1 and {} ({} mm), got {step}",
+                    f.name,
+                    top - f.height_mm
+                ),
+            ));
+        }
+    }
+    let a = p.angular_step_deg;
+    let turns = 360.0 / a;
+    if !(a.is_finite() && a > 0.0 && a <= 360.0 && (turns - turns.round()).abs() < 1e-9) {
+        return Err((
+            "planner.angular_step_deg",
+            format!("must divide 360 evenly (thesis 3.5), got {a}"),
+        ));
+    }
+    if !(0.0..=1.0).contains(&p.sf_c) {
+        return Err(("planner.sf_c", format!("must be in [0, 1], got {}", p.sf_c)));
+    }
+    let friction_cone_deg = friction.atan().to_degrees();
+    if !(p.vertical_deviation_deg >= 0.0 && p.vertical_deviation_deg < friction_cone_deg) {
+        return Err((
+            "planner.vertical_deviation_deg",
+            format!(
+                "must be in [0, {friction_cone_deg:.1}) (below the friction cone of mu = {}), got {}",
+                friction, p.vertical_deviation_deg
+            ),
+        ));
+    }
+    if p.curvature_segments == 0 {
+        return Err((
+            "planner.curvature_segments",
+            "must be at least 1".to_string(),
+        ));
+    }
+    for (key, v) in [
+        ("planner.magnify_factor", p.magnify_factor),
+        (
+            "planner.joint_deviation_theta1_deg",
+            p.joint_deviation_theta1_deg,
+        ),
+        (
+            "planner.joint_deviation_theta2_deg",
+            p.joint_deviation_theta2_deg,
+        ),
+        ("planner.pitch_range_deg", p.pitch_range_deg),
+    ] {
+        if !(v.is_finite() && v >= 0.0) {
+            return Err((key, format!("must be zero or positive, got {v}")));
+        }
+    }
+    Ok(())
 }
 
 /// A short, stable description of an I/O error.

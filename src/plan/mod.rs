@@ -47,6 +47,18 @@ pub fn grade_domain(
     let t = Instant::now();
     let domain = Domain::build(mesh, params, hand);
     timings.insert("stage1_domain".to_string(), ms(t));
+    grade_built(domain, hand, params, friction, timings)
+}
+
+/// Stages 2–3 on an already built stage-1 domain (which depends only on the mesh, the
+/// AngularStep, the HeightStep and the finger offset): what a parameter sweep repeats.
+pub fn grade_built(
+    domain: Domain,
+    hand: &Hand,
+    params: &PlannerParams,
+    friction: f64,
+    timings: &mut BTreeMap<String, f64>,
+) -> GradedDomain {
     let t = Instant::now();
     let cparams = CurvatureParams::from_planner(params, hand, friction);
     let curvature = curvature::grade_elevations(&domain, &cparams);

@@ -373,7 +373,13 @@ fn units_scale_to_millimetres() {
 
 #[test]
 fn committed_assets_match_the_generator() {
-    for (name, mesh) in objects::thesis_objects() {
+    let thesis = objects::thesis_objects()
+        .into_iter()
+        .map(|(n, m)| (n.to_string(), m));
+    let train = objects::training_objects()
+        .into_iter()
+        .map(|(n, m)| (format!("train/{n}"), m));
+    for (name, mesh) in thesis.chain(train) {
         let path = crate::root().join(format!("assets/objects/{name}.stl"));
         let committed = std::fs::read(&path).unwrap();
         assert!(

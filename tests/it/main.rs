@@ -7,6 +7,7 @@ mod geometry;
 mod planner;
 mod sim;
 mod thesis_table;
+mod tune;
 
 use std::path::PathBuf;
 

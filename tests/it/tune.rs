@@ -1,0 +1,87 @@
+//! `grasp-sim tune`: a grid over planner parameters ranked by simulated outcomes.
+
+use grasp_sim::batch::{default_template, expand};
+use grasp_sim::tune::{grid, parse_sweep, tune};
+
+#[test]
+fn sweeps_parse_and_grids_multiply() {
+    let s = parse_sweep("sf_c=0:1:0.1").unwrap();
+    assert_eq!(s.values.len(), 11);
+    assert_eq!(s.values[3], 0.3);
+    assert!(parse_sweep("colour=0:1:0.1")
+        .unwrap_err()
+        .contains("unknown parameter"));
+    assert!(parse_sweep("sf_c=1:0:0.1").is_err());
+    assert!(parse_sweep("sf_c=0:1").is_err());
+    let g = grid(&[
+        parse_sweep("sf_c=0:1:0.5").unwrap(),
+        parse_sweep("pitch_range_deg=0:10:10").unwrap(),
+    ]);
+    assert_eq!(g.len(), 6);
+    assert_eq!(g[0], vec![0.0, 0.0]);
+    assert_eq!(g[5], vec![1.0, 10.0]);
+}
+
+#[test]
+fn settings_that_must_rank_differently_do_and_geometry_is_built_once() {
+    // The cup needs about 6° of palm pitch to lie on its taper: with no pitch allowed it is
+    // ungraspable, with 10° it is grasped and held. The D40 cylinder needs none.
+    let root = crate::root();
+    let items = expand(&[
+        root.join("scenarios/cup.toml"),
+        root.join("scenarios/cylinder_d40.toml"),
+    ])
+    .unwrap();
+    let sweeps = [
+        parse_sweep("pitch_range_deg=0:10:10").unwrap(),
+        parse_sweep("sf_c=0.5:0.6:0.1").unwrap(),
+    ];
+    let r = tune(&items, &default_template(), &sweeps, 1, 2).unwrap();
+    assert_eq!(r.settings.len(), 4);
+    for s in &r.settings {
+        let expected = if s.values[0] == 0.0 { 0.5 } else { 1.0 };
+        assert_eq!(s.hold_rate, expected, "{:?}", s.values);
+    }
+    assert_eq!(
+        r.settings[r.best].values[0], 10.0,
+        "best {:?}",
+        r.settings[r.best].values
+    );
+    let cup_no_pitch = &r.settings[0].objects[0];
+    assert_eq!(cup_no_pitch.status, "ungraspable");
+    // Loading, alignment and the vertical slices are done once per object, not per setting:
+    // neither swept parameter changes the AngularStep or the HeightStep.
+    assert_eq!(r.counters.objects_loaded, 2);
+    assert_eq!(r.counters.domains_built, 2);
+    assert_eq!(r.counters.plans, 8);
+    // A grasp found by several settings is simulated once.
+    assert!(r.counters.sim_reused > 0, "{:?}", r.counters);
+    // Sweeping the AngularStep does build one domain per value and object.
+    let r = tune(
+        &items,
+        &default_template(),
+        &[parse_sweep("angular_step_deg=10:20:10").unwrap()],
+        1,
+        1,
+    )
+    .unwrap();
+    assert_eq!(r.counters.domains_built, 4);
+}
+
+#[test]
+fn invalid_settings_are_marked_not_run() {
+    let root = crate::root();
+    let items = expand(&[root.join("scenarios/cylinder_d40.toml")]).unwrap();
+    // 3 mm does not divide the 25 mm finger gap.
+    let r = tune(
+        &items,
+        &default_template(),
+        &[parse_sweep("height_step_mm=2.5:3:0.5").unwrap()],
+        1,
+        1,
+    )
+    .unwrap();
+    assert_eq!(r.settings[1].objects[0].status, "invalid");
+    assert_eq!(r.settings[1].hold_rate, 0.0);
+    assert_eq!(r.best, 0);
+}
