@@ -36,6 +36,11 @@ pub struct Cli {
     #[arg(long, value_name = "DIR")]
     pub export_mjcf: Option<PathBuf>,
 
+    /// Write the thesis-style figures (SVG), the planned and simulated 3D scenes (.glb) and a
+    /// self-contained report.html into DIR/<scenario>/.
+    #[arg(long, value_name = "DIR")]
+    pub report: Option<PathBuf>,
+
     /// Write the hand as URDF into DIR/<scenario>/hand.urdf.
     #[arg(long, value_name = "DIR")]
     pub export_urdf: Option<PathBuf>,

@@ -29,6 +29,7 @@ pub mod scenario;
 pub mod sim;
 pub mod slice;
 pub mod tune;
+pub mod visual;
 
 use report::{
     ExpectReport, GradesReport, IndexScale, ObjectReport, PlanReport, PoseReport, RunReport,
@@ -65,6 +66,8 @@ pub struct RunOptions {
     pub export_mjcf: Option<std::path::PathBuf>,
     /// Write the hand as URDF into this folder (a subfolder per scenario).
     pub export_urdf: Option<std::path::PathBuf>,
+    /// Write figures, 3D scenes and report.html into this folder (a subfolder per scenario).
+    pub report: Option<std::path::PathBuf>,
 }
 
 impl Default for RunOptions {
@@ -75,6 +78,7 @@ impl Default for RunOptions {
             candidates: 1,
             export_mjcf: None,
             export_urdf: None,
+            report: None,
         }
     }
 }
@@ -194,7 +198,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         },
         timings_ms: timings,
     };
-    let sim = run_sim(
+    let (sim, sim_poses) = run_sim(
         scenario,
         options,
         &aligned,
@@ -203,7 +207,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         mass_kg,
     )?;
     let expect = judge(&scenario.expect, &plan, &sim);
-    Ok(RunReport {
+    let report = RunReport {
         scenario: scenario.name.clone(),
         object,
         plan,
@@ -214,7 +218,19 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             .into_iter()
             .map(|w| format!("{}: {w}", scenario.object.mesh.display()))
             .collect(),
-    })
+    };
+    if let Some(dir) = &options.report {
+        visual::write_report(
+            &dir.join(&scenario.name),
+            &report,
+            &graded,
+            found.grasps.first(),
+            &aligned.mesh,
+            &scenario.hand,
+            sim_poses.as_deref(),
+        )?;
+    }
+    Ok(report)
 }
 
 /// Runs the physics check on the first grasp, or on `override_angles`.
@@ -225,7 +241,7 @@ fn run_sim(
     graded: &plan::GradedDomain,
     grasp: Option<&plan::search::Grasp>,
     mass_kg: f64,
-) -> Result<SimReport, Error> {
+) -> Result<(SimReport, Option<Vec<sim::BodyPose>>), Error> {
     let not_run = |reason: &str| SimReport {
         verdict: "not_run".to_string(),
         reason: Some(reason.to_string()),
@@ -235,15 +251,16 @@ fn run_sim(
         export::write_urdf(&dir.join(&scenario.name), &scenario.hand, &scenario.sim)?;
     }
     if options.no_sim && options.export_mjcf.is_none() {
-        return Ok(not_run("--no-sim"));
+        return Ok((not_run("--no-sim"), None));
     }
     let p = &scenario.sim;
     let (pose, source) = match (&p.override_angles, grasp) {
         (Some(angles), _) => {
             let n = graded.domain.elevations.len();
             if n == 0 {
-                return Ok(not_run(
-                    "override_angles: the object has no indexed elevation",
+                return Ok((
+                    not_run("override_angles: the object has no indexed elevation"),
+                    None,
                 ));
             }
             let index = p.override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
@@ -258,9 +275,10 @@ fn run_sim(
                     "override_angles",
                 ),
                 Err(e) => {
-                    return Ok(not_run(&format!(
-                        "override_angles: palm placement failed: {e:?}"
-                    )))
+                    return Ok((
+                        not_run(&format!("override_angles: palm placement failed: {e:?}")),
+                        None,
+                    ))
                 }
             }
         }
@@ -276,7 +294,7 @@ fn run_sim(
             },
             "planner",
         ),
-        (None, None) => return Ok(not_run("no feasible grasp to check")),
+        (None, None) => return Ok((not_run("no feasible grasp to check"), None)),
     };
     let shape = sim::ObjectShape::from_mesh(&aligned.mesh, aligned.original.volume_mm3);
     let friction = scenario.object.friction;
@@ -296,12 +314,13 @@ fn run_sim(
         )?;
     }
     if options.no_sim {
-        return Ok(not_run("--no-sim"));
+        return Ok((not_run("--no-sim"), None));
     }
     let out = sim::check(&scenario.hand, &pose, &shape, mass_kg, friction, p);
     let payload_margin = (options.payload && out.verdict == sim::Verdict::Hold)
         .then(|| sim::payload_margin(&scenario.hand, &pose, &shape, mass_kg, friction, p));
-    Ok(SimReport {
+    let poses = out.final_poses.clone();
+    let report = SimReport {
         verdict: out.verdict.as_str().to_string(),
         reason: None,
         translation_mm: Some(out.translation_mm),
@@ -318,7 +337,8 @@ fn run_sim(
             None
         },
         directions: out.directions,
-    })
+    };
+    Ok((report, Some(poses)))
 }
 
 fn pose_report(

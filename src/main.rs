@@ -77,6 +77,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         candidates: cli.candidates as usize,
         export_mjcf: cli.export_mjcf,
         export_urdf: cli.export_urdf,
+        report: cli.report,
     };
     // Everything is run before anything is printed, so bad input anywhere leaves no partial output.
     let mut reports = Vec::new();

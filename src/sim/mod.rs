@@ -31,3 +31,6 @@ pub mod scene;
 
 pub use protocol::{check, payload_margin, DirectionOutcome, SimOutcome, Verdict};
 pub use scene::{ObjectShape, SimHand};
+
+/// A body's pose: position `[m]` and orientation, aligned object frame.
+pub type BodyPose = (nalgebra::Vector3<f64>, nalgebra::UnitQuaternion<f64>);

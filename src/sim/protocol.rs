@@ -75,6 +75,9 @@ pub struct SimOutcome {
     pub steps: usize,
     /// Wall time `[ms]`.
     pub wall_ms: f64,
+    /// Where the first gravity direction's run left the bodies (aligned frame, metres): the
+    /// palm, phalanx 1 and 2 of each finger, then the object.
+    pub final_poses: Vec<(Vector3<f64>, nalgebra::UnitQuaternion<f64>)>,
 }
 
 /// Standard gravity `[m/s²]`.
@@ -108,9 +111,28 @@ pub fn check(
     };
     let mut outcomes = Vec::new();
     let mut steps = 0;
+    let mut final_poses = Vec::new();
     for g in directions {
         let mut scene = build(hand, pose, object, mass_kg, friction, params);
         let (o, n) = run_one(&mut scene, g, params, object.is_revolution);
+        if final_poses.is_empty() {
+            let mut handles = vec![scene.palm];
+            for &(b1, b2, _, _) in &scene.fingers {
+                handles.push(b1);
+                handles.push(b2);
+            }
+            handles.push(scene.object);
+            final_poses = handles
+                .iter()
+                .map(|h| {
+                    let p = scene.world.bodies[*h].position();
+                    (
+                        convert::vector_mm(p.translation) * convert::M_PER_MM,
+                        convert::unit_quaternion(p.rotation),
+                    )
+                })
+                .collect();
+        }
         outcomes.push(o);
         steps += n;
     }
@@ -131,6 +153,7 @@ pub fn check(
         steps,
         directions: outcomes,
         wall_ms: t0.elapsed().as_secs_f64() * 1000.0,
+        final_poses,
     }
 }
 

@@ -8,6 +8,7 @@ mod planner;
 mod sim;
 mod thesis_table;
 mod tune;
+mod visual;
 
 use std::path::PathBuf;
 

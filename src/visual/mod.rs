@@ -1,0 +1,93 @@
+//! Seeing the grasp (`--report DIR`): the thesis's figures as SVG, the planned and simulated
+//! scenes as binary glTF, and one self-contained HTML page.
+
+pub mod figures;
+pub mod glb;
+pub mod html;
+pub mod svg;
+
+use crate::hand::Hand;
+use crate::mesh::Mesh;
+use crate::plan::search::Grasp;
+use crate::plan::GradedDomain;
+use crate::report::RunReport;
+use std::path::Path;
+
+/// Writes every figure (`*.svg`) and `report.html` into `dir`; returns the figure names.
+///
+/// # Errors
+/// The file that could not be written.
+pub fn write_report(
+    dir: &Path,
+    report: &RunReport,
+    graded: &GradedDomain,
+    grasp: Option<&Grasp>,
+    mesh: &Mesh,
+    hand: &Hand,
+    simulated: Option<&[crate::sim::BodyPose]>,
+) -> Result<Vec<String>, crate::export::ExportError> {
+    let err = |path: &Path, e: std::io::Error| crate::export::ExportError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
+    let mut figs: Vec<(String, String)> = vec![
+        (
+            "effective_elevation".to_string(),
+            figures::effective_elevation(graded),
+        ),
+        (
+            "grades_curvature".to_string(),
+            figures::grades(graded, "curvature"),
+        ),
+        (
+            "grades_diameter".to_string(),
+            figures::grades(graded, "diameter"),
+        ),
+        (
+            "grades_combined".to_string(),
+            figures::grades(graded, "combined"),
+        ),
+        ("grades_palm".to_string(), figures::grades(graded, "palm")),
+    ];
+    if let Some(g) = grasp {
+        figs.push(("palm".to_string(), figures::palm(g, hand)));
+        figs.push(("finger_planes".to_string(), figures::finger_planes(g, hand)));
+        for (k, f) in hand.finger_list.iter().enumerate() {
+            figs.push((
+                format!("finger_{}", f.name.trim_start_matches("finger_")),
+                figures::finger(g, hand, mesh, k),
+            ));
+        }
+    }
+    for (name, svg) in &figs {
+        let path = dir.join(format!("{name}.svg"));
+        std::fs::write(&path, svg).map_err(|e| err(&path, e))?;
+    }
+    if let Some(g) = grasp {
+        let theta: Vec<[f64; 2]> = g
+            .fingers
+            .iter()
+            .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
+            .collect();
+        let planned = glb::planned_poses(hand, &g.palm.origin, &g.palm.axes, &theta);
+        let mut bodies = glb::hand_bodies(hand, &planned);
+        bodies.push(glb::object_body(
+            mesh,
+            nalgebra::Vector3::zeros(),
+            nalgebra::UnitQuaternion::identity(),
+        ));
+        let path = dir.join("grasp_planned.glb");
+        std::fs::write(&path, glb::glb(&bodies)).map_err(|e| err(&path, e))?;
+        if let Some(poses) = simulated.filter(|p| p.len() == planned.len() + 1) {
+            let mut bodies = glb::hand_bodies(hand, &poses[..planned.len()]);
+            let (t, r) = poses[planned.len()];
+            bodies.push(glb::object_body(mesh, t, r));
+            let path = dir.join("grasp_simulated.glb");
+            std::fs::write(&path, glb::glb(&bodies)).map_err(|e| err(&path, e))?;
+        }
+    }
+    let path = dir.join("report.html");
+    std::fs::write(&path, html::page(report, &figs)).map_err(|e| err(&path, e))?;
+    Ok(figs.into_iter().map(|(n, _)| n).collect())
+}
