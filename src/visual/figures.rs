@@ -109,7 +109,8 @@ pub fn grades(g: &GradedDomain, which: &str) -> String {
         "combined" => "Grades with significance factors (Fig. 4.6)",
         _ => "Palm grades after the third stage (Fig. 4.7)",
     };
-    let mut p = Plot::new(title, "grade", "Z [mm]", (-0.15, 1.05), (lo, hi), false);
+    // Room on the right for the legend.
+    let mut p = Plot::new(title, "grade", "Z [mm]", (-0.15, 1.45), (lo, hi), false);
     let step = g.domain.height_step_mm;
     for (z, grade) in e.iter().zip(v) {
         match grade {
