@@ -101,15 +101,7 @@ fn bench_sim(c: &mut Criterion) {
         &mut BTreeMap::new(),
     );
     let g0 = &found.grasps[0];
-    let pose = SimHand {
-        origin_mm: g0.palm.origin,
-        axes: g0.palm.axes,
-        theta_deg: g0
-            .fingers
-            .iter()
-            .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
-            .collect(),
-    };
+    let pose = SimHand::from_grasp(g0);
     let shape = ObjectShape::from_mesh(&a.mesh, mass_properties(&a.mesh).volume_mm3);
     let mass = 500.0 * mass_properties(&a.mesh).volume_mm3 * 1e-9;
     let mut g = c.benchmark_group("sim");

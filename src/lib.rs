@@ -282,18 +282,7 @@ fn run_sim(
                 }
             }
         }
-        (None, Some(g)) => (
-            sim::SimHand {
-                origin_mm: g.palm.origin,
-                axes: g.palm.axes,
-                theta_deg: g
-                    .fingers
-                    .iter()
-                    .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
-                    .collect(),
-            },
-            "planner",
-        ),
+        (None, Some(g)) => (sim::SimHand::from_grasp(g), "planner"),
         (None, None) => return Ok((not_run("no feasible grasp to check"), None)),
     };
     let shape = sim::ObjectShape::from_mesh(&aligned.mesh, aligned.original.volume_mm3);

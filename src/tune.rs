@@ -363,15 +363,7 @@ fn run_object(
                     *o
                 }
                 None => {
-                    let pose = SimHand {
-                        origin_mm: g.palm.origin,
-                        axes: g.palm.axes,
-                        theta_deg: g
-                            .fingers
-                            .iter()
-                            .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
-                            .collect(),
-                    };
+                    let pose = SimHand::from_grasp(g);
                     let s = &p.scenario.sim;
                     let out = sim::check(hand, &pose, &p.shape, p.mass_kg, friction, s);
                     counters.sim_runs += 1;

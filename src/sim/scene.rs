@@ -19,6 +19,21 @@ pub struct SimHand {
     pub theta_deg: Vec<[f64; 2]>,
 }
 
+impl SimHand {
+    /// The palm pose and the centre ALS's joint angles of a planned grasp.
+    pub fn from_grasp(g: &crate::plan::search::Grasp) -> SimHand {
+        SimHand {
+            origin_mm: g.palm.origin,
+            axes: g.palm.axes,
+            theta_deg: g
+                .fingers
+                .iter()
+                .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
+                .collect(),
+        }
+    }
+}
+
 /// The object's collision shape, built once per object and shared by every run.
 #[derive(Clone)]
 pub struct ObjectShape {
