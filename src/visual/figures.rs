@@ -40,20 +40,29 @@ fn draw_slice(p: &mut Plot, s: &Slice, mirror: f64) {
     }
 }
 
-/// Fig. 4.3: the vertical slice at approach angle 0 with the Effective Elevation and the
-/// Indexed Elevations.
-pub fn effective_elevation(g: &GradedDomain) -> String {
-    let s = &g.domain.slices[0];
+/// A plot of a vertical slice with equal scales and room around it, the slice drawn.
+fn slice_plot(title: &str, s: &Slice, extra_right: f64) -> (Plot, (f64, f64)) {
     let (x, y) = bounds(s);
     let mut p = Plot::new(
-        "Effective Elevation over the vertical slice at 0 deg (Fig. 4.3)",
+        title,
         "s [mm]",
         "Z [mm]",
-        pad(x, 20.0),
+        pad((x.0, x.1 + extra_right), 20.0),
         pad(y, 10.0),
         true,
     );
     draw_slice(&mut p, s, 1.0);
+    (p, x)
+}
+
+/// Fig. 4.3: the vertical slice at approach angle 0 with the Effective Elevation and the
+/// Indexed Elevations.
+pub fn effective_elevation(g: &GradedDomain) -> String {
+    let (mut p, x) = slice_plot(
+        "Effective Elevation over the vertical slice at 0 deg (Fig. 4.3)",
+        &g.domain.slices[0],
+        0.0,
+    );
     let [lo, hi] = g.domain.effective;
     let right = x.1 + 12.0;
     p.line(
@@ -126,20 +135,14 @@ pub fn grades(g: &GradedDomain, which: &str) -> String {
 /// Figs. 4.8–4.10: the vertical slice at the approach angle with the palm domain, the contact
 /// points and the palm outline.
 pub fn palm(g: &Grasp, hand: &Hand) -> String {
-    let s = &g.palm.slice;
-    let (x, y) = bounds(s);
-    let mut p = Plot::new(
+    let (mut p, _) = slice_plot(
         &format!(
             "Palm on the vertical slice at {:.0} deg: contacts and outline (Figs. 4.8-4.10)",
             g.approach_angle_deg
         ),
-        "s [mm]",
-        "Z [mm]",
-        pad((x.0, x.1 + hand.palm.offset_mm), 20.0),
-        pad(y, 10.0),
-        true,
+        &g.palm.slice,
+        hand.palm.offset_mm,
     );
-    draw_slice(&mut p, s, 1.0);
     let pitch = g.palm.pitch_rad;
     let up = Vector2::new(-pitch.sin(), pitch.cos());
     let back = Vector2::new(pitch.cos(), pitch.sin());
@@ -178,17 +181,11 @@ pub fn palm(g: &Grasp, hand: &Hand) -> String {
 
 /// Fig. 4.11: the nine finger slice planes seen edge-on in the vertical slice.
 pub fn finger_planes(g: &Grasp, hand: &Hand) -> String {
-    let s = &g.palm.slice;
-    let (x, y) = bounds(s);
-    let mut p = Plot::new(
+    let (mut p, x) = slice_plot(
         "Finger slice planes, seen edge-on (Fig. 4.11)",
-        "s [mm]",
-        "Z [mm]",
-        pad(x, 20.0),
-        pad(y, 10.0),
-        true,
+        &g.palm.slice,
+        0.0,
     );
-    draw_slice(&mut p, s, 1.0);
     let a = g.palm.approach_rad;
     let to2 = |v: nalgebra::Vector3<f64>| Vector2::new(v.x * a.cos() + v.y * a.sin(), v.z);
     let origin = to2(g.palm.origin.coords);
