@@ -16,6 +16,7 @@
 use crate::hand::{Hand, Side};
 use crate::mesh::{AlignedObject, Mesh};
 use crate::scenario::{GravityMode, SimParams};
+use crate::sim::scene::bend;
 use crate::sim::{ObjectShape, SimHand};
 use nalgebra::{Point3, Rotation3, UnitQuaternion, Vector3};
 use std::fmt::Write;
@@ -69,10 +70,6 @@ fn side_sign(side: Side) -> f64 {
         Side::Left => 1.0,
         Side::Right => -1.0,
     }
-}
-
-fn bend(theta_deg: f64) -> f64 {
-    (180.0 - theta_deg).to_radians()
 }
 
 /// Writes `scene.xml`, the object's mesh file(s) and `protocol.json` into `dir`.

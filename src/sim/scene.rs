@@ -138,8 +138,9 @@ impl Scene {
     }
 }
 
-/// Bend from straight of a joint at interior angle `theta_deg` `[rad]`.
-fn bend(theta_deg: f64) -> f64 {
+/// Bend from straight of a joint at interior angle `theta_deg` `[rad]`: the joint value used
+/// by the rapier scene and by the MJCF and URDF exports alike.
+pub fn bend(theta_deg: f64) -> f64 {
     (180.0 - theta_deg).to_radians()
 }
 
