@@ -1,15 +1,8 @@
 //! `grasp-sim batch`: stable order across thread counts, shards that concatenate to the whole,
 //! and an output file written whole.
 
-use std::process::Command;
-
 fn batch(args: &[&str]) -> (Option<i32>, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_grasp-sim"))
-        .current_dir(crate::root())
-        .arg("batch")
-        .args(args)
-        .output()
-        .unwrap();
+    let out = crate::grasp_sim().arg("batch").args(args).output().unwrap();
     (
         out.status.code(),
         String::from_utf8(out.stdout).unwrap(),

@@ -1,11 +1,8 @@
 //! MJCF and URDF export: well-formed XML with the expected bodies, joints and actuators.
 
-use std::process::Command;
-
 fn export(scenario: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_grasp-sim"))
-        .current_dir(crate::root())
+    let out = crate::grasp_sim()
         .args(["--json", "--no-sim", "--export-mjcf"])
         .arg(dir.path())
         .arg("--export-urdf")

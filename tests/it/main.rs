@@ -12,6 +12,13 @@ mod visual;
 
 use std::path::PathBuf;
 
+/// The built binary, run from the repository root (bundled scenarios resolve from there).
+pub fn grasp_sim() -> std::process::Command {
+    let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_grasp-sim"));
+    c.current_dir(root());
+    c
+}
+
 /// The repository root.
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

@@ -3,7 +3,6 @@
 
 use grasp_sim::scenario::Scenario;
 use grasp_sim::{run, RunOptions};
-use std::process::Command;
 
 fn scenario_with(mesh: &str, sim: &str) -> (tempfile::TempDir, Scenario) {
     let dir = tempfile::tempdir().unwrap();
@@ -53,9 +52,7 @@ fn the_scene_matches_the_plan() {
 
 #[test]
 fn open_fingers_drop_the_object() {
-    let root = crate::root();
-    let out = Command::new(env!("CARGO_BIN_EXE_grasp-sim"))
-        .current_dir(&root)
+    let out = crate::grasp_sim()
         .args(["--json", "scenarios/sim_open_fingers.toml"])
         .output()
         .unwrap();

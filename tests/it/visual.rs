@@ -1,11 +1,8 @@
 //! `--report DIR`: thesis-style SVG figures, planned and simulated glTF scenes, report.html.
 
-use std::process::Command;
-
 fn report(scenario: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_grasp-sim"))
-        .current_dir(crate::root())
+    let out = crate::grasp_sim()
         .arg(format!("scenarios/{scenario}.toml"))
         .arg("--report")
         .arg(dir.path())
