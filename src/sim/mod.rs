@@ -5,7 +5,7 @@
 //! planner's millimetres and degrees and [`convert`] converts once. The scene is built in the
 //! aligned object frame, where the thesis's weight acts along −Z.
 //!
-//! Scene ([`scene`]): the palm is a kinematic box held at the planned pose; each phalanx is a
+//! Scene ([`scene`]): the palm is a fixed box at the planned pose; each phalanx is a
 //! dynamic box (finger width and thickness 2 × finger offset; phalanx 2's thinned tip as a thinner
 //! box); joints are revolute on the finger joint axes with the hand's limits, as multibody
 //! (reduced-coordinate) joints: a 10 g phalanx pressing a 0.2 kg object is a mass ratio that
@@ -29,7 +29,7 @@ pub mod convert;
 pub mod protocol;
 pub mod scene;
 
-pub use protocol::{check, payload_margin, DirectionOutcome, SimOutcome, Verdict};
+pub use protocol::{check, payload_bracket, payload_margin, DirectionOutcome, SimOutcome, Verdict};
 pub use scene::{ObjectShape, SimHand};
 
 /// A body's pose: position `[m]` and orientation, aligned object frame.

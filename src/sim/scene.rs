@@ -184,9 +184,13 @@ pub fn build(
     let r_palm = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
         nalgebra::Matrix3::from_columns(&[x, y, z]),
     ));
-    let palm = world.bodies.insert(
-        RigidBodyBuilder::kinematic_position_based().pose(convert::pose(&pose.origin_mm, &r_palm)),
-    );
+    // The palm never moves during the check: a fixed body. (A kinematic body here made rapier
+    // refresh the palm's contacts irregularly: the object, pressed against the palm, sank into it
+    // for about five steps and was thrown back in one, a 0.16 mm sawtooth that ratcheted it along
+    // the fingers by 0.03 mm per period, docs/SIM.md.)
+    let palm = world
+        .bodies
+        .insert(RigidBodyBuilder::fixed().pose(convert::pose(&pose.origin_mm, &r_palm)));
     let mm = |v: f64| (v * convert::M_PER_MM) as f32;
     let (h_lo, h_hi) = hand.finger_height_span();
     let m = hand.palm.margin_mm;
@@ -350,6 +354,11 @@ pub fn build(
                 disp[l.assembly_id()] = angle as f32;
             }
         }
+        // rapier gives every multibody angular dof a default viscous damping of 0.1 N·m·s/rad
+        // (`MultibodyJoint::default_damping`). The hand has none (the motors carry their own
+        // damping) and neither has the MJCF export: at a 0.07 N·m torque limit it capped the
+        // closing speed near 0.7 rad/s, so phalanx 2 had only just touched when gravity came on.
+        mb.damping_mut().fill(0.0);
         mb.apply_displacements(&disp);
         mb.forward_kinematics(&world.bodies, true);
         mb.update_rigid_bodies(&mut world.bodies, true);

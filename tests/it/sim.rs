@@ -143,20 +143,26 @@ fn scenario(name: &str) -> grasp_sim::report::RunReport {
 
 #[test]
 fn hold_slip_and_drop_are_told_apart() {
-    // The same hand and protocol: the thesis cup holds; with motors too weak for its weight it
-    // slides down through the fingers; a slippery, heavy cylinder falls out.
+    // The same hand and protocol: the thesis cup holds; with motors too weak for its weight the
+    // chapter 4 object slides down and tilts until its ridge rests on the fingers (a slip: moved,
+    // still in the hand); with weaker motors still the cup slides out, and a slippery, heavy
+    // cylinder falls out.
     let hold = scenario("cup");
     assert_eq!(hold.sim.verdict, "hold", "{:?}", hold.sim);
     assert!(hold.sim.translation_mm.unwrap() < 5.0);
-    let slip = scenario("sim_cup_weak_motors");
+    let slip = scenario("sim_chapter4_weak_motors");
     assert_eq!(slip.sim.verdict, "slip", "{:?}", slip.sim);
     let t = slip.sim.translation_mm.unwrap();
-    assert!(t > 5.0 && t < 100.0, "slip of {t} mm");
+    assert!(t > 5.0 && t < 40.0, "slip of {t} mm");
     assert!(slip.sim.directions[0].in_contact);
-    let drop = scenario("sim_d40_slippery_heavy");
-    assert_eq!(drop.sim.verdict, "drop", "{:?}", drop.sim);
-    assert!(!drop.sim.directions[0].in_contact);
-    for r in [&hold, &slip, &drop] {
+    let mut drops = Vec::new();
+    for name in ["sim_cup_weak_motors", "sim_d40_slippery_heavy"] {
+        let drop = scenario(name);
+        assert_eq!(drop.sim.verdict, "drop", "{name}: {:?}", drop.sim);
+        assert!(!drop.sim.directions[0].in_contact);
+        drops.push(drop);
+    }
+    for r in [&hold, &slip].into_iter().chain(&drops) {
         assert_eq!(
             r.expect.met,
             Some(true),
