@@ -306,8 +306,8 @@ fn run_sim(
         return Ok((not_run("--no-sim"), None));
     }
     let out = sim::check(&scenario.hand, &pose, &shape, mass_kg, friction, p);
-    let payload_margin = (options.payload && out.verdict == sim::Verdict::Hold)
-        .then(|| sim::payload_margin(&scenario.hand, &pose, &shape, mass_kg, friction, p));
+    let payload = (options.payload && out.verdict == sim::Verdict::Hold)
+        .then(|| sim::payload_bracket(&scenario.hand, &pose, &shape, mass_kg, friction, p));
     let poses = out.final_poses.clone();
     let report = SimReport {
         verdict: out.verdict.as_str().to_string(),
@@ -321,10 +321,11 @@ fn run_sim(
         mass_kg: Some(mass_kg),
         grasp_source: Some(source.to_string()),
         payload_margin: if options.payload {
-            Some(payload_margin.unwrap_or(0.0))
+            Some(payload.map_or(0.0, |(held, _)| held))
         } else {
             None
         },
+        payload_fails_at: payload.and_then(|(_, failed)| failed),
         directions: out.directions,
     };
     Ok((report, Some(poses)))

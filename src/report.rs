@@ -202,6 +202,11 @@ pub struct SimReport {
     /// Largest mass multiplier (up to 64) at which the grasp still holds (`--payload`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub payload_margin: Option<f64>,
+    /// The smallest mass multiplier the payload search saw fail, within 5 % above the margin
+    /// (`--payload`; absent when the grasp held at 64×). Hold and failure need not alternate
+    /// once around that boundary: near it the outcome depends on the details of the contacts.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub payload_fails_at: Option<f64>,
     /// Per gravity direction.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub directions: Vec<crate::sim::DirectionOutcome>,

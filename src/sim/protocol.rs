@@ -273,6 +273,20 @@ pub fn payload_margin(
     friction: f64,
     params: &SimParams,
 ) -> f64 {
+    payload_bracket(hand, pose, object, mass_kg, friction, params).0
+}
+
+/// The payload search of [`payload_margin`], with the bracket it ends on: the largest
+/// multiplier seen to hold and the one seen to fail just above it (within 5 %), or `None` if
+/// the grasp held at 64×.
+pub fn payload_bracket(
+    hand: &Hand,
+    pose: &SimHand,
+    object: &ObjectShape,
+    mass_kg: f64,
+    friction: f64,
+    params: &SimParams,
+) -> (f64, Option<f64>) {
     let holds =
         |k: f64| check(hand, pose, object, mass_kg * k, friction, params).verdict == Verdict::Hold;
     let mut lo = 1.0;
@@ -288,7 +302,7 @@ pub fn payload_margin(
         }
     }
     let Some(mut hi) = hi else {
-        return 64.0;
+        return (64.0, None);
     };
     while hi / lo > 1.05 {
         let mid = (lo * hi).sqrt();
@@ -298,5 +312,5 @@ pub fn payload_margin(
             hi = mid;
         }
     }
-    lo
+    (lo, Some(hi))
 }

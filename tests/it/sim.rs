@@ -188,7 +188,7 @@ fn a_cylinder_spinning_about_its_axis_is_judged_by_its_tilt() {
 
 #[test]
 fn payload_margin_is_found_by_bisection() {
-    let path = crate::root().join("scenarios/cylinder_d40.toml");
+    let path = crate::root().join("scenarios/cylinder_d60.toml");
     let s = Scenario::load(&path).unwrap();
     let opts = RunOptions {
         payload: true,
@@ -196,13 +196,18 @@ fn payload_margin_is_found_by_bisection() {
     };
     let r = run(&s, &opts).unwrap();
     let m = r.sim.payload_margin.unwrap();
-    assert!(m > 1.0 && m < 64.0, "margin {m}");
-    // Just above the margin the grasp no longer holds; at it, it does.
+    let failed = r.sim.payload_fails_at.expect("D60 fails below 64x");
+    assert!(m > 8.0 && m < 64.0, "margin {m}");
+    assert!(
+        failed > m && failed <= m * 1.05 + 1e-9,
+        "bracket {m} .. {failed}"
+    );
+    // The bracket is real: at the margin the grasp holds, at the failing multiplier it does not.
     let check = |k: f64| {
         let mut heavier = s.clone();
         heavier.object.mass = grasp_sim::scenario::MassSpec::Mass(r.object.mass_kg * k);
         run(&heavier, &RunOptions::default()).unwrap().sim.verdict
     };
     assert_eq!(check(m), "hold");
-    assert_ne!(check(m * 1.1), "hold");
+    assert_ne!(check(failed), "hold");
 }
