@@ -256,30 +256,9 @@ fn run_sim(
     let p = &scenario.sim;
     let (pose, source) = match (&p.override_angles, grasp) {
         (Some(angles), _) => {
-            let n = graded.domain.elevations.len();
-            if n == 0 {
-                return Ok((
-                    not_run("override_angles: the object has no indexed elevation"),
-                    None,
-                ));
-            }
-            let index = p.override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
-            let z1 = graded.domain.elevations[index - 1];
-            match plan::palm::place_palm(&aligned.mesh, &scenario.hand, z1, 0.0, 0.0) {
-                Ok(palm) => (
-                    sim::SimHand {
-                        origin_mm: palm.origin,
-                        axes: palm.axes,
-                        theta_deg: angles.clone(),
-                    },
-                    "override_angles",
-                ),
-                Err(e) => {
-                    return Ok((
-                        not_run(&format!("override_angles: palm placement failed: {e:?}")),
-                        None,
-                    ))
-                }
+            match override_pose(&aligned.mesh, &scenario.hand, graded, p, angles) {
+                Ok(pose) => (pose, "override_angles"),
+                Err(reason) => return Ok((not_run(&reason), None)),
             }
         }
         (None, Some(g)) => (sim::SimHand::from_grasp(g), "planner"),
@@ -329,6 +308,32 @@ fn run_sim(
         directions: out.directions,
     };
     Ok((report, Some(poses)))
+}
+
+/// The hand pose for a scenario whose joint angles are fixed by `[sim] override_angles`: the
+/// palm at approach 0 and pitch 0 on indexed elevation `override_index` (default: the middle
+/// one) of the graded domain. `Err` gives the reason the grasp cannot be checked.
+pub(crate) fn override_pose(
+    mesh: &mesh::Mesh,
+    hand: &hand::Hand,
+    graded: &plan::palm_grade::GradedDomain,
+    p: &scenario::SimParams,
+    angles: &[[f64; 2]],
+) -> Result<sim::SimHand, String> {
+    let n = graded.domain.elevations.len();
+    if n == 0 {
+        return Err("override_angles: the object has no indexed elevation".to_string());
+    }
+    let index = p.override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
+    let z1 = graded.domain.elevations[index - 1];
+    match plan::palm::place_palm(mesh, hand, z1, 0.0, 0.0) {
+        Ok(palm) => Ok(sim::SimHand {
+            origin_mm: palm.origin,
+            axes: palm.axes,
+            theta_deg: angles.to_vec(),
+        }),
+        Err(e) => Err(format!("override_angles: palm placement failed: {e:?}")),
+    }
 }
 
 fn pose_report(

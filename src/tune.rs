@@ -12,7 +12,7 @@
 
 use crate::batch::{scenario_for, Item};
 use crate::mesh::{align, load_stl, AlignedObject};
-use crate::plan::{self, search::Grasp, Domain};
+use crate::plan::{self, Domain};
 use crate::scenario::{validate_planner, MassSpec, PlannerParams, Scenario};
 use crate::sim::{self, ObjectShape, SimHand, Verdict};
 use crate::Error;
@@ -120,7 +120,8 @@ pub fn grid(sweeps: &[Sweep]) -> Vec<Vec<f64>> {
 pub struct ObjectResult {
     /// Scenario name.
     pub scenario: String,
-    /// `feasible`, `ungraspable`, or `invalid` (the setting breaks a rule for this hand).
+    /// `feasible`, `ungraspable`, `override_angles` (the scenario fixes the joint angles: checked
+    /// with them, not planned), or `invalid` (the setting breaks a rule for this hand).
     pub status: String,
     /// `hold`, `slip`, `drop` or `not_run`.
     pub verdict: String,
@@ -180,17 +181,14 @@ struct Prepared {
     mass_kg: f64,
 }
 
-fn fingerprint(g: &Grasp) -> Vec<u64> {
-    let mut k = vec![
-        g.palm.origin.x.to_bits(),
-        g.palm.origin.y.to_bits(),
-        g.palm.origin.z.to_bits(),
-        g.palm.pitch_rad.to_bits(),
-        g.palm.approach_rad.to_bits(),
-    ];
-    for f in &g.fingers {
-        k.push(f.centre.theta1_deg.to_bits());
-        k.push(f.centre.theta2_deg.to_bits());
+/// What identifies a grasp for the physics check: its palm pose and joint angles, bit for bit.
+fn fingerprint(h: &SimHand) -> Vec<u64> {
+    let mut k: Vec<u64> = h.origin_mm.iter().map(|v| v.to_bits()).collect();
+    for a in &h.axes {
+        k.extend(a.iter().map(|v| v.to_bits()));
+    }
+    for t in &h.theta_deg {
+        k.extend(t.iter().map(|v| v.to_bits()));
     }
     k
 }
@@ -340,12 +338,31 @@ fn run_object(
             .clone();
         let mut t = BTreeMap::new();
         let graded = plan::grade_built(domain, hand, &params, friction, &mut t);
-        let found = plan::search::search(&p.aligned.mesh, hand, &graded, &params, candidates);
-        counters.plans += 1;
-        if found.grasps.is_empty() {
+        let s = &p.scenario.sim;
+        // A scenario that fixes the joint angles (`[sim] override_angles`) is checked with them,
+        // as `grasp-sim scenario.toml` does: its outcome does not depend on the planner.
+        let (status, poses) = if let Some(angles) = &s.override_angles {
+            match crate::override_pose(&p.aligned.mesh, hand, &graded, s, angles) {
+                Ok(pose) => ("override_angles", vec![pose]),
+                Err(_) => ("override_angles", Vec::new()),
+            }
+        } else {
+            let found = plan::search::search(&p.aligned.mesh, hand, &graded, &params, candidates);
+            counters.plans += 1;
+            let poses: Vec<SimHand> = found.grasps.iter().map(SimHand::from_grasp).collect();
+            (
+                if poses.is_empty() {
+                    "ungraspable"
+                } else {
+                    "feasible"
+                },
+                poses,
+            )
+        };
+        if poses.is_empty() {
             results.push(ObjectResult {
                 scenario: name,
-                status: "ungraspable".to_string(),
+                status: status.to_string(),
                 verdict: "not_run".to_string(),
                 translation_mm: None,
                 payload_margin: None,
@@ -355,16 +372,15 @@ fn run_object(
         // The best of the candidates by simulation: hold before slip before drop, then the
         // smaller translation; the first in search order on a tie.
         let mut best: Option<(Verdict, f64, Option<f64>)> = None;
-        for g in &found.grasps {
-            let key = fingerprint(g);
+        for pose in &poses {
+            let key = fingerprint(pose);
             let outcome = match sims.get(&key) {
                 Some(o) => {
                     counters.sim_reused += 1;
                     *o
                 }
                 None => {
-                    let pose = SimHand::from_grasp(g);
-                    let s = &p.scenario.sim;
+                    let pose = pose.clone();
                     let out = sim::check(hand, &pose, &p.shape, p.mass_kg, friction, s);
                     counters.sim_runs += 1;
                     let margin = (out.verdict == Verdict::Hold).then(|| {
@@ -386,7 +402,7 @@ fn run_object(
         let (verdict, translation, margin) = best.expect("at least one grasp");
         results.push(ObjectResult {
             scenario: name,
-            status: "feasible".to_string(),
+            status: status.to_string(),
             verdict: verdict.as_str().to_string(),
             translation_mm: Some(translation),
             payload_margin: margin,

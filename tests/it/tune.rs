@@ -85,3 +85,27 @@ fn invalid_settings_are_marked_not_run() {
     assert_eq!(r.settings[1].hold_rate, 0.0);
     assert_eq!(r.best, 0);
 }
+
+#[test]
+fn a_scenario_with_fixed_joint_angles_is_checked_with_them() {
+    // sim_open_fingers fixes the fingers wide open: tune must check that grasp, as the scenario
+    // says, and get its `drop`, not plan and check a grasp of its own.
+    let root = crate::root();
+    let items = expand(&[root.join("scenarios/sim_open_fingers.toml")]).unwrap();
+    let r = tune(
+        &items,
+        &default_template(),
+        &[parse_sweep("sf_c=0:1:1").unwrap()],
+        1,
+        1,
+    )
+    .unwrap();
+    for s in &r.settings {
+        let o = &s.objects[0];
+        assert_eq!(o.status, "override_angles");
+        assert_eq!(o.verdict, "drop", "{o:?}");
+        assert_eq!(s.hold_rate, 0.0);
+    }
+    assert_eq!(r.counters.plans, 0);
+    assert_eq!(r.counters.sim_runs, 1);
+}
