@@ -14,7 +14,7 @@ use grasp_sim::mesh::{align, mass_properties};
 use grasp_sim::objects;
 use grasp_sim::plan::plan;
 use grasp_sim::scenario::{GravityMode, PlannerParams, SimParams};
-use grasp_sim::sim::{check, ObjectShape, SimHand};
+use grasp_sim::sim::{check, Case, ObjectShape, SimHand};
 use grasp_sim::slice::{slice, Plane};
 use std::collections::BTreeMap;
 use std::hint::black_box;
@@ -112,7 +112,15 @@ fn bench_sim(c: &mut Criterion) {
             ..SimParams::default()
         };
         g.bench_function(name, |b| {
-            b.iter(|| check(&hand, &pose, &shape, mass, 0.3, &params))
+            let case = Case {
+                hand: &hand,
+                pose: &pose,
+                object: &shape,
+                mass_kg: mass,
+                friction: 0.3,
+                params: &params,
+            };
+            b.iter(|| check(&case))
         });
     }
     g.finish();

@@ -284,9 +284,17 @@ fn run_sim(
     if options.no_sim {
         return Ok((not_run("--no-sim"), None));
     }
-    let out = sim::check(&scenario.hand, &pose, &shape, mass_kg, friction, p);
-    let payload = (options.payload && out.verdict == sim::Verdict::Hold)
-        .then(|| sim::payload_bracket(&scenario.hand, &pose, &shape, mass_kg, friction, p));
+    let case = sim::Case {
+        hand: &scenario.hand,
+        pose: &pose,
+        object: &shape,
+        mass_kg,
+        friction,
+        params: p,
+    };
+    let out = sim::check(&case);
+    let payload =
+        (options.payload && out.verdict == sim::Verdict::Hold).then(|| sim::payload_bracket(&case));
     let poses = out.final_poses.clone();
     let report = SimReport {
         verdict: out.verdict.as_str().to_string(),

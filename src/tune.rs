@@ -381,11 +381,17 @@ fn run_object(
                 }
                 None => {
                     let pose = pose.clone();
-                    let out = sim::check(hand, &pose, &p.shape, p.mass_kg, friction, s);
+                    let case = sim::Case {
+                        hand,
+                        pose: &pose,
+                        object: &p.shape,
+                        mass_kg: p.mass_kg,
+                        friction,
+                        params: s,
+                    };
+                    let out = sim::check(&case);
                     counters.sim_runs += 1;
-                    let margin = (out.verdict == Verdict::Hold).then(|| {
-                        sim::payload_margin(hand, &pose, &p.shape, p.mass_kg, friction, s)
-                    });
+                    let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
                     let o = (out.verdict, out.translation_mm, margin);
                     sims.insert(key, o);
                     o

@@ -30,7 +30,7 @@ pub mod protocol;
 pub mod scene;
 
 pub use protocol::{check, payload_bracket, payload_margin, DirectionOutcome, SimOutcome, Verdict};
-pub use scene::{ObjectShape, SimHand};
+pub use scene::{Case, ObjectShape, SimHand};
 
 /// A body's pose: position `[m]` and orientation, aligned object frame.
 pub type BodyPose = (nalgebra::Vector3<f64>, nalgebra::UnitQuaternion<f64>);

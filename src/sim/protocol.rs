@@ -1,8 +1,7 @@
 //! The hold test: close, gravity on, hold, measure, judge.
 
 use super::convert;
-use super::scene::{build, ObjectShape, Scene, SimHand};
-use crate::hand::Hand;
+use super::scene::{build, Case, Scene};
 use crate::scenario::{GravityMode, SimParams};
 use nalgebra::Vector3;
 use rapier3d::prelude::*;
@@ -89,14 +88,8 @@ const G: f64 = 9.81;
 /// (inertially) a body of revolution about its principal axis (`object.is_revolution`): a spin
 /// about that axis leaves it occupying the same space in the hand, so only the tilt of the axis
 /// counts.
-pub fn check(
-    hand: &Hand,
-    pose: &SimHand,
-    object: &ObjectShape,
-    mass_kg: f64,
-    friction: f64,
-    params: &SimParams,
-) -> SimOutcome {
+pub fn check(case: &Case) -> SimOutcome {
+    let params = case.params;
     let t0 = Instant::now();
     let directions: Vec<Vector3<f64>> = match params.gravity {
         GravityMode::Down => vec![-Vector3::z()],
@@ -113,8 +106,8 @@ pub fn check(
     let mut steps = 0;
     let mut final_poses = Vec::new();
     for g in directions {
-        let mut scene = build(hand, pose, object, mass_kg, friction, params);
-        let (o, n) = run_one(&mut scene, g, params, object.is_revolution);
+        let mut scene = build(case);
+        let (o, n) = run_one(&mut scene, g, params, case.object.is_revolution);
         if final_poses.is_empty() {
             let mut handles = vec![scene.palm];
             for &(b1, b2, _, _) in &scene.fingers {
@@ -265,30 +258,15 @@ fn joint_errors(scene: &Scene) -> Vec<[f64; 2]> {
 
 /// The largest mass multiplier, up to 64, at which the grasp still holds: doubling until it
 /// fails, then bisecting to a relative 5 %. Returns 64 if it holds at 64×.
-pub fn payload_margin(
-    hand: &Hand,
-    pose: &SimHand,
-    object: &ObjectShape,
-    mass_kg: f64,
-    friction: f64,
-    params: &SimParams,
-) -> f64 {
-    payload_bracket(hand, pose, object, mass_kg, friction, params).0
+pub fn payload_margin(case: &Case) -> f64 {
+    payload_bracket(case).0
 }
 
 /// The payload search of [`payload_margin`], with the bracket it ends on: the largest
 /// multiplier seen to hold and the one seen to fail just above it (within 5 %), or `None` if
 /// the grasp held at 64×.
-pub fn payload_bracket(
-    hand: &Hand,
-    pose: &SimHand,
-    object: &ObjectShape,
-    mass_kg: f64,
-    friction: f64,
-    params: &SimParams,
-) -> (f64, Option<f64>) {
-    let holds =
-        |k: f64| check(hand, pose, object, mass_kg * k, friction, params).verdict == Verdict::Hold;
+pub fn payload_bracket(case: &Case) -> (f64, Option<f64>) {
+    let holds = |k: f64| check(&case.heavier(k)).verdict == Verdict::Hold;
     let mut lo = 1.0;
     let mut hi = None;
     let mut k = 2.0;

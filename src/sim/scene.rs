@@ -144,15 +144,44 @@ pub fn bend(theta_deg: f64) -> f64 {
     (180.0 - theta_deg).to_radians()
 }
 
+/// What one physics check is about: the hand, where it is and how it is planned to close, the
+/// object and its physical properties, and the protocol's parameters.
+#[derive(Clone, Copy)]
+pub struct Case<'a> {
+    /// The hand.
+    pub hand: &'a Hand,
+    /// Palm pose and planned joint angles.
+    pub pose: &'a SimHand,
+    /// The object's collision shape.
+    pub object: &'a ObjectShape,
+    /// Object mass `[kg]`.
+    pub mass_kg: f64,
+    /// Coulomb friction coefficient, everywhere.
+    pub friction: f64,
+    /// The protocol's parameters.
+    pub params: &'a SimParams,
+}
+
+impl Case<'_> {
+    /// The same case with the object's mass multiplied by `k`.
+    pub fn heavier(&self, k: f64) -> Self {
+        Case {
+            mass_kg: self.mass_kg * k,
+            ..*self
+        }
+    }
+}
+
 /// Builds the scene with the fingers open and gravity off.
-pub fn build(
-    hand: &Hand,
-    pose: &SimHand,
-    object: &ObjectShape,
-    mass_kg: f64,
-    friction: f64,
-    params: &SimParams,
-) -> Scene {
+pub fn build(case: &Case) -> Scene {
+    let Case {
+        hand,
+        pose,
+        object,
+        mass_kg,
+        friction,
+        params,
+    } = *case;
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::ZERO;
     let ip = &mut world.integration_parameters;

@@ -103,7 +103,7 @@ fn the_same_scenario_gives_the_same_sim_numbers() {
 fn rapier_tolerances_are_pinned_at_hand_scale() {
     // At rapier's default length unit (1 m) the allowed penetration would be 5 mm and the
     // prediction distance 20 mm: most of a 40 mm object. grasp-sim sets a 1 cm unit.
-    use grasp_sim::sim::scene::{build, ObjectShape, SimHand};
+    use grasp_sim::sim::scene::{build, Case, ObjectShape, SimHand};
     let (_d, s) = scenario_with("cylinder_d40.stl", "");
     let mesh = grasp_sim::objects::cylinder(40.0, 124.0);
     let shape = ObjectShape::from_mesh(&mesh, grasp_sim::mesh::mass_properties(&mesh).volume_mm3);
@@ -117,7 +117,14 @@ fn rapier_tolerances_are_pinned_at_hand_scale() {
         ],
         theta_deg: vec![[72.1, 91.8]; 3],
     };
-    let scene = build(&s.hand, &pose, &shape, 0.078, 0.3, &s.sim);
+    let scene = build(&Case {
+        hand: &s.hand,
+        pose: &pose,
+        object: &shape,
+        mass_kg: 0.078,
+        friction: 0.3,
+        params: &s.sim,
+    });
     let ip = &scene.world.integration_parameters;
     assert!(
         (ip.allowed_linear_error() - 5e-5).abs() < 1e-9,
