@@ -17,7 +17,7 @@ use crate::hand::{Hand, Side};
 use crate::mesh::{AlignedObject, Mesh};
 use crate::scenario::{GravityMode, SimParams};
 use crate::sim::scene::bend;
-use crate::sim::{ObjectShape, SimHand};
+use crate::sim::Case;
 use nalgebra::{Point3, Rotation3, UnitQuaternion, Vector3};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -36,20 +36,11 @@ pub struct ExportError {
 pub struct ExportInput<'a> {
     /// Scenario name (the MJCF model name).
     pub name: &'a str,
-    /// The hand.
-    pub hand: &'a Hand,
-    /// Palm pose and planned joint angles.
-    pub pose: &'a SimHand,
-    /// The aligned object.
+    /// The aligned object (its mesh is written beside the XML).
     pub object: &'a AlignedObject,
-    /// Its collision shape, as the rapier check built it.
-    pub shape: &'a ObjectShape,
-    /// Object mass `[kg]`.
-    pub mass_kg: f64,
-    /// Friction coefficient.
-    pub friction: f64,
-    /// The physics check's parameters.
-    pub sim: &'a SimParams,
+    /// The physics check the scene mirrors: hand, pose, collision shape, mass, friction and
+    /// protocol parameters.
+    pub case: Case<'a>,
 }
 
 const MM: f64 = 1e-3;
@@ -82,9 +73,10 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
         message: e.to_string(),
     };
     std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
-    let hand = input.hand;
-    let sim = input.sim;
-    let [x, y, z] = input.pose.axes;
+    let case = &input.case;
+    let hand = case.hand;
+    let sim = case.params;
+    let [x, y, z] = case.pose.axes;
     let r_palm = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
         nalgebra::Matrix3::from_columns(&[x, y, z]),
     ));
@@ -93,7 +85,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     let l2c = l2 - hand.phalanx_2.unusable_distal_mm;
     let (h_lo, h_hi) = hand.finger_height_span();
     let m = hand.palm.margin_mm;
-    let mu = input.friction;
+    let mu = case.friction;
     let finger_density = sim.finger_density_kg_m3;
     let lim = |r: [f64; 2]| (bend(r[1]), bend(r[0]));
     let (lo1, hi1) = lim(hand.joints.theta1_range_deg);
@@ -101,7 +93,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
 
     // Object meshes: one hull, or the decomposition's parts, in metres.
     let mut meshes: Vec<(String, Mesh)> = Vec::new();
-    match input.shape.shape.as_compound() {
+    match case.object.shape.as_compound() {
         Some(compound) => {
             for (k, (_, part)) in compound.shapes().iter().enumerate() {
                 if let Some(poly) = part.as_convex_polyhedron() {
@@ -163,7 +155,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     }
     let _ = writeln!(s, "  </asset>");
     let _ = writeln!(s, "  <worldbody>");
-    let palm_pos = input.pose.origin_mm.coords * MM;
+    let palm_pos = case.pose.origin_mm.coords * MM;
     let _ = writeln!(
         s,
         "    <body name=\"palm\" pos=\"{}\" quat=\"{}\">",
@@ -233,7 +225,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     let _ = writeln!(s, "    </body>");
     // The object: free, at the origin of the aligned frame, with grasp-sim's inertia.
     let props = crate::mesh::mass_properties(&input.object.mesh);
-    let density_kg_mm3 = input.mass_kg / props.volume_mm3;
+    let density_kg_mm3 = case.mass_kg / props.volume_mm3;
     let inertia = props.inertia * density_kg_mm3 * MM * MM;
     let c = props.centroid.coords * MM;
     let _ = writeln!(s, "    <body name=\"object\" pos=\"0 0 0\">");
@@ -242,7 +234,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
         s,
         "      <inertial pos=\"{}\" mass=\"{:.9}\" fullinertia=\"{:.12e} {:.12e} {:.12e} {:.12e} {:.12e} {:.12e}\"/>",
         v3(&c),
-        input.mass_kg,
+        case.mass_kg,
         inertia[(0, 0)],
         inertia[(1, 1)],
         inertia[(2, 2)],
@@ -296,7 +288,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     let mut open = Vec::new();
     let mut planned = Vec::new();
     let mut ctrl = Vec::new();
-    for [t1, t2] in &input.pose.theta_deg {
+    for [t1, t2] in &case.pose.theta_deg {
         let (b1, b2) = (bend(*t1), bend(*t2));
         open.push((b1 - margin).max(lo1));
         open.push((b2 - margin).max(lo2));
@@ -342,8 +334,8 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
         "hold_translation_mm": sim.hold_translation_mm,
         "hold_rotation_deg": sim.hold_rotation_deg,
         "gravity": match sim.gravity { GravityMode::Down => "down", GravityMode::Six => "six" },
-        "is_revolution": input.shape.is_revolution,
-        "mass_kg": input.mass_kg,
+        "is_revolution": case.object.is_revolution,
+        "mass_kg": case.mass_kg,
         "friction": mu,
     });
     let path = dir.join("protocol.json");

@@ -265,33 +265,27 @@ fn run_sim(
         (None, None) => return Ok((not_run("no feasible grasp to check"), None)),
     };
     let shape = sim::ObjectShape::from_mesh(&aligned.mesh, aligned.original.volume_mm3);
-    let friction = scenario.object.friction;
+    let case = sim::Case {
+        hand: &scenario.hand,
+        pose: &pose,
+        object: &shape,
+        mass_kg,
+        friction: scenario.object.friction,
+        params: p,
+    };
     if let Some(dir) = &options.export_mjcf {
         export::write_mjcf(
             &dir.join(&scenario.name),
             &export::ExportInput {
                 name: &scenario.name,
-                hand: &scenario.hand,
-                pose: &pose,
                 object: aligned,
-                shape: &shape,
-                mass_kg,
-                friction,
-                sim: p,
+                case,
             },
         )?;
     }
     if options.no_sim {
         return Ok((not_run("--no-sim"), None));
     }
-    let case = sim::Case {
-        hand: &scenario.hand,
-        pose: &pose,
-        object: &shape,
-        mass_kg,
-        friction,
-        params: p,
-    };
     let out = sim::check(&case);
     let payload =
         (options.payload && out.verdict == sim::Verdict::Hold).then(|| sim::payload_bracket(&case));
