@@ -151,7 +151,7 @@ fn scenario(name: &str) -> grasp_sim::report::RunReport {
 #[test]
 fn hold_slip_and_drop_are_told_apart() {
     // The same hand and protocol: the thesis cup holds; with motors too weak for its weight the
-    // chapter 4 object slides down and tilts until its ridge rests on the fingers (a slip: moved,
+    // chapter 4 object slides down and tilts until it rests on the top finger (a slip: moved,
     // still in the hand); with weaker motors still the cup slides out, and a slippery, heavy
     // cylinder falls out.
     let hold = scenario("cup");
