@@ -212,12 +212,7 @@ fn json_lines_report_the_object_contract() {
             "scenarios/cup.toml",
         ],
     );
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    crate::assert_success(&out);
     let text = String::from_utf8(out.stdout).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines.len(), 2);
@@ -284,12 +279,7 @@ fn every_bundled_scenario_runs() {
     }
     assert!(args.len() >= 9, "eight thesis scenarios expected");
     let out = bin().current_dir(&root).args(&args).output().unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    crate::assert_success(&out);
 }
 
 #[test]
@@ -323,12 +313,7 @@ fn a_binary_file_whose_header_says_solid_is_read_as_binary() {
     env.write("solid_header.stl", &bytes);
     let s = env.basic_scenario("solid_header.stl", "");
     let out = env.run(&["--json", s.to_str().unwrap()]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    crate::assert_success(&out);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["object"]["triangles"], 576);
 }

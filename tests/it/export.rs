@@ -2,19 +2,13 @@
 
 fn export(scenario: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
-    let out = crate::grasp_sim()
-        .args(["--json", "--no-sim", "--export-mjcf"])
-        .arg(dir.path())
-        .arg("--export-urdf")
-        .arg(dir.path())
-        .arg(format!("scenarios/{scenario}.toml"))
-        .output()
-        .unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    crate::succeed(
+        crate::grasp_sim()
+            .args(["--json", "--no-sim", "--export-mjcf"])
+            .arg(dir.path())
+            .arg("--export-urdf")
+            .arg(dir.path())
+            .arg(format!("scenarios/{scenario}.toml")),
     );
     dir
 }

@@ -23,3 +23,20 @@ pub fn grasp_sim() -> std::process::Command {
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
+
+/// Runs `cmd` and returns its output, failing the test (with its stderr) unless it exits 0.
+pub fn succeed(cmd: &mut std::process::Command) -> std::process::Output {
+    let out = cmd.output().unwrap();
+    assert_success(&out);
+    out
+}
+
+/// Fails the test, showing the stderr, unless the process exited with status 0.
+pub fn assert_success(out: &std::process::Output) {
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

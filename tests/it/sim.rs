@@ -52,16 +52,8 @@ fn the_scene_matches_the_plan() {
 
 #[test]
 fn open_fingers_drop_the_object() {
-    let out = crate::grasp_sim()
-        .args(["--json", "scenarios/sim_open_fingers.toml"])
-        .output()
-        .unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out =
+        crate::succeed(crate::grasp_sim().args(["--json", "scenarios/sim_open_fingers.toml"]));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["sim"]["verdict"], "drop");
     assert_eq!(v["sim"]["grasp_source"], "override_angles");

@@ -2,17 +2,11 @@
 
 fn report(scenario: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
-    let out = crate::grasp_sim()
-        .arg(format!("scenarios/{scenario}.toml"))
-        .arg("--report")
-        .arg(dir.path())
-        .output()
-        .unwrap();
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    crate::succeed(
+        crate::grasp_sim()
+            .arg(format!("scenarios/{scenario}.toml"))
+            .arg("--report")
+            .arg(dir.path()),
     );
     dir
 }
