@@ -380,10 +380,9 @@ fn run_object(
                     *o
                 }
                 None => {
-                    let pose = pose.clone();
                     let case = sim::Case {
                         hand,
-                        pose: &pose,
+                        pose,
                         object: &p.shape,
                         mass_kg: p.mass_kg,
                         friction,
