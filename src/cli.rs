@@ -49,6 +49,11 @@ pub struct Cli {
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=1000))]
     pub candidates: u32,
 
+    /// With the physics check: check candidates in search order until one holds or N have been
+    /// checked (default: the scenario's `[sim] max_checked`, 8).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100))]
+    pub max_checked: Option<u32>,
+
     #[command(subcommand)]
     pub command: Option<Command>,
 }

@@ -146,6 +146,12 @@ pub struct Finger {
 }
 
 impl Hand {
+    /// A finger's width `[mm]`: its centreline to each side wall is the finger offset (thesis
+    /// 3.3.2), so no gap narrower than this lets a finger in.
+    pub fn finger_width_mm(&self) -> f64 {
+        2.0 * self.fingers.offset_mm
+    }
+
     /// Reads and validates a hand file, applying `overrides` (dotted key → number) first.
     ///
     /// # Errors

@@ -26,6 +26,7 @@ pub mod objects;
 pub mod plan;
 pub mod report;
 pub mod scenario;
+pub mod select;
 pub mod sim;
 pub mod slice;
 pub mod tune;
@@ -62,6 +63,9 @@ pub struct RunOptions {
     pub payload: bool,
     /// How many feasible grasps to collect, in search order (the thesis stops at 1).
     pub candidates: usize,
+    /// With the physics check: check candidates in search order until one holds or this many
+    /// have been checked (`None`: the scenario's `[sim] max_checked`).
+    pub max_checked: Option<usize>,
     /// Write the planned grasp as an MJCF scene into this folder (a subfolder per scenario).
     pub export_mjcf: Option<std::path::PathBuf>,
     /// Write the hand as URDF into this folder (a subfolder per scenario).
@@ -70,12 +74,16 @@ pub struct RunOptions {
     pub report: Option<std::path::PathBuf>,
 }
 
+/// Candidates the physics check runs on at most before a run settles for the best it saw.
+pub const DEFAULT_MAX_CHECKED: usize = 8;
+
 impl Default for RunOptions {
     fn default() -> Self {
         RunOptions {
             no_sim: false,
             payload: false,
             candidates: 1,
+            max_checked: None,
             export_mjcf: None,
             export_urdf: None,
             report: None,
@@ -120,42 +128,75 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             quaternion_wxyz: [q.w, q.i, q.j, q.k],
         },
     };
-    let (graded, found) = plan::plan(
-        &aligned.mesh,
-        &scenario.hand,
-        &scenario.planner,
-        scenario.object.friction,
-        options.candidates,
+    let shapes: std::cell::RefCell<BTreeMap<mesh::GraspAxis, sim::ObjectShape>> =
+        Default::default();
+    let shape_for = |a: &mesh::AlignedObject| -> sim::ObjectShape {
+        shapes
+            .borrow_mut()
+            .entry(a.axis)
+            .or_insert_with(|| sim::ObjectShape::from_mesh(&a.mesh, volume))
+            .clone()
+    };
+    let check = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
+        let shape = shape_for(a);
+        let pose = sim::SimHand::from_grasp(g);
+        sim::check(&sim::Case {
+            hand: &scenario.hand,
+            pose: &pose,
+            object: &shape,
+            mass_kg,
+            friction: scenario.object.friction,
+            params: &scenario.sim,
+        })
+    };
+    // The physics check chooses among candidates only when it runs on the planner's grasps.
+    let checks_candidates = !options.no_sim && scenario.sim.override_angles.is_none();
+    let selection = select::select(
+        &loaded.mesh,
+        &select::SelectParams {
+            hand: &scenario.hand,
+            planner: &scenario.planner,
+            friction: scenario.object.friction,
+            collect: options.candidates,
+            max_checked: checks_candidates.then_some(
+                options
+                    .max_checked
+                    .unwrap_or(scenario.sim.max_checked)
+                    .max(1),
+            ),
+            check: &check,
+        },
         &mut timings,
     );
-    let grasps: Vec<report::GraspReport> = found
-        .grasps
+    let shown = selection.reported_axis();
+    let graded = &shown.graded;
+    let all_grasps: Vec<report::GraspReport> = selection
+        .candidates
         .iter()
-        .map(|g| grasp_report(g, &aligned))
+        .map(|c| {
+            grasp_report(
+                &c.grasp,
+                &selection.axes[c.axis_plan].aligned,
+                c.check.as_ref(),
+            )
+        })
         .collect();
-    let (status, reason) = if !grasps.is_empty() {
+    let chosen_report = selection.chosen.map(|i| all_grasps[i].clone());
+    let candidates_tried: usize = selection.axes.iter().map(|a| a.candidates_tried).sum();
+    let mut all_rejections: BTreeMap<String, usize> = BTreeMap::new();
+    for a in &selection.axes {
+        for (r, n) in &a.rejections {
+            *all_rejections
+                .entry(r.describe(&scenario.hand))
+                .or_insert(0) += n;
+        }
+    }
+    let (status, reason) = if chosen_report.is_some() {
         ("feasible", None)
-    } else if graded.sorted_indices.is_empty() {
-        ("ungraspable", graded.reason.clone())
     } else {
-        let mut counts: Vec<(String, usize)> = found
-            .rejections
-            .iter()
-            .map(|(r, n)| (r.describe(&scenario.hand), *n))
-            .collect();
-        counts.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
-        let top: Vec<String> = counts
-            .iter()
-            .take(3)
-            .map(|(d, n)| format!("{d} ({n})"))
-            .collect();
         (
             "ungraspable",
-            Some(format!(
-                "no kinematically feasible grasp in {} candidates; most rejected by: {}",
-                found.candidates_tried,
-                top.join(", ")
-            )),
+            Some(ungraspable_reason(&selection, &scenario.hand)),
         )
     };
     let g = &graded.grades;
@@ -184,27 +225,30 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             combined: g.combined.clone(),
             palm: g.palm.clone(),
         },
-        candidates_tried: found.candidates_tried,
-        rejections: found
-            .rejections
-            .iter()
-            .map(|(r, n)| (r.describe(&scenario.hand), *n))
-            .collect(),
-        grasp: grasps.first().cloned(),
-        grasps: if options.candidates > 1 {
-            grasps
+        candidates_tried,
+        rejections: all_rejections,
+        grasp: chosen_report,
+        grasps: if all_grasps.len() > 1 {
+            all_grasps
         } else {
             Vec::new()
         },
+        candidates_checked: selection.checked(),
+        axes: selection.axes.iter().map(axis_report).collect(),
         timings_ms: timings,
     };
+    let chosen = selection.chosen();
     let (sim, sim_poses) = run_sim(
         scenario,
         options,
-        &aligned,
-        &graded,
-        found.grasps.first(),
+        match chosen {
+            Some(c) => &selection.axes[c.axis_plan].aligned,
+            None => &aligned,
+        },
+        &selection.axes[0].graded,
+        chosen.map(|c| (&c.grasp, c.check.clone())),
         mass_kg,
+        &shape_for,
     )?;
     let expect = judge(&scenario.expect, &plan, &sim);
     let report = RunReport {
@@ -223,9 +267,9 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         visual::write_report(
             &dir.join(&scenario.name),
             &report,
-            &graded,
-            found.grasps.first(),
-            &aligned.mesh,
+            graded,
+            chosen.map(|c| &c.grasp),
+            &shown.aligned.mesh,
             &scenario.hand,
             sim_poses.as_deref(),
         )?;
@@ -239,8 +283,9 @@ fn run_sim(
     options: &RunOptions,
     aligned: &mesh::AlignedObject,
     graded: &plan::GradedDomain,
-    grasp: Option<&plan::search::Grasp>,
+    grasp: Option<(&plan::search::Grasp, Option<sim::SimOutcome>)>,
     mass_kg: f64,
+    shape_for: &dyn Fn(&mesh::AlignedObject) -> sim::ObjectShape,
 ) -> Result<(SimReport, Option<Vec<sim::BodyPose>>), Error> {
     let not_run = |reason: &str| SimReport {
         verdict: "not_run".to_string(),
@@ -254,17 +299,17 @@ fn run_sim(
         return Ok((not_run("--no-sim"), None));
     }
     let p = &scenario.sim;
-    let (pose, source) = match (&p.override_angles, grasp) {
+    let (pose, source, done) = match (&p.override_angles, grasp) {
         (Some(angles), _) => {
             match override_pose(&aligned.mesh, &scenario.hand, graded, p, angles) {
-                Ok(pose) => (pose, "override_angles"),
+                Ok(pose) => (pose, "override_angles", None),
                 Err(reason) => return Ok((not_run(&reason), None)),
             }
         }
-        (None, Some(g)) => (sim::SimHand::from_grasp(g), "planner"),
+        (None, Some((g, done))) => (sim::SimHand::from_grasp(g), "planner", done),
         (None, None) => return Ok((not_run("no feasible grasp to check"), None)),
     };
-    let shape = sim::ObjectShape::from_mesh(&aligned.mesh, aligned.original.volume_mm3);
+    let shape = shape_for(aligned);
     let case = sim::Case {
         hand: &scenario.hand,
         pose: &pose,
@@ -286,7 +331,11 @@ fn run_sim(
     if options.no_sim {
         return Ok((not_run("--no-sim"), None));
     }
-    let out = sim::check(&case);
+    // The candidate search already checked the chosen grasp: the same case, the same outcome.
+    let out = match done {
+        Some(out) => out,
+        None => sim::check(&case),
+    };
     let payload =
         (options.payload && out.verdict == sim::Verdict::Hold).then(|| sim::payload_bracket(&case));
     let poses = out.final_poses.clone();
@@ -348,7 +397,64 @@ fn pose_report(
     }
 }
 
-fn grasp_report(g: &plan::search::Grasp, aligned: &mesh::AlignedObject) -> report::GraspReport {
+/// Why no grasp was found: the thesis axis's reason under the thesis's rules, and what the
+/// other axes and rules met.
+fn ungraspable_reason(selection: &select::Selection, hand: &hand::Hand) -> String {
+    let describe = |a: &select::AxisPlan| -> String {
+        if let Some(r) = &a.graded.reason {
+            return r.clone();
+        }
+        let mut counts: Vec<(String, usize)> = a
+            .rejections
+            .iter()
+            .map(|(r, n)| (r.describe(hand), *n))
+            .collect();
+        counts.sort_by(|x, y| y.1.cmp(&x.1).then(x.0.cmp(&y.0)));
+        let top: Vec<String> = counts
+            .iter()
+            .take(3)
+            .map(|(d, n)| format!("{d} ({n})"))
+            .collect();
+        format!(
+            "no kinematically feasible grasp in {} candidates; most rejected by: {}",
+            a.candidates_tried,
+            top.join(", ")
+        )
+    };
+    let first = describe(&selection.axes[0]);
+    match selection.axes.len() {
+        1 => first,
+        n => format!(
+            "{first} (and no grasp in the {} other axis and rule combinations tried: see plan.axes)",
+            n - 1
+        ),
+    }
+}
+
+fn axis_report(a: &select::AxisPlan) -> report::AxisReport {
+    let v = a.aligned.principal_axis_original();
+    report::AxisReport {
+        axis: [v.x, v.y, v.z],
+        axis_name: a.aligned.axis.name(),
+        rules: a.rules,
+        indexed_elevations: a.graded.domain.elevations.len(),
+        sorted_indices: a.graded.sorted_indices.len(),
+        candidates_tried: a.candidates_tried,
+        grasps_found: a.grasps_found,
+        reason: (a.grasps_found == 0).then(|| {
+            a.graded
+                .reason
+                .clone()
+                .unwrap_or_else(|| "every candidate rejected".to_string())
+        }),
+    }
+}
+
+fn grasp_report(
+    g: &plan::search::Grasp,
+    aligned: &mesh::AlignedObject,
+    check: Option<&sim::SimOutcome>,
+) -> report::GraspReport {
     let [x, y, z] = g.palm.axes;
     let m = nalgebra::Matrix3::from_columns(&[x, y, z]);
     let r_aligned = nalgebra::UnitQuaternion::from_rotation_matrix(
@@ -378,6 +484,18 @@ fn grasp_report(g: &plan::search::Grasp, aligned: &mesh::AlignedObject) -> repor
                 tip_contact: f.centre.is_tip_contact,
             })
             .collect(),
+        axis: {
+            let v = aligned.principal_axis_original();
+            [v.x, v.y, v.z]
+        },
+        axis_name: aligned.axis.name(),
+        rules: g.rules,
+        relaxations: g.relaxations.clone(),
+        check: check.map(|o| report::CandidateCheck {
+            verdict: o.verdict.as_str().to_string(),
+            translation_mm: o.translation_mm,
+            rotation_deg: o.rotation_deg,
+        }),
     }
 }
 

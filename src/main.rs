@@ -75,6 +75,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         no_sim: cli.no_sim,
         payload: cli.payload,
         candidates: cli.candidates as usize,
+        max_checked: cli.max_checked.map(|n| n as usize),
         export_mjcf: cli.export_mjcf,
         export_urdf: cli.export_urdf,
         report: cli.report,

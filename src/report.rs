@@ -92,9 +92,15 @@ pub struct PlanReport {
     /// The first feasible grasp (the thesis's Grasp Parameter Set).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grasp: Option<GraspReport>,
-    /// With `--candidates N`: up to N feasible grasps in search order (the first is `grasp`).
+    /// Every feasible grasp collected, in search order (across axes and rules): with
+    /// `--candidates N` at least N, with the physics check every candidate checked, each with
+    /// its verdict. Empty when the first grasp is the only one (it is `grasp`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub grasps: Vec<GraspReport>,
+    /// Candidates the physics check ran on, in search order until one held.
+    pub candidates_checked: usize,
+    /// Each principal axis and rule set the planner tried, in order.
+    pub axes: Vec<AxisReport>,
     /// Per-stage wall times `[ms]`.
     pub timings_ms: std::collections::BTreeMap<String, f64>,
 }
@@ -117,6 +123,52 @@ pub struct GraspReport {
     pub palm_pose_aligned: PoseReport,
     /// Per finger, the centre ALS's angles and all three ALS.
     pub fingers: Vec<FingerReport>,
+    /// The principal axis the grasp wraps (the aligned +Z it was planned about), unit, in the
+    /// mesh's original frame.
+    pub axis: [f64; 3],
+    /// That axis by its moment of inertia: `least` (the thesis's), `middle` or `largest`, with
+    /// `-` when turned round.
+    pub axis_name: String,
+    /// `thesis` or `extended`.
+    pub rules: crate::plan::RuleSet,
+    /// The thesis rules the grasp relaxed (empty under the thesis's rules).
+    pub relaxations: Vec<crate::plan::Relaxation>,
+    /// The physics check on this grasp, when it ran on it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub check: Option<CandidateCheck>,
+}
+
+/// The physics check's verdict on one candidate grasp.
+#[derive(Debug, Clone, Serialize)]
+pub struct CandidateCheck {
+    /// `hold`, `slip` or `drop`.
+    pub verdict: String,
+    /// Worst direction's translation relative to the palm `[mm]`.
+    pub translation_mm: f64,
+    /// Worst direction's rotation relative to the palm `[deg]`.
+    pub rotation_deg: f64,
+}
+
+/// What the planner found about one principal axis under one rule set.
+#[derive(Debug, Clone, Serialize)]
+pub struct AxisReport {
+    /// The axis, unit, in the mesh's original frame.
+    pub axis: [f64; 3],
+    /// `least`, `middle` or `largest` (moment), `-` when turned round.
+    pub axis_name: String,
+    /// `thesis` or `extended`.
+    pub rules: crate::plan::RuleSet,
+    /// Indexed elevations about this axis.
+    pub indexed_elevations: usize,
+    /// Candidate palm elevations after stage 3.
+    pub sorted_indices: usize,
+    /// Candidates (elevation × approach angle) tried.
+    pub candidates_tried: usize,
+    /// Feasible grasps found.
+    pub grasps_found: usize,
+    /// Why there was none, when there was none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 /// One finger of a grasp.

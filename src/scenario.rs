@@ -184,6 +184,9 @@ pub struct SimParams {
     pub override_angles: Option<Vec<[f64; 2]>>,
     /// Finger_1's elevation index for `override_angles` (default: the middle of the domain).
     pub override_index: Option<usize>,
+    /// A run checks the planner's candidates in search order until one holds or this many have
+    /// been checked (1: only the first grasp, as the thesis would give it).
+    pub max_checked: usize,
 }
 
 impl Default for SimParams {
@@ -209,6 +212,7 @@ impl Default for SimParams {
             open_margin_deg: 20.0,
             override_angles: None,
             override_index: None,
+            max_checked: crate::DEFAULT_MAX_CHECKED,
         }
     }
 }
@@ -430,6 +434,7 @@ impl Scenario {
             ("sim.solver_iterations", s.solver_iterations),
             ("sim.pgs_iterations", s.pgs_iterations),
             ("sim.stabilization_iterations", s.stabilization_iterations),
+            ("sim.max_checked", s.max_checked),
         ] {
             if !(1..=100).contains(&v) {
                 return Err(invalid(key, format!("must be in 1..=100, got {v}")));

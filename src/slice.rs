@@ -285,6 +285,20 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
         ));
     }
     contours.retain(|c| c.points.len() >= 2 && !c.normals.is_empty());
+    // A closed single-shell mesh never takes this path, so its slices are exactly the cut.
+    let mut repaired = false;
+    if contours.iter().any(|c| !c.is_closed) {
+        let tol = join_tolerance(mesh, segments.iter().map(|s| s.triangle));
+        repaired = join_open(&mut contours, tol);
+    }
+    if repaired || has_overlapping_outers(&contours) {
+        contours = union_closed(contours);
+    }
+    finish(*plane, contours)
+}
+
+/// Sorts contours (decreasing absolute area, ties by first point) and finds the outermost.
+fn finish(plane: Plane, mut contours: Vec<Contour>) -> Slice {
     contours.sort_by(|a, b| {
         b.signed_area()
             .abs()
@@ -296,7 +310,7 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
         .iter()
         .position(|c| c.is_closed && c.signed_area() > 0.0);
     Slice {
-        plane: *plane,
+        plane,
         contours,
         outermost,
     }
@@ -362,4 +376,250 @@ fn build_contour(
         normals,
         is_closed,
     }
+}
+
+impl Contour {
+    /// A contour from a polyline, with each segment's outward normal taken from the geometry:
+    /// the material lies on the left of the direction of travel (counter-clockwise outer
+    /// boundaries, clockwise holes), so the outward normal is the travel direction turned
+    /// clockwise. For a cut through a triangle this is the triangle's projected normal (the
+    /// segment lies in the triangle, so the normal's projection is perpendicular to it).
+    pub fn from_polyline(points: Vec<Point2<f64>>, is_closed: bool) -> Contour {
+        let n = points.len();
+        let segments = if is_closed { n } else { n.saturating_sub(1) };
+        let normals = (0..segments)
+            .map(|i| {
+                let d = points[(i + 1) % n] - points[i];
+                Vector2::new(d.y, -d.x)
+                    .try_normalize(0.0)
+                    .unwrap_or_else(Vector2::x)
+            })
+            .collect();
+        Contour {
+            points,
+            normals,
+            is_closed,
+        }
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the points.
+    fn bounds(&self) -> (Point2<f64>, Point2<f64>) {
+        self.points.iter().fold(
+            (
+                Point2::new(f64::INFINITY, f64::INFINITY),
+                Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        )
+    }
+}
+
+/// How far apart two open ends of a slice may be and still be joined `[mm]`: twice the median
+/// longest edge of the triangles the plane cut. A missing triangle leaves a gap no wider than
+/// its own edges, which are of the size of its neighbours'; a real opening (a cup's rim, a cut
+/// made on purpose) is many edges wide.
+fn join_tolerance(mesh: &Mesh, cut: impl Iterator<Item = usize>) -> f64 {
+    let mut longest: Vec<f64> = cut
+        .map(|t| {
+            let [a, b, c] = mesh.corners(t);
+            (b - a).norm().max((c - b).norm()).max((a - c).norm())
+        })
+        .collect();
+    if longest.is_empty() {
+        return 0.0;
+    }
+    let mid = longest.len() / 2;
+    let (_, median, _) = longest.select_nth_unstable_by(mid, f64::total_cmp);
+    2.0 * *median
+}
+
+/// Joins open contours end to start where an end lies within `tol` of a start (its own start
+/// closes it), nearest pairs first; the gap becomes a straight segment. Returns true if and
+/// only if anything was joined. Contours that stay open are kept as they are, so the caller
+/// can report them.
+pub fn join_open(contours: &mut Vec<Contour>, tol: f64) -> bool {
+    let open: Vec<usize> = (0..contours.len())
+        .filter(|&i| !contours[i].is_closed)
+        .collect();
+    if open.is_empty() || tol.is_nan() || tol <= 0.0 {
+        return false;
+    }
+    let first = |i: usize| contours[i].points[0];
+    let last = |i: usize| *contours[i].points.last().expect("a contour has points");
+    // Candidate links (end of a → start of b), nearest first; ties broken by index so the
+    // result is deterministic.
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for &a in &open {
+        for &b in &open {
+            let d = (first(b) - last(a)).norm();
+            if d <= tol {
+                pairs.push((d, a, b));
+            }
+        }
+    }
+    if pairs.is_empty() {
+        return false;
+    }
+    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut next: HashMap<usize, usize> = HashMap::new();
+    let mut has_prev: HashSet<usize> = HashSet::new();
+    for &(_, a, b) in &pairs {
+        if next.contains_key(&a) || has_prev.contains(&b) {
+            continue;
+        }
+        next.insert(a, b);
+        has_prev.insert(b);
+    }
+    // Follow the links: paths from chains with no predecessor, then the cycles left.
+    let mut done: HashSet<usize> = HashSet::new();
+    let mut joined: Vec<Contour> = Vec::new();
+    let starts = open
+        .iter()
+        .copied()
+        .filter(|i| !has_prev.contains(i))
+        .chain(open.iter().copied());
+    for s in starts {
+        if done.contains(&s) {
+            continue;
+        }
+        let mut points: Vec<Point2<f64>> = Vec::new();
+        let mut cur = s;
+        let mut is_closed = false;
+        loop {
+            done.insert(cur);
+            for p in &contours[cur].points {
+                // A link that closes no gap (the end is the next start) adds no point twice.
+                if points
+                    .last()
+                    .is_none_or(|q: &Point2<f64>| (q - p).norm() > TINY_SEGMENT_MM)
+                {
+                    points.push(*p);
+                }
+            }
+            match next.get(&cur) {
+                Some(&n) if n == s => {
+                    is_closed = true;
+                    break;
+                }
+                Some(&n) if !done.contains(&n) => cur = n,
+                _ => break,
+            }
+        }
+        if is_closed
+            && points.len() > 1
+            && (points[0] - points[points.len() - 1]).norm() <= TINY_SEGMENT_MM
+        {
+            points.pop();
+        }
+        if points.len() >= 2 {
+            joined.push(Contour::from_polyline(points, is_closed));
+        }
+    }
+    contours.retain(|c| c.is_closed);
+    contours.extend(joined);
+    true
+}
+
+/// Returns true if and only if two closed outer (counter-clockwise) contours have overlapping
+/// bounds: overlapping or nested shells, whose union must be taken. The contours of one closed
+/// shell never overlap, except an island inside a hole, which the union leaves as it is.
+fn has_overlapping_outers(contours: &[Contour]) -> bool {
+    let outers: Vec<(Point2<f64>, Point2<f64>)> = contours
+        .iter()
+        .filter(|c| c.is_closed && c.signed_area() > 0.0)
+        .map(Contour::bounds)
+        .collect();
+    outers.iter().enumerate().any(|(i, a)| {
+        outers[i + 1..]
+            .iter()
+            .any(|b| a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y)
+    })
+}
+
+/// The union of the closed contours by the non-zero winding rule (i_overlay): overlapping
+/// shells become one outline, a hole stays a hole where no other shell fills it. Open contours
+/// are kept as they are.
+fn union_closed(contours: Vec<Contour>) -> Vec<Contour> {
+    use i_overlay::core::fill_rule::FillRule;
+    use i_overlay::float::simplify::SimplifyShape;
+    let (closed, open): (Vec<Contour>, Vec<Contour>) =
+        contours.into_iter().partition(|c| c.is_closed);
+    let rings: Vec<Vec<[f64; 2]>> = closed
+        .iter()
+        .map(|c| c.points.iter().map(|p| [p.x, p.y]).collect())
+        .collect();
+    let shapes = rings.simplify_shape(FillRule::NonZero);
+    let mut out: Vec<Contour> = shapes
+        .into_iter()
+        .flatten()
+        .filter(|ring| ring.len() >= 3)
+        .map(|ring| {
+            Contour::from_polyline(
+                ring.into_iter().map(|[x, y]| Point2::new(x, y)).collect(),
+                true,
+            )
+        })
+        .collect();
+    out.extend(open);
+    out
+}
+
+impl Slice {
+    /// Returns the number of contours that do not close.
+    pub fn open_count(&self) -> usize {
+        self.contours.iter().filter(|c| !c.is_closed).count()
+    }
+
+    /// The slice as a finger of width `gap_mm` meets it: open ends within `gap_mm` of each other
+    /// joined, and, where the slice is in several pieces, every gap narrower than `gap_mm`
+    /// between pieces filled (a morphological closing: the region grown by `gap_mm / 2` and
+    /// shrunk back, so concave corners get a fillet of that radius and convex ones stay). A
+    /// finger cannot enter a perforation or a slot narrower than itself, so for the planner it
+    /// is solid. A slice in one closed piece is returned unchanged.
+    pub fn bridged(&self, gap_mm: f64) -> Slice {
+        let mut contours = self.contours.clone();
+        let joined = join_open(&mut contours, gap_mm);
+        let pieces = contours
+            .iter()
+            .filter(|c| c.is_closed && c.signed_area() > 0.0)
+            .count();
+        if pieces < 2 || gap_mm.is_nan() || gap_mm <= 0.0 {
+            return if joined {
+                finish(self.plane, union_closed(contours))
+            } else {
+                self.clone()
+            };
+        }
+        finish(self.plane, close_gaps(contours, 0.5 * gap_mm))
+    }
+}
+
+/// Morphological closing of the closed contours by a disc of radius `r` (i_overlay's outline
+/// offset, round joins); open contours are kept as they are.
+fn close_gaps(contours: Vec<Contour>, r: f64) -> Vec<Contour> {
+    use i_overlay::mesh::float::outline::offset::OutlineOffset;
+    use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
+    let (closed, open): (Vec<Contour>, Vec<Contour>) =
+        contours.into_iter().partition(|c| c.is_closed);
+    let rings: Vec<Vec<[f64; 2]>> = closed
+        .iter()
+        .map(|c| c.points.iter().map(|p| [p.x, p.y]).collect())
+        .collect();
+    // Arcs in steps of 10 degrees: the fillet is then within r (1 - cos 5°) = 0.4 % of r.
+    let step = 10f64.to_radians();
+    let grown = rings.outline(&OutlineStyle::new(r).line_join(LineJoin::Round(step)));
+    let shrunk = grown.outline(&OutlineStyle::new(-r).line_join(LineJoin::Round(step)));
+    let mut out: Vec<Contour> = shrunk
+        .into_iter()
+        .flatten()
+        .filter(|ring| ring.len() >= 3)
+        .map(|ring| {
+            Contour::from_polyline(
+                ring.into_iter().map(|[x, y]| Point2::new(x, y)).collect(),
+                true,
+            )
+        })
+        .collect();
+    out.extend(open);
+    out
 }

@@ -36,6 +36,8 @@ pub struct AlignedObject {
     pub principal_moments: Vector3<f64>,
     /// Height of the aligned object along Z `[mm]`.
     pub height_mm: f64,
+    /// Which principal axis is aligned +Z.
+    pub axis: GraspAxis,
 }
 
 impl AlignedObject {
@@ -52,8 +54,76 @@ impl AlignedObject {
 
 const DEGENERATE_MOMENTS: f64 = 1e-6;
 
-/// Aligns `mesh` with its principal axis. The mesh must enclose a positive volume.
+/// Which principal axis becomes the grasp axis (aligned +Z), and in which sense.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+pub struct GraspAxis {
+    /// The axis by its moment of inertia: 0 the smallest (the thesis's axis), 1 the middle one,
+    /// 2 the largest.
+    pub rank: usize,
+    /// True if and only if the axis is turned round (the object stands on its other end).
+    pub flipped: bool,
+}
+
+impl GraspAxis {
+    /// The thesis's axis: the smallest moment, in the sense the alignment rule gives.
+    pub const THESIS: GraspAxis = GraspAxis {
+        rank: 0,
+        flipped: false,
+    };
+
+    /// The order in which the planner tries the axes: the thesis's axis first (the thesis
+    /// method, and the long axis of an elongated object, which the fingers wrap best), then the
+    /// middle and the largest moment (a flat object is wrapped round its rim about the largest);
+    /// the opposite senses last, since turning an object round changes only which end the
+    /// search starts from and where gravity pulls in the check.
+    pub const SEARCH_ORDER: [GraspAxis; 6] = [
+        GraspAxis {
+            rank: 0,
+            flipped: false,
+        },
+        GraspAxis {
+            rank: 1,
+            flipped: false,
+        },
+        GraspAxis {
+            rank: 2,
+            flipped: false,
+        },
+        GraspAxis {
+            rank: 0,
+            flipped: true,
+        },
+        GraspAxis {
+            rank: 1,
+            flipped: true,
+        },
+        GraspAxis {
+            rank: 2,
+            flipped: true,
+        },
+    ];
+
+    /// A short name: `least`, `middle` or `largest` (moment), with `-` when flipped.
+    pub fn name(&self) -> String {
+        let m = ["least", "middle", "largest"][self.rank.min(2)];
+        if self.flipped {
+            format!("{m}-")
+        } else {
+            m.to_string()
+        }
+    }
+}
+
+/// Aligns `mesh` with its principal axis of least moment (the thesis's axis). The mesh must
+/// enclose a positive volume.
 pub fn align(mesh: &Mesh) -> AlignedObject {
+    align_about(mesh, GraspAxis::THESIS)
+}
+
+/// Aligns `mesh` with the principal axis `which` as +Z. For the thesis's axis this is [`align`]'s
+/// rule; for another, X is the smaller-moment remaining axis (the object's widest direction
+/// across the grasp axis), signed by the same rule, and a flipped axis turns the object about X.
+pub fn align_about(mesh: &Mesh, which: GraspAxis) -> AlignedObject {
     let props = mass_properties(mesh);
     let eig = SymmetricEigen::new(props.inertia);
     // Sort eigenpairs by moment, ascending; ties broken by index for determinism.
@@ -66,11 +136,13 @@ pub fn align(mesh: &Mesh) -> AlignedObject {
     let axis = |i: usize| -> Vector3<f64> { eig.eigenvectors.column(order[i]).into_owned() };
     let moment = |i: usize| eig.eigenvalues[order[i]];
 
-    let z = sign_towards(axis(0), &[Vector3::z(), Vector3::x(), Vector3::y()]);
-    let (m1, m2) = (moment(1), moment(2));
+    let rank = which.rank.min(2);
+    let rest: Vec<usize> = (0..3).filter(|&i| i != rank).collect();
+    let z = sign_towards(axis(rank), &[Vector3::z(), Vector3::x(), Vector3::y()]);
+    let (m1, m2) = (moment(rest[0]), moment(rest[1]));
     let scale = m1.abs().max(m2.abs()).max(f64::MIN_POSITIVE);
     let x_raw = if (m2 - m1).abs() / scale > DEGENERATE_MOMENTS {
-        axis(1)
+        axis(rest[0])
     } else {
         [Vector3::x(), Vector3::y(), Vector3::z()]
             .iter()
@@ -81,6 +153,7 @@ pub fn align(mesh: &Mesh) -> AlignedObject {
     // Re-orthogonalise against z (eigenvectors are orthogonal only to rounding).
     let x = (x_raw - z * z.dot(&x_raw)).normalize();
     let x = sign_towards(x, &[Vector3::x(), Vector3::y(), Vector3::z()]);
+    let z = if which.flipped { -z } else { z };
     let y = z.cross(&x);
 
     // Rows of the rotation are the new axes expressed in the original frame.
@@ -113,6 +186,7 @@ pub fn align(mesh: &Mesh) -> AlignedObject {
             z.dot(&(props.inertia * z)),
         ),
         height_mm,
+        axis: which,
     }
 }
 

@@ -13,7 +13,7 @@ mod align;
 mod load;
 mod mass;
 
-pub use align::{align, AlignedObject};
+pub use align::{align, align_about, AlignedObject, GraspAxis};
 pub use load::{load_stl, parse_stl, LengthUnit, LoadedMesh};
 pub use mass::{mass_properties, MassProperties};
 

@@ -95,6 +95,9 @@ pub struct CurvatureParams {
     pub sharp_turn_deg: f64,
     /// A sharp turn this close to the touch point makes it ungraspable `[mm]`.
     pub sharp_distance_mm: f64,
+    /// The grade of a touch point the thesis calls ungraspable, under the extended rules (a
+    /// score below every category, 0.6–1.0, instead of a rejection); `None` under the thesis's.
+    pub ungraspable_grade: Option<f64>,
 }
 
 impl CurvatureParams {
@@ -113,6 +116,7 @@ impl CurvatureParams {
             friction_cone_deg: friction.atan().to_degrees(),
             sharp_turn_deg: 45.0,
             sharp_distance_mm: p.height_step_mm / 2.0,
+            ungraspable_grade: None,
         }
     }
 }
@@ -204,21 +208,36 @@ pub struct SideGrade {
 
 /// Curvature grades of every indexed elevation: `None` where ungraspable.
 pub fn grade_elevations(domain: &Domain, p: &CurvatureParams) -> Vec<Grade> {
+    grade_elevations_marked(domain, p).0
+}
+
+/// [`grade_elevations`], and per elevation whether a touch point the thesis calls ungraspable
+/// was graded with `p.ungraspable_grade` instead (always false when that is `None`).
+pub fn grade_elevations_marked(domain: &Domain, p: &CurvatureParams) -> (Vec<Grade>, Vec<bool>) {
     domain
         .elevations
         .iter()
         .map(|&z| {
             let mut sum = 0.0;
+            let mut floored = false;
             for (k, s) in domain.slices.iter().enumerate() {
-                let (left, right) = domain.touches(k, z)?;
+                let Some((left, right)) = domain.touches(k, z) else {
+                    return (None, false);
+                };
                 let zr = z_range(&s.contours);
                 let l = grade_side(&s.contours[left.contour], &left, -1.0, zr, p).grade;
                 let r = grade_side(&s.contours[right.contour], &right, 1.0, zr, p).grade;
-                sum += 0.5 * (l.ok()? + r.ok()?);
+                let g = p.ungraspable_grade;
+                floored |= l.is_err() || r.is_err();
+                match (l.ok().or(g), r.ok().or(g)) {
+                    (Some(l), Some(r)) => sum += 0.5 * (l + r),
+                    _ => return (None, false),
+                }
             }
-            (!domain.slices.is_empty()).then(|| sum / domain.slices.len() as f64)
+            let grade = (!domain.slices.is_empty()).then(|| sum / domain.slices.len() as f64);
+            (grade, floored && grade.is_some())
         })
-        .collect()
+        .unzip()
 }
 
 fn z_range(contours: &[Contour]) -> (f64, f64) {
@@ -474,6 +493,7 @@ mod tests {
             friction_cone_deg: 0.3f64.atan().to_degrees(),
             sharp_turn_deg: 45.0,
             sharp_distance_mm: 1.25,
+            ungraspable_grade: None,
         }
     }
 

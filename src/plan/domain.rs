@@ -29,6 +29,12 @@ pub struct Domain {
     pub elevations: Vec<f64>,
     /// HeightStep `[mm]`.
     pub height_step_mm: f64,
+    /// The elevations every vertical slice spans (the thesis's Effective Elevation before the
+    /// finger offset is taken off) `[mm]`.
+    pub span_mm: [f64; 2],
+    /// Outward directions of the object's large flat side faces, as angles from +X `[deg]`
+    /// (see [`face_directions_deg`]); the palm approaching at such an angle lies flat on the face.
+    pub face_directions_deg: Vec<f64>,
 }
 
 /// Where a horizontal line at one elevation touches a slice's outline on one side.
@@ -45,12 +51,19 @@ pub struct Touch {
 impl Domain {
     /// Runs stage 1.
     pub fn build(mesh: &Mesh, params: &PlannerParams, hand: &Hand) -> Domain {
+        Domain::build_with(mesh, params, hand, hand.fingers.offset_mm)
+    }
+
+    /// Stage 1 with the Effective Elevation shrunk by `shrink_mm` at both ends instead of the
+    /// finger offset: 0 under the extended rules, whose outer fingers may touch the object
+    /// beyond the thesis's Effective Elevation (see [`super::palm_grade::rank_with`]).
+    pub fn build_with(mesh: &Mesh, params: &PlannerParams, hand: &Hand, shrink_mm: f64) -> Domain {
         let step = params.angular_step_deg;
         let count = (180.0 / step).round().max(1.0) as usize;
         let angles_deg: Vec<f64> = (0..count).map(|k| k as f64 * step).collect();
         let slices: Vec<Slice> = angles_deg
             .iter()
-            .map(|a| slice(mesh, &Plane::vertical(a.to_radians())))
+            .map(|a| slice(mesh, &Plane::vertical(a.to_radians())).bridged(hand.finger_width_mm()))
             .collect();
         let mut lo = f64::NEG_INFINITY;
         let mut hi = f64::INFINITY;
@@ -65,8 +78,7 @@ impl Domain {
             lo = lo.max(a);
             hi = hi.min(b);
         }
-        let offset = hand.fingers.offset_mm;
-        let effective = [lo + offset, hi - offset];
+        let effective = [lo + shrink_mm, hi - shrink_mm];
         let h = params.height_step_mm;
         let mut elevations = Vec::new();
         if effective[0].is_finite() && effective[1] >= effective[0] {
@@ -80,6 +92,8 @@ impl Domain {
             effective,
             elevations,
             height_step_mm: h,
+            span_mm: [lo, hi],
+            face_directions_deg: face_directions_deg(mesh, params.vertical_deviation_deg),
         }
     }
 
@@ -126,4 +140,69 @@ pub fn outermost_crossings(contours: &[Contour], z: f64) -> Option<(Touch, Touch
         }
     }
     Some((left?, right?))
+}
+
+/// A flat face counts as large when it holds at least this share of the side area.
+const LARGE_FACE_SHARE: f64 = 0.05;
+
+/// The outward directions (angles from +X in `[0, 360)` `[deg]`) of the object's large flat side
+/// faces: triangles whose normal is within the Vertical Deviation Range of horizontal, grouped
+/// by azimuth where neighbours differ by at most 0.5°, each group at least 5 % of the side area
+/// (a cylinder's facets, 2.5° apart and under 1 % each, are not faces), as its area-weighted
+/// mean azimuth rounded to 1e-6°. The thesis's AngularStep grid depends on where the alignment
+/// happened to put X; these directions do not.
+pub fn face_directions_deg(mesh: &Mesh, vertical_deviation_deg: f64) -> Vec<f64> {
+    let max_z = vertical_deviation_deg.to_radians().sin();
+    let mut side: Vec<(f64, f64)> = Vec::new();
+    for t in 0..mesh.triangles.len() {
+        let n = mesh.area_normal(t);
+        let area = 0.5 * n.norm();
+        if area <= 0.0 || (n.z / (2.0 * area)).abs() > max_z {
+            continue;
+        }
+        side.push((n.y.atan2(n.x).to_degrees().rem_euclid(360.0), area));
+    }
+    let total: f64 = side.iter().map(|s| s.1).sum();
+    if side.is_empty() || total <= 0.0 {
+        return Vec::new();
+    }
+    side.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    // Start the groups after the widest gap in azimuth, so no group straddles 0°/360°.
+    let n = side.len();
+    let start = (0..n)
+        .max_by(|&i, &j| {
+            let gap = |k: usize| (side[(k + 1) % n].0 - side[k].0).rem_euclid(360.0);
+            gap(i).total_cmp(&gap(j)).then(j.cmp(&i))
+        })
+        .map_or(0, |i| (i + 1) % n);
+    let mut faces = Vec::new();
+    let mut group: Vec<(f64, f64)> = Vec::new();
+    let mut flush = |group: &mut Vec<(f64, f64)>| {
+        let area: f64 = group.iter().map(|g| g.1).sum();
+        if area >= LARGE_FACE_SHARE * total {
+            let a0 = group[0].0;
+            let mean = group
+                .iter()
+                .map(|(a, _)| (a - a0 + 180.0).rem_euclid(360.0) - 180.0 + a0)
+                .zip(group.iter().map(|g| g.1))
+                .map(|(a, w)| a * w)
+                .sum::<f64>()
+                / area;
+            faces.push((mean.rem_euclid(360.0) * 1e6).round() / 1e6);
+        }
+        group.clear();
+    };
+    for k in 0..n {
+        let cur = side[(start + k) % n];
+        if let Some(last) = group.last() {
+            if (cur.0 - last.0).rem_euclid(360.0) > 0.5 {
+                flush(&mut group);
+            }
+        }
+        group.push(cur);
+    }
+    flush(&mut group);
+    faces.sort_by(f64::total_cmp);
+    faces.dedup();
+    faces
 }

@@ -21,6 +21,7 @@
 use super::geom2::ConvexPolygon;
 use super::kinematics::{inward_normal, phalanx1_direction};
 use super::palm::{PalmPlacement, PENETRATION_TOL_MM};
+use super::{Relaxation, RuleSet};
 use crate::hand::{Hand, Side};
 use crate::mesh::Mesh;
 use crate::slice::{slice, Slice};
@@ -51,6 +52,8 @@ pub struct FingerPlacement {
     pub centre: AlsAngles,
     /// Bottom ALS.
     pub bottom: AlsAngles,
+    /// The thesis rules this finger's placement relaxed (extended rules only; else empty).
+    pub relaxations: Vec<Relaxation>,
 }
 
 /// Why a finger could not be placed.
@@ -75,12 +78,19 @@ pub enum FingerRejection {
 }
 
 /// Positions finger `k` of `hand` on a placed palm: all three ALS and their agreement.
+///
+/// Under [`RuleSet::Extended`], an ALS that meets nothing is allowed while another touches
+/// ([`Relaxation::AlsOffObject`]), and the finger stops where its first ALS touches: its most
+/// open θ1 and θ2 over the ALS that touch, with a deviation beyond the Joint Angular Deviation
+/// recorded ([`Relaxation::JointDeviationRecorded`]) instead of rejected. An ALS off the object
+/// is reported with the finger's angles. Every other rejection (range, penetration) stands.
 pub fn place_finger(
     mesh: &Mesh,
     hand: &Hand,
     palm: &PalmPlacement,
     k: usize,
     deviation_deg: [f64; 2],
+    rules: RuleSet,
 ) -> Result<FingerPlacement, FingerRejection> {
     let f = &hand.finger_list[k];
     let o = hand.fingers.offset_mm;
@@ -89,9 +99,12 @@ pub fn place_finger(
         Side::Right => -1.0,
     };
     let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
-        let s = slice(mesh, &palm.finger_plane(f.height_mm + dz));
+        let s = slice(mesh, &palm.finger_plane(f.height_mm + dz)).bridged(2.0 * o);
         place_als(&s, hand, mirror)
     };
+    if rules == RuleSet::Extended {
+        return place_finger_extended(f.name.clone(), [als(0.0), als(o), als(-o)], deviation_deg);
+    }
     let centre = als(0.0)?;
     let top = als(o)?;
     let bottom = als(-o)?;
@@ -107,6 +120,59 @@ pub fn place_finger(
         top,
         centre,
         bottom,
+        relaxations: Vec::new(),
+    })
+}
+
+/// The extended rules' finger (see [`place_finger`]); `als` is centre, top, bottom.
+fn place_finger_extended(
+    name: String,
+    als: [Result<AlsAngles, FingerRejection>; 3],
+    deviation_deg: [f64; 2],
+) -> Result<FingerPlacement, FingerRejection> {
+    let is_off = |r: &FingerRejection| {
+        matches!(
+            r,
+            FingerRejection::Phalanx1NoContact | FingerRejection::Phalanx2NoContact
+        )
+    };
+    let mut relaxations = Vec::new();
+    for r in &als {
+        match r {
+            Err(e) if !is_off(e) => return Err(*e),
+            Err(_) => relaxations.push(Relaxation::AlsOffObject),
+            Ok(_) => {}
+        }
+    }
+    let touching: Vec<&AlsAngles> = als.iter().filter_map(|r| r.as_ref().ok()).collect();
+    let first = touching
+        .iter()
+        .copied()
+        .max_by(|a, b| a.theta1_deg.total_cmp(&b.theta1_deg))
+        .ok_or_else(|| *als[0].as_ref().expect_err("no ALS touched"))?;
+    let theta2 = touching
+        .iter()
+        .map(|a| a.theta2_deg)
+        .fold(f64::NEG_INFINITY, f64::max);
+    let finger = AlsAngles {
+        theta2_deg: theta2,
+        ..*first
+    };
+    if touching.iter().any(|a| {
+        (a.theta1_deg - finger.theta1_deg).abs() > deviation_deg[0]
+            || (a.theta2_deg - finger.theta2_deg).abs() > deviation_deg[1]
+    }) {
+        relaxations.push(Relaxation::JointDeviationRecorded);
+    }
+    relaxations.sort();
+    relaxations.dedup();
+    let pick = |r: &Result<AlsAngles, FingerRejection>| *r.as_ref().unwrap_or(&finger);
+    Ok(FingerPlacement {
+        name,
+        top: pick(&als[1]),
+        centre: finger,
+        bottom: pick(&als[2]),
+        relaxations,
     })
 }
 

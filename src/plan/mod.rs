@@ -34,6 +34,46 @@ use std::time::Instant;
 /// A grade of an indexed elevation: a number (larger is better), or ungraspable.
 pub type Grade = Option<f64>;
 
+/// Which rules the planner applies.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum RuleSet {
+    /// The thesis's rules, as written.
+    Thesis,
+    /// The thesis's rules with the relaxations of [`Relaxation`], tried only when the thesis's
+    /// rules find no grasp on any axis (or none that holds in the physics check).
+    Extended,
+}
+
+/// A rule of the thesis relaxed under [`RuleSet::Extended`], and why it may be.
+///
+/// The thesis is strict so that a kinematic plan is safe without any force analysis; with the
+/// physics check judging every grasp, the planner may propose more.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Relaxation {
+    /// An outer finger sits beyond the Effective Elevation (or on an elevation graded
+    /// ungraspable) where it still meets the object: a short object (a ball, a can lying down)
+    /// is shorter than the fingers' span, yet a real hand wraps it with the outer fingers on its
+    /// shoulders.
+    OuterFingerBeyondElevation,
+    /// A touch point the curvature rules call ungraspable (a slope beyond the Vertical Deviation
+    /// Range, a sharp curve change) is graded below every category instead of rejected, while
+    /// the finger still makes contact: a rounded object has no vertical wall, but friction and
+    /// the enveloping fingers still hold it.
+    CurvatureGraded,
+    /// The palm outline would take in part of the object (a knob's grip, a handle, a rim
+    /// wider than the elevation the palm was placed at): the palm is moved back along its
+    /// normal until it only touches, and the fingers reach round from there.
+    PalmBackedOff,
+    /// An ALS of a finger meets nothing (the finger's edge is off the object) while another ALS
+    /// of the finger touches: the finger closes until its first ALS touches.
+    AlsOffObject,
+    /// The ALS of a finger disagree beyond the Joint Angular Deviation: the finger stops where its
+    /// first ALS touches (its most open angles), and the deviation is recorded, not rejected.
+    JointDeviationRecorded,
+}
+
 /// Runs stages 1–3 on an aligned object: the reduced, graded, sorted search domain.
 ///
 /// `timings` receives the wall time of each stage `[ms]`.
@@ -44,10 +84,29 @@ pub fn grade_domain(
     friction: f64,
     timings: &mut BTreeMap<String, f64>,
 ) -> GradedDomain {
+    grade_domain_with(mesh, hand, params, friction, RuleSet::Thesis, timings)
+}
+
+/// Stages 1–3 under a rule set: the extended rules widen the Effective Elevation to the whole
+/// object (for the outer fingers only) and grade curvature instead of rejecting it.
+pub fn grade_domain_with(
+    mesh: &Mesh,
+    hand: &Hand,
+    params: &PlannerParams,
+    friction: f64,
+    rules: RuleSet,
+    timings: &mut BTreeMap<String, f64>,
+) -> GradedDomain {
     let t = Instant::now();
-    let domain = Domain::build(mesh, params, hand);
+    let shrink = match rules {
+        RuleSet::Thesis => hand.fingers.offset_mm,
+        // An outer finger's centreline may lie beyond the object's end by up to the finger
+        // offset less EXTENDED_MIN_OVERLAP_MM: its inner edge still overlaps the object.
+        RuleSet::Extended => EXTENDED_MIN_OVERLAP_MM - hand.fingers.offset_mm,
+    };
+    let domain = Domain::build_with(mesh, params, hand, shrink);
     timings.insert("stage1_domain".to_string(), ms(t));
-    grade_built(domain, hand, params, friction, timings)
+    grade_built_with(domain, hand, params, friction, rules, timings)
 }
 
 /// Stages 2–3 on an already built stage-1 domain (which depends only on the mesh, the
@@ -59,19 +118,43 @@ pub fn grade_built(
     friction: f64,
     timings: &mut BTreeMap<String, f64>,
 ) -> GradedDomain {
+    grade_built_with(domain, hand, params, friction, RuleSet::Thesis, timings)
+}
+
+/// [`grade_built`] under a rule set.
+pub fn grade_built_with(
+    domain: Domain,
+    hand: &Hand,
+    params: &PlannerParams,
+    friction: f64,
+    rules: RuleSet,
+    timings: &mut BTreeMap<String, f64>,
+) -> GradedDomain {
     let t = Instant::now();
-    let cparams = CurvatureParams::from_planner(params, hand, friction);
-    let curvature = curvature::grade_elevations(&domain, &cparams);
+    let mut cparams = CurvatureParams::from_planner(params, hand, friction);
+    if rules == RuleSet::Extended {
+        cparams.ungraspable_grade = Some(EXTENDED_CURVATURE_FLOOR);
+    }
+    let (curvature, floored) = curvature::grade_elevations_marked(&domain, &cparams);
     timings.insert("stage2_curvature".to_string(), ms(t));
     let t = Instant::now();
     let range = kinematics::graspable_range_with(hand, params.magnify_factor);
     let diameter = diameter::grade_elevations(&domain, range.used());
     timings.insert("stage2_diameter".to_string(), ms(t));
     let t = Instant::now();
-    let graded = palm_grade::rank(domain, curvature, diameter, range, params, hand);
+    let mut graded = palm_grade::rank_with(domain, curvature, diameter, range, params, hand, rules);
+    graded.curvature_relaxed = floored;
     timings.insert("stage3_palm".to_string(), ms(t));
     graded
 }
+
+/// Under the extended rules, how much of an outer finger's width must still lie on the
+/// object's extent along the axis `[mm]`.
+pub const EXTENDED_MIN_OVERLAP_MM: f64 = 2.0;
+
+/// The curvature grade of a touch point the thesis calls ungraspable, under the extended rules:
+/// below the lowest category (Cat_8, 0.6), so such elevations come after every graded one.
+pub const EXTENDED_CURVATURE_FLOOR: f64 = 0.5;
 
 /// The whole kinematic planner on an aligned object: stages 1–3, then the search for up to
 /// `max_grasps` feasible grasps (thesis chapter 3).

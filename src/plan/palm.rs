@@ -48,6 +48,9 @@ pub struct PalmPlacement {
     pub contacts: Vec<Point2<f64>>,
     /// The vertical slice at the approach angle.
     pub slice: Slice,
+    /// How far the palm was moved back from its thesis position so as not to take in the
+    /// object (extended rules only; else 0) `[mm]`.
+    pub backed_off_mm: f64,
 }
 
 /// Why a palm placement failed.
@@ -69,8 +72,22 @@ pub fn place_palm(
     approach_rad: f64,
     pitch_range_rad: f64,
 ) -> Result<PalmPlacement, PalmRejection> {
+    place_palm_with(mesh, hand, z1, approach_rad, pitch_range_rad, false)
+}
+
+/// [`place_palm`]; with `back_off`, a palm outline that takes in part of the object in the
+/// vertical plane is moved back along its normal until it only touches (the extended rules'
+/// [`super::Relaxation::PalmBackedOff`]) instead of being rejected.
+pub fn place_palm_with(
+    mesh: &Mesh,
+    hand: &Hand,
+    z1: f64,
+    approach_rad: f64,
+    pitch_range_rad: f64,
+    back_off: bool,
+) -> Result<PalmPlacement, PalmRejection> {
     let plane = Plane::vertical(approach_rad);
-    let vslice = slice(mesh, &plane);
+    let vslice = slice(mesh, &plane).bridged(hand.finger_width_mm());
     let h1 = hand.finger_list[0].height_mm;
     let (h_lo, h_hi) = hand.finger_height_span();
     let m = hand.palm.margin_mm;
@@ -157,7 +174,15 @@ pub fn place_palm(
     // Finger_1's point on the contact line at elevation z1, then the palm centre.
     let t = (z1 - first.y) / up.y;
     let p1 = first + up * t;
-    let centre = p1 - up * h1;
+    let mut centre = p1 - up * h1;
+    let mut backed_off_mm = 0.0;
+    if back_off {
+        let depth = penetration_depth(&vslice, centre, up, back, [h_lo - m, h_hi + m]);
+        if depth > PENETRATION_TOL_MM {
+            centre += back * depth;
+            backed_off_mm = depth;
+        }
+    }
     let outline = ConvexPolygon::new(vec![
         centre + up * (h_lo - m),
         centre + up * (h_hi + m),
@@ -187,6 +212,7 @@ pub fn place_palm(
         axes: [x_p, y_p, z_p],
         contacts,
         slice: vslice,
+        backed_off_mm,
     })
 }
 
@@ -201,4 +227,42 @@ impl PalmPlacement {
             v: self.axes[1],
         }
     }
+}
+
+/// How far the object reaches past a palm contact line `[mm]`: the largest `(p − origin)·back`
+/// over the slice's contours where `(p − origin)·up` lies in `band` (segments clipped to the
+/// band, so a long segment counts where it crosses it); 0 or negative when nothing reaches past.
+/// `up` and `back` are orthonormal.
+pub fn penetration_depth(
+    s: &Slice,
+    origin: Point2<f64>,
+    up: Vector2<f64>,
+    back: Vector2<f64>,
+    band: [f64; 2],
+) -> f64 {
+    let mut depth = f64::NEG_INFINITY;
+    for c in &s.contours {
+        for i in 0..c.segment_count() {
+            let (a, b) = c.segment(i);
+            let (ua, ub) = ((a - origin).dot(&up), (b - origin).dot(&up));
+            let (da, db) = ((a - origin).dot(&back), (b - origin).dot(&back));
+            // Clip the segment's parameter range to the band.
+            let (mut t0, mut t1) = (0.0f64, 1.0f64);
+            if (ub - ua).abs() < 1e-12 {
+                if ua < band[0] || ua > band[1] {
+                    continue;
+                }
+            } else {
+                let ta = (band[0] - ua) / (ub - ua);
+                let tb = (band[1] - ua) / (ub - ua);
+                t0 = t0.max(ta.min(tb));
+                t1 = t1.min(ta.max(tb));
+                if t0 > t1 {
+                    continue;
+                }
+            }
+            depth = depth.max(da + (db - da) * t0).max(da + (db - da) * t1);
+        }
+    }
+    depth
 }

@@ -16,6 +16,7 @@
 
 use super::diameter::DiameterGrades;
 use super::kinematics::GraspableRange;
+use super::RuleSet;
 use super::{Domain, Grade};
 use crate::hand::Hand;
 use crate::scenario::PlannerParams;
@@ -52,6 +53,9 @@ pub struct GradedDomain {
     pub sorted_indices: Vec<usize>,
     /// Why nothing survived, when `sorted_indices` is empty.
     pub reason: Option<String>,
+    /// Per index, true where a curvature grade used the extended rules' floor for a touch
+    /// point the thesis calls ungraspable (all false under the thesis's rules).
+    pub curvature_relaxed: Vec<bool>,
 }
 
 /// Stage 3: combine, check the palm span, grade palm positions and sort them.
@@ -62,6 +66,31 @@ pub fn rank(
     range: GraspableRange,
     params: &PlannerParams,
     hand: &Hand,
+) -> GradedDomain {
+    rank_with(
+        domain,
+        curvature,
+        diameter,
+        range,
+        params,
+        hand,
+        RuleSet::Thesis,
+    )
+}
+
+/// Stage 3 under a rule set. Under [`RuleSet::Extended`] the domain spans the whole object
+/// ([`Domain::build_with`] with no shrink); the inner fingers must still sit on graded indices
+/// within the thesis's Effective Elevation, the outer (highest and lowest) fingers may sit on
+/// any index of the object, graded or not (an ungraded one counts 0 in the palm grade), and the
+/// Largest Span Height check is not made (see [`super::Relaxation::OuterFingerBeyondElevation`]).
+pub fn rank_with(
+    domain: Domain,
+    curvature: Vec<Grade>,
+    diameter: DiameterGrades,
+    range: GraspableRange,
+    params: &PlannerParams,
+    hand: &Hand,
+    rules: RuleSet,
 ) -> GradedDomain {
     let n = domain.elevations.len();
     let step = domain.height_step_mm;
@@ -100,7 +129,34 @@ pub fn rank(
     let finger_span_mm = (spread - low) as f64 * step;
 
     let mut palm: Vec<Grade> = vec![None; n];
-    if largest_span_mm > finger_span_mm {
+    if rules == RuleSet::Extended {
+        let o = hand.fingers.offset_mm;
+        let inner_range = [domain.span_mm[0] + o, domain.span_mm[1] - o];
+        for (i0, slot) in palm.iter_mut().enumerate() {
+            let i = i0 as i64;
+            let mut sum = 0.0;
+            let mut ok = true;
+            for &off in &finger_offsets {
+                let j = i - off;
+                if j < 0 || j >= n as i64 {
+                    ok = false;
+                    break;
+                }
+                let g = combined[j as usize];
+                let is_outer = spread != low && (off == spread || off == low);
+                let z = domain.elevations[j as usize];
+                let inside = z >= inner_range[0] - 1e-9 && z <= inner_range[1] + 1e-9;
+                if !is_outer && (g.is_none() || !inside) {
+                    ok = false;
+                    break;
+                }
+                sum += g.unwrap_or(0.0);
+            }
+            if ok {
+                *slot = Some(sum / finger_offsets.len() as f64);
+            }
+        }
+    } else if largest_span_mm > finger_span_mm {
         for (i0, slot) in palm.iter_mut().enumerate() {
             let i = i0 as i64;
             let (lo, hi) = (i - spread, i - low);
@@ -150,6 +206,7 @@ pub fn rank(
         largest_span_mm,
         sorted_indices,
         reason,
+        curvature_relaxed: vec![false; n],
     }
 }
 

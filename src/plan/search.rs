@@ -4,8 +4,10 @@
 //! ends the search (or the first `max_grasps`, beyond the thesis, for ranking by simulation).
 
 use super::finger::{place_finger, FingerPlacement, FingerRejection};
-use super::palm::{place_palm, PalmPlacement, PalmRejection};
-use super::GradedDomain;
+use super::palm::{
+    penetration_depth, place_palm_with, PalmPlacement, PalmRejection, PENETRATION_TOL_MM,
+};
+use super::{GradedDomain, Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
 use crate::scenario::PlannerParams;
@@ -24,6 +26,10 @@ pub struct Grasp {
     pub palm: PalmPlacement,
     /// The fingers, in hand order.
     pub fingers: Vec<FingerPlacement>,
+    /// The rule set that produced it.
+    pub rules: RuleSet,
+    /// The thesis rules it relaxed (sorted, each once): empty under the thesis's rules.
+    pub relaxations: Vec<Relaxation>,
 }
 
 /// What rejected a candidate.
@@ -83,37 +89,99 @@ pub fn search(
     params: &PlannerParams,
     max_grasps: usize,
 ) -> SearchResult {
-    let mut result = SearchResult {
-        grasps: Vec::new(),
-        candidates_tried: 0,
-        rejections: BTreeMap::new(),
-    };
+    let mut grasps = Vec::new();
+    let (candidates_tried, rejections) =
+        search_with(mesh, hand, graded, params, RuleSet::Thesis, |g| {
+            grasps.push(g);
+            grasps.len() < max_grasps
+        });
+    SearchResult {
+        grasps,
+        candidates_tried,
+        rejections,
+    }
+}
+
+/// The approach angles tried at each elevation `[deg]`: the AngularStep grid 0, AngularStep, …
+/// (thesis 3.7), then the directions normal to the object's large flat side faces that the grid
+/// misses, so that a box is approached square to its faces however the alignment turned it
+/// about the axis (see [`face_directions_deg`]).
+pub fn approach_angles_deg(graded: &GradedDomain, params: &PlannerParams) -> Vec<f64> {
     let steps = (360.0 / params.angular_step_deg).round() as usize;
+    let mut angles: Vec<f64> = (0..steps)
+        .map(|k| k as f64 * params.angular_step_deg)
+        .collect();
+    let grid = angles.clone();
+    for a in &graded.domain.face_directions_deg {
+        let on_grid = grid.iter().any(|g| {
+            let d = (a - g).rem_euclid(360.0);
+            d.min(360.0 - d) < 0.01
+        });
+        if !on_grid {
+            angles.push(*a);
+        }
+    }
+    angles
+}
+
+/// Walks the sorted domain, handing each feasible grasp to `on_grasp` in search order until it
+/// returns false or the domain is exhausted. Returns the candidates tried and the rejections.
+pub fn search_with(
+    mesh: &Mesh,
+    hand: &Hand,
+    graded: &GradedDomain,
+    params: &PlannerParams,
+    rules: RuleSet,
+    mut on_grasp: impl FnMut(Grasp) -> bool,
+) -> (usize, BTreeMap<Rejection, usize>) {
+    let mut tried = 0;
+    let mut rejections = BTreeMap::new();
     let deviation = [
         params.joint_deviation_theta1_deg,
         params.joint_deviation_theta2_deg,
     ];
+    let angles = approach_angles_deg(graded, params);
     for &index in &graded.sorted_indices {
         let z1 = graded.domain.elevations[index - 1];
-        for k in 0..steps {
-            if result.grasps.len() >= max_grasps {
-                return result;
-            }
-            let approach_deg = k as f64 * params.angular_step_deg;
-            result.candidates_tried += 1;
-            match try_candidate(mesh, hand, z1, approach_deg, params, deviation) {
-                Ok((palm, fingers)) => result.grasps.push(Grasp {
-                    elevation_index: index,
-                    elevation_mm: z1,
-                    approach_angle_deg: approach_deg,
-                    palm,
-                    fingers,
-                }),
-                Err(r) => *result.rejections.entry(r).or_insert(0) += 1,
+        for &approach_deg in &angles {
+            tried += 1;
+            match try_candidate(mesh, hand, z1, approach_deg, params, deviation, rules) {
+                Ok((palm, fingers)) => {
+                    let mut relaxations: Vec<Relaxation> = fingers
+                        .iter()
+                        .flat_map(|f| f.relaxations.iter().copied())
+                        .collect();
+                    if finger_indices(graded, index)
+                        .any(|j| graded.curvature_relaxed.get(j - 1) == Some(&true))
+                    {
+                        relaxations.push(Relaxation::CurvatureGraded);
+                    }
+                    if palm.backed_off_mm > 0.0 {
+                        relaxations.push(Relaxation::PalmBackedOff);
+                    }
+                    if rules == RuleSet::Extended && uses_outer_elevation(graded, index, hand) {
+                        relaxations.push(Relaxation::OuterFingerBeyondElevation);
+                    }
+                    relaxations.sort();
+                    relaxations.dedup();
+                    let go_on = on_grasp(Grasp {
+                        elevation_index: index,
+                        elevation_mm: z1,
+                        approach_angle_deg: approach_deg,
+                        palm,
+                        fingers,
+                        rules,
+                        relaxations,
+                    });
+                    if !go_on {
+                        return (tried, rejections);
+                    }
+                }
+                Err(r) => *rejections.entry(r).or_insert(0) += 1,
             }
         }
     }
-    result
+    (tried, rejections)
 }
 
 fn try_candidate(
@@ -123,17 +191,80 @@ fn try_candidate(
     approach_deg: f64,
     params: &PlannerParams,
     deviation: [f64; 2],
+    rules: RuleSet,
 ) -> Result<(PalmPlacement, Vec<FingerPlacement>), Rejection> {
-    let palm = place_palm(
+    let extended = rules == RuleSet::Extended;
+    let mut palm = place_palm_with(
         mesh,
         hand,
         z1,
         approach_deg.to_radians(),
         params.pitch_range_deg.to_radians(),
+        extended,
     )
     .map_err(Rejection::Palm)?;
+    if extended {
+        // The palm stops at its first contact in any finger plane, not only in the vertical
+        // plane it was placed in.
+        let depth = palm_backoff_in_finger_planes(mesh, hand, &palm);
+        if depth > PENETRATION_TOL_MM {
+            palm.origin += palm.axes[0] * depth;
+            palm.backed_off_mm += depth;
+        }
+    }
     let fingers = (0..hand.finger_list.len())
-        .map(|k| place_finger(mesh, hand, &palm, k, deviation).map_err(|r| Rejection::Finger(k, r)))
+        .map(|k| {
+            place_finger(mesh, hand, &palm, k, deviation, rules)
+                .map_err(|r| Rejection::Finger(k, r))
+        })
         .collect::<Result<Vec<_>, _>>()?;
     Ok((palm, fingers))
+}
+
+/// Returns true if and only if a finger of the grasp at Finger_1's `index` sits on an elevation
+/// the thesis would not use: outside its Effective Elevation (the extended domain is the whole
+/// object) or graded ungraspable.
+fn uses_outer_elevation(graded: &GradedDomain, index: usize, hand: &Hand) -> bool {
+    let o = hand.fingers.offset_mm;
+    let d = &graded.domain;
+    let inner = [d.span_mm[0] + o, d.span_mm[1] - o];
+    graded.finger_offsets.len() != finger_indices(graded, index).count()
+        || finger_indices(graded, index).any(|j| {
+            let z = d.elevations[j - 1];
+            graded.grades.combined[j - 1].is_none() || z < inner[0] - 1e-9 || z > inner[1] + 1e-9
+        })
+}
+
+/// The indices (1-based) of the fingers for Finger_1 at `index`, those inside the domain.
+fn finger_indices(graded: &GradedDomain, index: usize) -> impl Iterator<Item = usize> + '_ {
+    let n = graded.domain.elevations.len() as i64;
+    graded
+        .finger_offsets
+        .iter()
+        .map(move |&off| index as i64 - off)
+        .filter(move |&j| j >= 1 && j <= n)
+        .map(|j| j as usize)
+}
+
+/// How far the palm must move back along its normal so that its outline touches but does not
+/// take in the object in any finger slice plane (the three ALS planes of every finger) `[mm]`.
+fn palm_backoff_in_finger_planes(mesh: &Mesh, hand: &Hand, palm: &PalmPlacement) -> f64 {
+    let o = hand.fingers.offset_mm;
+    let hw = hand.palm.half_width_mm;
+    let mut depth = f64::NEG_INFINITY;
+    for f in &hand.finger_list {
+        for dz in [-o, 0.0, o] {
+            let s = crate::slice::slice(mesh, &palm.finger_plane(f.height_mm + dz))
+                .bridged(hand.finger_width_mm());
+            // Finger-plane coordinates: x away from the object (contact surface at 0), y sideways.
+            depth = depth.max(penetration_depth(
+                &s,
+                nalgebra::Point2::origin(),
+                nalgebra::Vector2::y(),
+                nalgebra::Vector2::x(),
+                [-hw, hw],
+            ));
+        }
+    }
+    depth
 }

@@ -201,11 +201,16 @@ fn payload_margin_is_found_by_bisection() {
         failed > m && failed <= m * 1.05 + 1e-9,
         "bracket {m} .. {failed}"
     );
-    // The bracket is real: at the margin the grasp holds, at the failing multiplier it does not.
+    // The bracket is real: at the margin the grasp holds, at the failing multiplier it does not
+    // (the same grasp: a run would otherwise go on to the next candidate).
     let check = |k: f64| {
         let mut heavier = s.clone();
         heavier.object.mass = grasp_sim::scenario::MassSpec::Mass(r.object.mass_kg * k);
-        run(&heavier, &RunOptions::default()).unwrap().sim.verdict
+        let first_only = RunOptions {
+            max_checked: Some(1),
+            ..RunOptions::default()
+        };
+        run(&heavier, &first_only).unwrap().sim.verdict
     };
     assert_eq!(check(m), "hold");
     assert_ne!(check(failed), "hold");

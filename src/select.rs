@@ -1,0 +1,216 @@
+//! Choosing the grasp: the thesis planner on every principal axis, the rules beyond the thesis
+//! when it finds nothing, and (with the physics check) candidates checked in search order until
+//! one holds.
+//!
+//! Order (issues 13 and 14): rule sets outer, axes inner, each axis's candidates in the thesis's
+//! search order. The thesis's rules on the thesis's axis come first, so a thesis object gets the
+//! thesis's grasp; the other axes follow ([`GraspAxis::SEARCH_ORDER`] says why in that order);
+//! the extended rules ([`RuleSet::Extended`]) only when the thesis's rules found no grasp on any
+//! axis, or, with the physics check, when none of their grasps held and checks remain.
+//!
+//! Without the physics check the first feasible grasp is the answer, as in the thesis
+//! (`--candidates N` collects N). With it, candidates are checked one by one until one holds or
+//! `max_checked` have been checked; the first that holds is the answer (else the first that
+//! slipped, else the first checked), and every candidate checked is reported with its verdict.
+
+use crate::hand::Hand;
+use crate::mesh::{align_about, AlignedObject, GraspAxis, Mesh};
+use crate::plan::search::{search_with, Grasp, Rejection};
+use crate::plan::{self, GradedDomain, RuleSet};
+use crate::scenario::PlannerParams;
+use crate::sim::{SimOutcome, Verdict};
+use std::collections::BTreeMap;
+
+/// The planner's view of the object about one axis under one rule set.
+#[derive(Debug, Clone)]
+pub struct AxisPlan {
+    /// The axis and the object aligned with it.
+    pub aligned: AlignedObject,
+    /// The rule set used.
+    pub rules: RuleSet,
+    /// Stages 1–3 about this axis.
+    pub graded: GradedDomain,
+    /// Candidates (elevation × approach angle) tried.
+    pub candidates_tried: usize,
+    /// How often each constraint rejected a candidate.
+    pub rejections: BTreeMap<Rejection, usize>,
+    /// Feasible grasps found about this axis.
+    pub grasps_found: usize,
+    /// True if and only if the search walked the whole sorted domain.
+    pub exhausted: bool,
+}
+
+/// A feasible grasp and, when the physics check ran on it, its outcome.
+#[derive(Debug, Clone)]
+pub struct Candidate {
+    /// Which [`AxisPlan`] it came from (index into [`Selection::axes`]).
+    pub axis_plan: usize,
+    /// The grasp, in that plan's aligned frame.
+    pub grasp: Grasp,
+    /// The physics check's outcome, when it ran on this candidate.
+    pub check: Option<SimOutcome>,
+}
+
+/// Everything the selection did.
+#[derive(Debug, Clone)]
+pub struct Selection {
+    /// Every (axis, rule set) planned, in order.
+    pub axes: Vec<AxisPlan>,
+    /// Every feasible grasp collected, in search order.
+    pub candidates: Vec<Candidate>,
+    /// The chosen candidate (index into `candidates`), if any.
+    pub chosen: Option<usize>,
+}
+
+impl Selection {
+    /// The chosen candidate.
+    pub fn chosen(&self) -> Option<&Candidate> {
+        self.chosen.map(|i| &self.candidates[i])
+    }
+
+    /// The axis plan the report describes: the chosen grasp's, else the thesis's axis under the
+    /// thesis's rules (the first planned).
+    pub fn reported_axis(&self) -> &AxisPlan {
+        match self.chosen() {
+            Some(c) => &self.axes[c.axis_plan],
+            None => &self.axes[0],
+        }
+    }
+
+    /// How many candidates the physics check ran on.
+    pub fn checked(&self) -> usize {
+        self.candidates.iter().filter(|c| c.check.is_some()).count()
+    }
+}
+
+/// What the selection needs besides the object.
+pub struct SelectParams<'a> {
+    /// The hand.
+    pub hand: &'a Hand,
+    /// Planner parameters.
+    pub planner: &'a PlannerParams,
+    /// Coulomb friction (the planner's friction cone).
+    pub friction: f64,
+    /// Feasible grasps to collect at least (`--candidates`).
+    pub collect: usize,
+    /// With the physics check: at most this many candidates are checked. `None`: no check.
+    pub max_checked: Option<usize>,
+    /// Runs the physics check on a grasp about an axis.
+    #[allow(clippy::type_complexity)]
+    pub check: &'a dyn Fn(&AlignedObject, &Grasp) -> SimOutcome,
+}
+
+/// Plans across axes and rule sets, checking candidates when asked (see the module docs).
+///
+/// `timings` receives the summed wall time of each planner stage `[ms]`.
+pub fn select(mesh: &Mesh, p: &SelectParams, timings: &mut BTreeMap<String, f64>) -> Selection {
+    let mut sel = Selection {
+        axes: Vec::new(),
+        candidates: Vec::new(),
+        chosen: None,
+    };
+    let collect = p.collect.max(1);
+    let mut aligned_cache: Vec<Option<AlignedObject>> = vec![None; GraspAxis::SEARCH_ORDER.len()];
+    for rules in [RuleSet::Thesis, RuleSet::Extended] {
+        if rules == RuleSet::Extended && !wants_extended(&sel, p) {
+            break;
+        }
+        for (k, axis) in GraspAxis::SEARCH_ORDER.iter().enumerate() {
+            if is_done(&sel, p, collect) {
+                break;
+            }
+            let aligned = aligned_cache[k]
+                .get_or_insert_with(|| align_about(mesh, *axis))
+                .clone();
+            let mut t = BTreeMap::new();
+            let graded = plan::grade_domain_with(
+                &aligned.mesh,
+                p.hand,
+                p.planner,
+                p.friction,
+                rules,
+                &mut t,
+            );
+            let slot = sel.axes.len();
+            let t0 = std::time::Instant::now();
+            let mut found = 0;
+            let mut stopped = false;
+            let (tried, rejections) =
+                search_with(&aligned.mesh, p.hand, &graded, p.planner, rules, |g| {
+                    found += 1;
+                    let check = match p.max_checked {
+                        Some(max) if sel.checked() < max && !has_hold(&sel) => {
+                            Some((p.check)(&aligned, &g))
+                        }
+                        _ => None,
+                    };
+                    sel.candidates.push(Candidate {
+                        axis_plan: slot,
+                        grasp: g,
+                        check,
+                    });
+                    stopped = is_done(&sel, p, collect);
+                    !stopped
+                });
+            *t.entry("search".to_string()).or_insert(0.0) += ms(t0);
+            for (key, v) in t {
+                *timings.entry(key).or_insert(0.0) += v;
+            }
+            sel.axes.push(AxisPlan {
+                aligned,
+                rules,
+                graded,
+                candidates_tried: tried,
+                rejections,
+                grasps_found: found,
+                exhausted: !stopped,
+            });
+        }
+    }
+    sel.chosen = choose(&sel.candidates);
+    sel
+}
+
+/// Returns true if and only if enough is known: without the check, `collect` grasps; with it,
+/// a grasp that holds (or the check budget spent) and `collect` grasps.
+fn is_done(sel: &Selection, p: &SelectParams, collect: usize) -> bool {
+    let collected = sel.candidates.len() >= collect;
+    match p.max_checked {
+        None => collected,
+        Some(max) => collected && (has_hold(sel) || sel.checked() >= max),
+    }
+}
+
+/// The extended rules are tried when the thesis's rules found nothing on any axis, or, with the
+/// physics check, when nothing they found held and checks remain.
+fn wants_extended(sel: &Selection, p: &SelectParams) -> bool {
+    if sel.candidates.is_empty() {
+        return true;
+    }
+    match p.max_checked {
+        None => false,
+        Some(max) => !has_hold(sel) && sel.checked() < max,
+    }
+}
+
+fn has_hold(sel: &Selection) -> bool {
+    sel.candidates
+        .iter()
+        .any(|c| c.check.as_ref().is_some_and(|o| o.verdict == Verdict::Hold))
+}
+
+/// The first candidate that held, else the first that slipped, else the first found.
+fn choose(candidates: &[Candidate]) -> Option<usize> {
+    let first_with = |v: Verdict| {
+        candidates
+            .iter()
+            .position(|c| c.check.as_ref().is_some_and(|o| o.verdict == v))
+    };
+    first_with(Verdict::Hold)
+        .or_else(|| first_with(Verdict::Slip))
+        .or_else(|| (!candidates.is_empty()).then_some(0))
+}
+
+fn ms(t: std::time::Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1000.0
+}
