@@ -1,22 +1,20 @@
 //! Running many objects: input expansion, templates, sharding, parallel runs in a stable order.
 //!
-//! An input is a scenario file, an STL file, or a folder (its `*.toml` scenarios and `*.stl`
-//! meshes, not recursing, sorted by path). An STL is run with a template scenario: by default the
+//! An input is a scenario file, a mesh file (STL, OBJ or PLY), or a folder (its `*.toml`
+//! scenarios and meshes, not recursing, sorted by path). A mesh is run with a template scenario: by default the
 //! thesis hand (built into the binary), millimetres, 500 kg/m³, μ = 0.3, the thesis's planner and
 //! physics defaults. Results come back in input order whatever the number of threads; a shard
 //! `K/N` is the K-th of N contiguous blocks, so the shards' outputs concatenate to the whole.
 
 use crate::hand::Hand;
 use crate::report::RunReport;
-use crate::scenario::{
-    Expect, MassSpec, ObjectSpec, Outcome, PlannerParams, Scenario, ScenarioError, SimParams,
-};
+use crate::scenario::{MassSpec, ObjectSpec, PlannerParams, Scenario, ScenarioError, SimParams};
 use crate::{run, Error, RunOptions};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// The thesis hand file, built in for templates.
-pub const THESIS_HAND_TOML: &str = include_str!("../assets/hands/thesis.toml");
+pub const THESIS_HAND_TOML: &str = crate::hand::BUNDLED[0].1;
 
 /// One thing to run.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
@@ -37,11 +35,11 @@ impl Item {
 }
 
 /// Expands inputs into items, in a deterministic order. A folder gives its scenarios (`*.toml`)
-/// when it has any (they name their own meshes), its meshes (`*.stl`) otherwise.
+/// when it has any (they name their own meshes), its meshes (`*.stl`, `*.obj`, `*.ply`) otherwise.
 ///
 /// # Errors
 /// [`ScenarioError::Io`] for an input that does not exist or is neither a folder, a `.toml` nor
-/// a `.stl` file.
+/// a mesh file.
 pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
     let mut items = Vec::new();
     for input in inputs {
@@ -63,7 +61,7 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
         } else if input.is_file() {
             items.push(classify(input.clone()).ok_or_else(|| ScenarioError::Io {
                 path: input.clone(),
-                message: "neither a scenario (.toml) nor a mesh (.stl)".to_string(),
+                message: "neither a scenario (.toml) nor a mesh (.stl, .obj, .ply)".to_string(),
             })?);
         } else {
             return Err(ScenarioError::Io {
@@ -78,7 +76,7 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
 fn classify(p: PathBuf) -> Option<Item> {
     match p.extension()?.to_str()?.to_ascii_lowercase().as_str() {
         "toml" => Some(Item::Scenario(p)),
-        "stl" => Some(Item::Mesh(p)),
+        "stl" | "obj" | "ply" => Some(Item::Mesh(p)),
         _ => None,
     }
 }
@@ -100,17 +98,8 @@ pub fn default_template() -> Scenario {
         hand_file: PathBuf::from("<built-in thesis hand>"),
         planner: PlannerParams::default(),
         sim: SimParams::default(),
-        expect: Expect {
-            outcome: Outcome::Hold,
-            approach_angle_deg: None,
-            palm_pitch_deg: None,
-            elevation_index: None,
-            theta_deg: None,
-            index_tolerance: 2,
-            pitch_tolerance_deg: 1.5,
-            theta_tolerance_deg: 3.0,
-            theta2_tolerance_deg: None,
-        },
+        // A bare mesh comes with no expectation: nothing to judge (issue 16, item 2).
+        expect: None,
     }
 }
 

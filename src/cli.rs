@@ -15,9 +15,15 @@ use std::path::PathBuf;
     subcommand_negates_reqs = true
 )]
 pub struct Cli {
-    /// Scenario files (TOML) to run, in order.
-    #[arg(required = true, value_name = "SCENARIO")]
+    /// Scenario files (TOML) or bare meshes (STL, OBJ, PLY) to run, in order. A bare mesh runs
+    /// with the bundled thesis hand and the defaults, and judges nothing.
+    #[arg(required = true, value_name = "SCENARIO | MESH")]
     pub scenarios: Vec<PathBuf>,
+
+    /// Length unit of bare meshes given on the command line (scenarios say theirs in
+    /// `[object] units`).
+    #[arg(long, value_name = "UNIT", default_value = "mm", value_parser = ["mm", "m", "inch"])]
+    pub units: String,
 
     /// Print one JSON object per scenario (JSON Lines) instead of the summary.
     #[arg(long)]
@@ -59,12 +65,15 @@ pub enum Command {
     /// Run many objects: every scenario and STL in the given folders, or the files given; one
     /// JSON line per object, in input order, and a summary on stderr.
     Batch {
-        /// Folders, scenario files (.toml) or meshes (.stl).
+        /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
         #[arg(required = true, value_name = "DIR | SCENARIO")]
         inputs: Vec<PathBuf>,
-        /// Scenario used for bare STL files (default: the thesis hand and defaults).
+        /// Scenario used for bare meshes (default: the thesis hand and defaults).
         #[arg(long, value_name = "SCENARIO")]
         template: Option<PathBuf>,
+        /// Length unit of bare meshes (overrides the template's).
+        #[arg(long, value_name = "UNIT", value_parser = ["mm", "m", "inch"])]
+        units: Option<String>,
         /// Write the JSON lines to this file instead of stdout (written whole, or not at all).
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
@@ -85,7 +94,7 @@ pub enum Command {
     /// rate, then mean payload margin, then mean translation); writes tune.csv, tune.json and
     /// score_<param>.svg into --out.
     Tune {
-        /// Folders, scenario files (.toml) or meshes (.stl).
+        /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
         #[arg(required = true, value_name = "DIR | SCENARIO")]
         inputs: Vec<PathBuf>,
         /// NAME=START:END:STEP, repeatable (sf_c, height_step_mm, angular_step_deg,
@@ -99,7 +108,7 @@ pub enum Command {
         /// Plan up to N grasps per object and keep the best by simulation.
         #[arg(long, value_name = "N", default_value_t = 1)]
         candidates: usize,
-        /// Scenario used for bare STL files (default: the thesis hand and defaults).
+        /// Scenario used for bare meshes (default: the thesis hand and defaults).
         #[arg(long, value_name = "SCENARIO")]
         template: Option<PathBuf>,
         /// Worker threads (default: all cores).

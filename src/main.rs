@@ -32,6 +32,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         Some(cli::Command::Batch {
             inputs,
             template,
+            units,
             out,
             jobs,
             shard,
@@ -46,6 +47,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
             return batch(
                 &inputs,
                 template.as_deref(),
+                units.as_deref(),
                 out.as_deref(),
                 jobs,
                 shard.as_deref(),
@@ -79,10 +81,17 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         export_urdf: cli.export_urdf,
         report: cli.report,
     };
+    let mut template = grasp_sim::batch::default_template();
+    template.object.units = parse_units(&cli.units);
     // Everything is run before anything is printed, so bad input anywhere leaves no partial output.
     let mut reports = Vec::new();
     for path in &cli.scenarios {
-        let scenario = Scenario::load(path)?;
+        let item = if grasp_sim::mesh::MeshFormat::from_path(path).is_some() {
+            grasp_sim::batch::Item::Mesh(path.clone())
+        } else {
+            grasp_sim::batch::Item::Scenario(path.clone())
+        };
+        let scenario = grasp_sim::batch::scenario_for(&item, &template)?;
         let report = run(&scenario, &options)?;
         reports.push((scenario, report));
     }
@@ -162,13 +171,24 @@ fn tune(
     Ok(0)
 }
 
+fn parse_units(s: &str) -> grasp_sim::mesh::LengthUnit {
+    use grasp_sim::mesh::LengthUnit;
+    match s {
+        "m" => LengthUnit::M,
+        "inch" => LengthUnit::Inch,
+        _ => LengthUnit::Mm,
+    }
+}
+
 fn default_jobs() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
+#[allow(clippy::too_many_arguments)]
 fn batch(
     inputs: &[std::path::PathBuf],
     template: Option<&std::path::Path>,
+    units: Option<&str>,
     out: Option<&std::path::Path>,
     jobs: Option<usize>,
     shard: Option<&str>,
@@ -176,10 +196,13 @@ fn batch(
 ) -> anyhow::Result<u8> {
     use grasp_sim::batch;
     use std::io::IsTerminal;
-    let template = match template {
+    let mut template = match template {
         Some(p) => Scenario::load(p)?,
         None => batch::default_template(),
     };
+    if let Some(u) = units {
+        template.object.units = parse_units(u);
+    }
     let mut items = batch::expand(inputs)?;
     if let Some(s) = shard {
         let (k, n) = batch::parse_shard(s).map_err(|m| anyhow::anyhow!("--shard: {m}"))?;
