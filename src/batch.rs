@@ -189,6 +189,7 @@ pub fn summary(results: &[ItemResult], seconds: f64, jobs: usize) -> String {
     let mut ungraspable = 0;
     let mut errors = 0;
     let (mut hold, mut slip, mut drop) = (0, 0, 0);
+    let (mut met, mut not_met, mut unjudged) = (0, 0, 0);
     for r in results {
         match r {
             Ok(rep) => {
@@ -203,17 +204,35 @@ pub fn summary(results: &[ItemResult], seconds: f64, jobs: usize) -> String {
                     "drop" => drop += 1,
                     _ => {}
                 }
+                match rep.expect.met {
+                    Some(true) => met += 1,
+                    Some(false) => not_met += 1,
+                    None => unjudged += 1,
+                }
             }
             Err(_) => errors += 1,
         }
     }
     let n = results.len().max(1);
+    // Threads beyond the number of objects sit idle: per-object time counts the busy ones.
+    let busy = jobs.clamp(1, n);
     format!(
-        "batch: {} objects in {:.2} s ({:.3} s per object, {} jobs): {feasible} planned, \
-         {ungraspable} ungraspable; physics: {hold} hold, {slip} slip, {drop} drop; {errors} errors",
-        results.len(),
+        "batch: {} in {:.2} s ({:.3} s per object, {}): {feasible} planned, {ungraspable} \
+         ungraspable; physics: {hold} hold, {slip} slip, {drop} drop; expectations: {met} met, \
+         {not_met} not met, {unjudged} not judged; {}",
+        plural(results.len(), "object"),
         seconds,
-        seconds * jobs.max(1) as f64 / n as f64,
-        jobs.max(1)
+        seconds * busy as f64 / n as f64,
+        plural(jobs.max(1), "job"),
+        plural(errors, "error")
     )
+}
+
+/// `n thing` or `n things`.
+pub fn plural(n: usize, thing: &str) -> String {
+    if n == 1 {
+        format!("1 {thing}")
+    } else {
+        format!("{n} {thing}s")
+    }
 }

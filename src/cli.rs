@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 /// Plan enveloping grasps for a three-fingered hand and check them in a physics scene.
 ///
-/// Exit status: 0 every expectation met (or none could be judged yet), 1 an expectation not met,
-/// 2 bad input.
+/// Exit status: 0 every expectation met (or none stated), 1 an expectation not met, 2 bad input
+/// (the other inputs still run and print; the worst status wins).
 #[derive(Debug, Parser)]
 #[command(
     name = "grasp-sim",
@@ -62,8 +62,11 @@ pub struct Cli {
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Run many objects: every scenario and STL in the given folders, or the files given; one
+    /// Run many objects: every scenario and mesh in the given folders, or the files given; one
     /// JSON line per object, in input order, and a summary on stderr.
+    ///
+    /// Exit status: 0 every stated expectation met (bare meshes state none), 1 an expectation not
+    /// met, 2 an input could not be run (its JSON line has an `error`; the others still run).
     Batch {
         /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
         #[arg(required = true, value_name = "DIR | SCENARIO")]

@@ -81,34 +81,81 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         export_urdf: cli.export_urdf,
         report: cli.report,
     };
+    // Output folders are checked before any work, so an unwritable one costs nothing.
+    for (flag, dir) in [
+        ("--report", &options.report),
+        ("--export-mjcf", &options.export_mjcf),
+        ("--export-urdf", &options.export_urdf),
+    ] {
+        if let Some(d) = dir {
+            check_writable_dir(d).context(flag)?;
+        }
+    }
     let mut template = grasp_sim::batch::default_template();
     template.object.units = parse_units(&cli.units);
-    // Everything is run before anything is printed, so bad input anywhere leaves no partial output.
-    let mut reports = Vec::new();
+    // Each input runs on its own: a bad one is reported on stderr and the others still run and
+    // print; the exit status is the worst (2 bad input, 1 an expectation not met, 0).
+    let mut status = 0u8;
+    let mut out = std::io::stdout().lock();
     for path in &cli.scenarios {
         let item = if grasp_sim::mesh::MeshFormat::from_path(path).is_some() {
             grasp_sim::batch::Item::Mesh(path.clone())
         } else {
             grasp_sim::batch::Item::Scenario(path.clone())
         };
-        let scenario = grasp_sim::batch::scenario_for(&item, &template)?;
-        let report = run(&scenario, &options)?;
-        reports.push((scenario, report));
-    }
-    let mut out = std::io::stdout().lock();
-    let mut all_met = true;
-    for (_, report) in &reports {
+        let report = match grasp_sim::batch::scenario_for(&item, &template)
+            .and_then(|s| run(&s, &options))
+        {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("grasp-sim: error: {}", format!("{e:#}").replace('\n', " "));
+                status = 2;
+                continue;
+            }
+        };
         for w in &report.warnings {
             eprintln!("grasp-sim: warning: {w}");
         }
         if cli.json {
-            writeln!(out, "{}", serde_json::to_string(report)?)?;
+            writeln!(out, "{}", serde_json::to_string(&report)?)?;
         } else {
             write!(out, "{}", report.summary())?;
         }
-        all_met &= report.expect.met != Some(false);
+        out.flush()?;
+        if report.expect.met == Some(false) {
+            status = status.max(1);
+        }
     }
-    Ok(if all_met { 0 } else { 1 })
+    Ok(status)
+}
+
+/// Creates `dir` if needed and checks a file can be written in it.
+fn check_writable_dir(dir: &std::path::Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create folder", dir.display()))?;
+    let probe = dir.join(".grasp-sim-write-test");
+    std::fs::write(&probe, b"")
+        .and_then(|()| std::fs::remove_file(&probe))
+        .with_context(|| format!("{}: cannot write in this folder", dir.display()))
+}
+
+/// Checks that `file` can be written later: its folder exists and takes a file.
+fn check_writable_file(file: &std::path::Path) -> anyhow::Result<()> {
+    let dir = file
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "{}: cannot write: no folder {}",
+            file.display(),
+            dir.display()
+        );
+    }
+    let probe = dir.join(".grasp-sim-write-test");
+    std::fs::write(&probe, b"")
+        .and_then(|()| std::fs::remove_file(&probe))
+        .with_context(|| format!("{}: cannot write in {}", file.display(), dir.display()))
 }
 
 fn tune(
@@ -129,6 +176,7 @@ fn tune(
         None => batch::default_template(),
     };
     let items = batch::expand(inputs)?;
+    check_writable_dir(out).context("--out")?;
     let jobs = jobs.unwrap_or_else(default_jobs).max(1);
     let t0 = std::time::Instant::now();
     let result = tune::tune(&items, &template, &sweeps, candidates.max(1), jobs)?;
@@ -203,6 +251,9 @@ fn batch(
     if let Some(u) = units {
         template.object.units = parse_units(u);
     }
+    if let Some(path) = out {
+        check_writable_file(path).context("--out")?;
+    }
     let mut items = batch::expand(inputs)?;
     if let Some(s) = shard {
         let (k, n) = batch::parse_shard(s).map_err(|m| anyhow::anyhow!("--shard: {m}"))?;
@@ -240,9 +291,13 @@ fn batch(
     }
     let mut text = String::new();
     let mut errors = 0;
+    let mut not_met = 0;
     for (item, r) in items.iter().zip(&results) {
         let line = match r {
-            Ok(rep) => serde_json::to_string(rep)?,
+            Ok(rep) => {
+                not_met += usize::from(rep.expect.met == Some(false));
+                serde_json::to_string(rep)?
+            }
             Err(e) => {
                 errors += 1;
                 eprintln!("grasp-sim: error: {e}");
@@ -261,7 +316,13 @@ fn batch(
         "{}",
         batch::summary(&results, t0.elapsed().as_secs_f64(), jobs)
     );
-    Ok(if errors > 0 { 2 } else { 0 })
+    Ok(if errors > 0 {
+        2
+    } else if not_met > 0 {
+        1
+    } else {
+        0
+    })
 }
 
 /// Writes `bytes` to `path` through a temporary file beside it, so a reader never sees half a

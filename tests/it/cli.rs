@@ -192,14 +192,46 @@ fn bad_scenarios_name_the_file_and_key() {
     }
 }
 
+/// Issue 16 item 3: one bad input does not sink the others; the worst status wins.
 #[test]
-fn a_bad_scenario_after_a_good_one_prints_nothing() {
+fn a_bad_input_among_good_ones_is_reported_and_the_rest_run() {
     let env = Env::new();
     env.write("m.stl", good_mesh());
     let good = env.basic_scenario("m.stl", "");
-    let bad = env.scenario("bad.toml", "[object]\nmesh = \"gone.stl\"\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"hold\"\n");
-    let out = env.run(&["--json", good.to_str().unwrap(), bad.to_str().unwrap()]);
-    assert_bad_input(&out, "gone.stl", "no such file");
+    let bad = env.scenario("bad.toml", "[object]\nmesh = \"gone.stl\"\n");
+    let out = env.run(&[
+        "--json",
+        "--no-sim",
+        good.to_str().unwrap(),
+        "missing.toml",
+        bad.to_str().unwrap(),
+        "m.stl",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let text = String::from_utf8(out.stdout).unwrap();
+    let names: Vec<String> = text
+        .lines()
+        .map(|l| serde_json::from_str::<serde_json::Value>(l).unwrap()["scenario"].to_string())
+        .collect();
+    assert_eq!(names, ["\"t\"", "\"m\""]);
+    let errors: Vec<&str> = err.lines().filter(|l| l.contains("error")).collect();
+    assert_eq!(errors.len(), 2, "{err}");
+    assert!(
+        errors[0].contains("missing.toml") && errors[1].contains("gone.stl"),
+        "{err}"
+    );
+}
+
+/// Issue 16 item 3: an output folder that cannot be written is refused before any work.
+#[test]
+fn an_unwritable_report_folder_fails_before_the_run() {
+    let env = Env::new();
+    env.write("m.stl", good_mesh());
+    env.write("afile", "x");
+    let s = env.basic_scenario("m.stl", "");
+    let out = env.run(&["--report", "afile/sub", s.to_str().unwrap()]);
+    assert_bad_input(&out, "afile/sub", "--report");
 }
 
 #[test]
