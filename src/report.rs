@@ -310,8 +310,8 @@ impl RunReport {
         };
         let _ = writeln!(
             s,
-            "  Plan        {plan_line}; {} candidates tried",
-            p.candidates_tried
+            "  Plan        {plan_line}; {} tried",
+            crate::batch::plural(p.candidates_tried, "candidate")
         );
         if let Some(g) = &p.grasp {
             let _ = writeln!(s, "  Grasp Parameter Set:");
@@ -328,8 +328,9 @@ impl RunReport {
             }
             let _ = writeln!(
                 s,
-                "    ApproachAngle = {:.0} deg  Palm_Pitch_Angle = {:.1} deg",
-                g.approach_angle_deg, g.palm_pitch_deg
+                "    ApproachAngle = {:.0} deg  Palm_Pitch_Angle = {} deg",
+                g.approach_angle_deg,
+                fmt_signed(g.palm_pitch_deg, 1)
             );
             let _ = writeln!(
                 s,
@@ -436,5 +437,19 @@ fn capitalise(name: &str) -> String {
     match c.next() {
         Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
         None => String::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt_signed;
+
+    #[test]
+    fn a_value_that_rounds_to_zero_has_no_sign() {
+        assert_eq!(fmt_signed(-0.0, 2), "0.00");
+        assert_eq!(fmt_signed(-0.004, 2), "0.00");
+        assert_eq!(fmt_signed(-0.006, 2), "-0.01");
+        assert_eq!(fmt_signed(7.25, 1), "7.2");
+        assert_eq!(fmt_signed(-6.2, 1), "-6.2");
     }
 }

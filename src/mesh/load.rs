@@ -59,7 +59,14 @@ pub struct LoadedMesh {
     pub is_binary: bool,
     /// The file's format.
     pub format: MeshFormat,
+    /// The unit the file was read in.
+    pub unit: LengthUnit,
 }
+
+/// Objects smaller than this along their largest extent are implausible for a hand `[mm]`.
+const PLAUSIBLE_MIN_MM: f64 = 5.0;
+/// Objects larger than this along their largest extent are implausible for a hand `[mm]`.
+const PLAUSIBLE_MAX_MM: f64 = 2000.0;
 
 /// A mesh file format grasp-sim reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -445,7 +452,55 @@ impl LoadedMesh {
         if self.was_inverted {
             w.push("triangles were wound inside-out (negative volume); flipped".to_string());
         }
+        if let Some(u) = self.units_warning() {
+            w.push(u);
+        }
         w
+    }
+
+    /// A warning when the object's size is implausible for a hand (under 5 mm or over 2 m along
+    /// its largest extent), naming the unit it was read in and the likely one.
+    pub fn units_warning(&self) -> Option<String> {
+        let (lo, hi) = self.mesh.bounds();
+        let size = (hi - lo).max();
+        let read = match self.unit {
+            LengthUnit::Mm => "mm",
+            LengthUnit::M => "m",
+            LengthUnit::Inch => "inch",
+        };
+        let in_unit = size / self.unit.to_mm();
+        let likely = |unit: &str, factor: f64| {
+            format!(
+                "the object is {} {read} across as read (units = \"{read}\"): implausible for a \
+                 hand; if the file is in {unit} (the object then {} mm across), set units = \
+                 \"{unit}\" in [object], or --units {unit} for a bare mesh",
+                fmt_size(in_unit),
+                fmt_size(size * factor)
+            )
+        };
+        if size < PLAUSIBLE_MIN_MM {
+            // Too small: the file is probably in metres.
+            match self.unit {
+                LengthUnit::Mm => Some(likely("m", 1000.0)),
+                LengthUnit::Inch => Some(likely("m", 1000.0 / 25.4)),
+                LengthUnit::M => Some(format!(
+                    "the object is {} across: implausibly small for a hand",
+                    fmt_mm(size)
+                )),
+            }
+        } else if size > PLAUSIBLE_MAX_MM {
+            // Too large: the file is probably in millimetres.
+            match self.unit {
+                LengthUnit::M => Some(likely("mm", 1.0 / 1000.0)),
+                LengthUnit::Inch => Some(likely("mm", 1.0 / 25.4)),
+                LengthUnit::Mm => Some(format!(
+                    "the object is {} across: implausibly large for a hand",
+                    fmt_mm(size)
+                )),
+            }
+        } else {
+            None
+        }
     }
 }
 
@@ -655,5 +710,24 @@ fn build(
         was_inverted,
         is_binary,
         format,
+        unit,
     })
+}
+
+/// A length with three significant figures.
+fn fmt_size(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
+}
+
+/// A length in millimetres, or metres when over 10 m.
+fn fmt_mm(mm: f64) -> String {
+    if mm >= 10_000.0 {
+        format!("{} m", fmt_size(mm / 1000.0))
+    } else {
+        format!("{} mm", fmt_size(mm))
+    }
 }

@@ -397,6 +397,9 @@ fn a_minimal_scenario_needs_no_expect_and_no_hand() {
         "{text}"
     );
     assert!(text.contains("Expect      none given"), "{text}");
+    // Issue 16 item 10: "1 candidate", and no "-0.0" for a pitch that rounds to zero.
+    assert!(text.contains("; 1 candidate tried"), "{text}");
+    assert!(text.contains("Palm_Pitch_Angle = 0.0 deg"), "{text}");
 }
 
 /// Bare meshes on the command line (and mixed with scenarios) run with the bundled hand and the
@@ -468,4 +471,45 @@ fn the_summary_says_whether_the_grasp_held_and_why_not() {
         text.contains("Result      no grasp found: too thin"),
         "{text}"
     );
+}
+
+/// Issue 16 item 4: a size implausible for a hand is said, with the likely unit.
+#[test]
+fn implausible_sizes_warn_with_the_likely_unit() {
+    let env = Env::new();
+    let mut m = grasp_sim::objects::cylinder(40.0, 124.0);
+    m.map_vertices(|p| p / 1000.0);
+    env.write("in_m.stl", m.to_binary_stl());
+    let out = env.run(&["--no-sim", "in_m.stl"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("in_m.stl") && err.contains("0.124 mm across") && err.contains("--units m"),
+        "{err}"
+    );
+    env.write("cyl.stl", good_mesh());
+    let s = env.basic_scenario("cyl.stl", "");
+    let text = std::fs::read_to_string(&s)
+        .unwrap()
+        .replace("[object]\n", "[object]\nunits = \"m\"\n");
+    std::fs::write(&s, text).unwrap();
+    let out = env.run(&["--no-sim", s.to_str().unwrap()]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("124 m across as read") && err.contains("units = \"mm\""),
+        "{err}"
+    );
+    // A plausible object says nothing of units.
+    let out = env.run(&["--no-sim", "cyl.stl"]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("implausible"));
+}
+
+/// Issue 16 item 10: `gen-assets` outside the repository writes scenarios that run there (they
+/// name the bundled hand, not a path into the repository).
+#[test]
+fn gen_assets_elsewhere_gives_runnable_scenarios() {
+    let env = Env::new();
+    let out = env.run(&["gen-assets", "--out", "objs"]);
+    crate::assert_success(&out);
+    let s = env.path("objs/train/thin_rod.toml");
+    crate::assert_success(&env.run(&["--no-sim", s.to_str().unwrap()]));
 }
