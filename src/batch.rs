@@ -52,6 +52,7 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| p.is_file())
                 .filter_map(classify)
+                .filter(|i| !is_hand_file(i.path()))
                 .collect();
             if found.iter().any(|i| matches!(i, Item::Scenario(_))) {
                 found.retain(|i| matches!(i, Item::Scenario(_)));
@@ -71,6 +72,17 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
         }
     }
     Ok(items)
+}
+
+/// Returns true if and only if `path` is a TOML file that reads as a hand file (it has a
+/// `[palm]` table and `[[finger]]` entries): a folder holding its hand beside its scenarios is
+/// not a folder of one more scenario.
+fn is_hand_file(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "toml")
+        && std::fs::read_to_string(path)
+            .ok()
+            .and_then(|t| t.parse::<toml::Table>().ok())
+            .is_some_and(|t| t.contains_key("palm") && t.contains_key("finger"))
 }
 
 fn classify(p: PathBuf) -> Option<Item> {

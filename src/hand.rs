@@ -188,9 +188,16 @@ impl Hand {
                 problem,
             })?;
         }
-        let hand: Hand = toml::Value::Table(doc)
-            .try_into()
-            .map_err(|e: toml::de::Error| parse_err(e.message().replace('\n', " ")))?;
+        // Without overrides, parse the text itself so an error carries its line; with them, the
+        // edited table (the line is then that of the hand file as written, if any).
+        let hand: Hand = if overrides.is_empty() {
+            toml::from_str(text)
+                .map_err(|e: toml::de::Error| parse_err(crate::scenario::toml_message(&e, text)))?
+        } else {
+            toml::Value::Table(doc)
+                .try_into()
+                .map_err(|e: toml::de::Error| parse_err(e.message().replace('\n', " ")))?
+        };
         hand.validate(path)?;
         Ok(hand)
     }

@@ -152,3 +152,28 @@ fn batch_checks_its_output_file_first() {
         "{err}"
     );
 }
+
+/// Issue 16 item 7: a hand file lying in a folder of scenarios is not run as a scenario.
+#[test]
+fn batch_skips_hand_files_in_a_folder() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::copy(
+        crate::root().join("assets/objects/cylinder_d40.stl"),
+        dir.path().join("d40.stl"),
+    )
+    .unwrap();
+    std::fs::copy(
+        crate::root().join("assets/hands/thesis.toml"),
+        dir.path().join("hand.toml"),
+    )
+    .unwrap();
+    std::fs::write(
+        dir.path().join("s.toml"),
+        "[object]\nmesh = \"d40.stl\"\n[hand]\nfile = \"hand.toml\"\n",
+    )
+    .unwrap();
+    let (code, stdout, err) = batch(&["--no-sim", dir.path().to_str().unwrap()]);
+    assert_eq!(code, Some(0), "{err}");
+    assert_eq!(stdout.lines().count(), 1, "{stdout}");
+    assert!(err.contains("0 errors"), "{err}");
+}

@@ -513,3 +513,17 @@ fn gen_assets_elsewhere_gives_runnable_scenarios() {
     let s = env.path("objs/train/thin_rod.toml");
     crate::assert_success(&env.run(&["--no-sim", s.to_str().unwrap()]));
 }
+
+/// Issue 16 item 7: a hand-file error names its line.
+#[test]
+fn hand_file_errors_name_the_line() {
+    let env = Env::new();
+    env.write("m.stl", good_mesh());
+    let hand = std::fs::read_to_string(env.path("hand.toml")).unwrap();
+    env.write("hand.toml", hand.replace("gap_mm = 25.0", "gap_mn = 25.0"));
+    let s = env.basic_scenario("m.stl", "");
+    let out = env.run(&[s.to_str().unwrap()]);
+    assert_bad_input(&out, "hand.toml", "gap_mn");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("line ") && err.contains("gap_mm"), "{err}");
+}
