@@ -1,22 +1,20 @@
 //! Running many objects: input expansion, templates, sharding, parallel runs in a stable order.
 //!
-//! An input is a scenario file, an STL file, or a folder (its `*.toml` scenarios and `*.stl`
-//! meshes, not recursing, sorted by path). An STL is run with a template scenario: by default the
+//! An input is a scenario file, a mesh file (STL, OBJ or PLY), or a folder (its `*.toml`
+//! scenarios and meshes, not recursing, sorted by path). A mesh is run with a template scenario: by default the
 //! thesis hand (built into the binary), millimetres, 500 kg/m³, μ = 0.3, the thesis's planner and
 //! physics defaults. Results come back in input order whatever the number of threads; a shard
 //! `K/N` is the K-th of N contiguous blocks, so the shards' outputs concatenate to the whole.
 
 use crate::hand::Hand;
 use crate::report::RunReport;
-use crate::scenario::{
-    Expect, MassSpec, ObjectSpec, Outcome, PlannerParams, Scenario, ScenarioError, SimParams,
-};
+use crate::scenario::{MassSpec, ObjectSpec, PlannerParams, Scenario, ScenarioError, SimParams};
 use crate::{run, Error, RunOptions};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// The thesis hand file, built in for templates.
-pub const THESIS_HAND_TOML: &str = include_str!("../assets/hands/thesis.toml");
+pub const THESIS_HAND_TOML: &str = crate::hand::BUNDLED[0].1;
 
 /// One thing to run.
 #[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
@@ -37,11 +35,11 @@ impl Item {
 }
 
 /// Expands inputs into items, in a deterministic order. A folder gives its scenarios (`*.toml`)
-/// when it has any (they name their own meshes), its meshes (`*.stl`) otherwise.
+/// when it has any (they name their own meshes), its meshes (`*.stl`, `*.obj`, `*.ply`) otherwise.
 ///
 /// # Errors
 /// [`ScenarioError::Io`] for an input that does not exist or is neither a folder, a `.toml` nor
-/// a `.stl` file.
+/// a mesh file.
 pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
     let mut items = Vec::new();
     for input in inputs {
@@ -54,6 +52,7 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| p.is_file())
                 .filter_map(classify)
+                .filter(|i| !is_hand_file(i.path()))
                 .collect();
             if found.iter().any(|i| matches!(i, Item::Scenario(_))) {
                 found.retain(|i| matches!(i, Item::Scenario(_)));
@@ -63,7 +62,7 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
         } else if input.is_file() {
             items.push(classify(input.clone()).ok_or_else(|| ScenarioError::Io {
                 path: input.clone(),
-                message: "neither a scenario (.toml) nor a mesh (.stl)".to_string(),
+                message: "neither a scenario (.toml) nor a mesh (.stl, .obj, .ply)".to_string(),
             })?);
         } else {
             return Err(ScenarioError::Io {
@@ -75,10 +74,21 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
     Ok(items)
 }
 
+/// Returns true if and only if `path` is a TOML file that reads as a hand file (it has a
+/// `[palm]` table and `[[finger]]` entries): a folder holding its hand beside its scenarios is
+/// not a folder of one more scenario.
+fn is_hand_file(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "toml")
+        && std::fs::read_to_string(path)
+            .ok()
+            .and_then(|t| t.parse::<toml::Table>().ok())
+            .is_some_and(|t| t.contains_key("palm") && t.contains_key("finger"))
+}
+
 fn classify(p: PathBuf) -> Option<Item> {
     match p.extension()?.to_str()?.to_ascii_lowercase().as_str() {
         "toml" => Some(Item::Scenario(p)),
-        "stl" => Some(Item::Mesh(p)),
+        "stl" | "obj" | "ply" => Some(Item::Mesh(p)),
         _ => None,
     }
 }
@@ -100,17 +110,8 @@ pub fn default_template() -> Scenario {
         hand_file: PathBuf::from("<built-in thesis hand>"),
         planner: PlannerParams::default(),
         sim: SimParams::default(),
-        expect: Expect {
-            outcome: Outcome::Hold,
-            approach_angle_deg: None,
-            palm_pitch_deg: None,
-            elevation_index: None,
-            theta_deg: None,
-            index_tolerance: 2,
-            pitch_tolerance_deg: 1.5,
-            theta_tolerance_deg: 3.0,
-            theta2_tolerance_deg: None,
-        },
+        // A bare mesh comes with no expectation: nothing to judge (issue 16, item 2).
+        expect: None,
     }
 }
 
@@ -200,6 +201,7 @@ pub fn summary(results: &[ItemResult], seconds: f64, jobs: usize) -> String {
     let mut ungraspable = 0;
     let mut errors = 0;
     let (mut hold, mut slip, mut drop) = (0, 0, 0);
+    let (mut met, mut not_met, mut unjudged) = (0, 0, 0);
     for r in results {
         match r {
             Ok(rep) => {
@@ -214,17 +216,35 @@ pub fn summary(results: &[ItemResult], seconds: f64, jobs: usize) -> String {
                     "drop" => drop += 1,
                     _ => {}
                 }
+                match rep.expect.met {
+                    Some(true) => met += 1,
+                    Some(false) => not_met += 1,
+                    None => unjudged += 1,
+                }
             }
             Err(_) => errors += 1,
         }
     }
     let n = results.len().max(1);
+    // Threads beyond the number of objects sit idle: per-object time counts the busy ones.
+    let busy = jobs.clamp(1, n);
     format!(
-        "batch: {} objects in {:.2} s ({:.3} s per object, {} jobs): {feasible} planned, \
-         {ungraspable} ungraspable; physics: {hold} hold, {slip} slip, {drop} drop; {errors} errors",
-        results.len(),
+        "batch: {} in {:.2} s ({:.3} s per object, {}): {feasible} planned, {ungraspable} \
+         ungraspable; physics: {hold} hold, {slip} slip, {drop} drop; expectations: {met} met, \
+         {not_met} not met, {unjudged} not judged; {}",
+        plural(results.len(), "object"),
         seconds,
-        seconds * jobs.max(1) as f64 / n as f64,
-        jobs.max(1)
+        seconds * busy as f64 / n as f64,
+        plural(jobs.max(1), "job"),
+        plural(errors, "error")
     )
+}
+
+/// `n thing` or `n things`.
+pub fn plural(n: usize, thing: &str) -> String {
+    if n == 1 {
+        format!("1 {thing}")
+    } else {
+        format!("{n} {thing}s")
+    }
 }

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 
 /// Plan enveloping grasps for a three-fingered hand and check them in a physics scene.
 ///
-/// Exit status: 0 every expectation met (or none could be judged yet), 1 an expectation not met,
-/// 2 bad input.
+/// Exit status: 0 every expectation met (or none stated), 1 an expectation not met, 2 bad input
+/// (the other inputs still run and print; the worst status wins).
 #[derive(Debug, Parser)]
 #[command(
     name = "grasp-sim",
@@ -15,9 +15,15 @@ use std::path::PathBuf;
     subcommand_negates_reqs = true
 )]
 pub struct Cli {
-    /// Scenario files (TOML) to run, in order.
-    #[arg(required = true, value_name = "SCENARIO")]
+    /// Scenario files (TOML) or bare meshes (STL, OBJ, PLY) to run, in order. A bare mesh runs
+    /// with the bundled thesis hand and the defaults, and judges nothing.
+    #[arg(required = true, value_name = "SCENARIO | MESH")]
     pub scenarios: Vec<PathBuf>,
+
+    /// Length unit of bare meshes given on the command line (scenarios say theirs in
+    /// `[object] units`).
+    #[arg(long, value_name = "UNIT", default_value = "mm", value_parser = ["mm", "m", "inch"])]
+    pub units: String,
 
     /// Print one JSON object per scenario (JSON Lines) instead of the summary.
     #[arg(long)]
@@ -61,15 +67,21 @@ pub struct Cli {
 /// Subcommands.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Run many objects: every scenario and STL in the given folders, or the files given; one
+    /// Run many objects: every scenario and mesh in the given folders, or the files given; one
     /// JSON line per object, in input order, and a summary on stderr.
+    ///
+    /// Exit status: 0 every stated expectation met (bare meshes state none), 1 an expectation not
+    /// met, 2 an input could not be run (its JSON line has an `error`; the others still run).
     Batch {
-        /// Folders, scenario files (.toml) or meshes (.stl).
+        /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
         #[arg(required = true, value_name = "DIR | SCENARIO")]
         inputs: Vec<PathBuf>,
-        /// Scenario used for bare STL files (default: the thesis hand and defaults).
+        /// Scenario used for bare meshes (default: the thesis hand and defaults).
         #[arg(long, value_name = "SCENARIO")]
         template: Option<PathBuf>,
+        /// Length unit of bare meshes (overrides the template's).
+        #[arg(long, value_name = "UNIT", value_parser = ["mm", "m", "inch"])]
+        units: Option<String>,
         /// Write the JSON lines to this file instead of stdout (written whole, or not at all).
         #[arg(long, value_name = "FILE")]
         out: Option<PathBuf>,
@@ -90,7 +102,7 @@ pub enum Command {
     /// rate, then mean payload margin, then mean translation); writes tune.csv, tune.json and
     /// score_<param>.svg into --out.
     Tune {
-        /// Folders, scenario files (.toml) or meshes (.stl).
+        /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
         #[arg(required = true, value_name = "DIR | SCENARIO")]
         inputs: Vec<PathBuf>,
         /// NAME=START:END:STEP, repeatable (sf_c, height_step_mm, angular_step_deg,
@@ -104,7 +116,7 @@ pub enum Command {
         /// Plan up to N grasps per object and keep the best by simulation.
         #[arg(long, value_name = "N", default_value_t = 1)]
         candidates: usize,
-        /// Scenario used for bare STL files (default: the thesis hand and defaults).
+        /// Scenario used for bare meshes (default: the thesis hand and defaults).
         #[arg(long, value_name = "SCENARIO")]
         template: Option<PathBuf>,
         /// Worker threads (default: all cores).

@@ -11,6 +11,17 @@
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
+/// The hands built into the binary, by name: found wherever grasp-sim runs, without a path.
+pub const BUNDLED: [(&str, &str); 2] = [
+    ("thesis", include_str!("../assets/hands/thesis.toml")),
+    ("bh8", include_str!("../assets/hands/bh8.toml")),
+];
+
+/// The bundled hand called `name` (e.g. `thesis`), as `(name, TOML)`.
+pub fn bundled(name: &str) -> Option<(&'static str, &'static str)> {
+    BUNDLED.iter().copied().find(|(n, _)| *n == name)
+}
+
 /// Problems with a hand file.
 #[derive(Debug, thiserror::Error)]
 pub enum HandError {
@@ -183,9 +194,16 @@ impl Hand {
                 problem,
             })?;
         }
-        let hand: Hand = toml::Value::Table(doc)
-            .try_into()
-            .map_err(|e: toml::de::Error| parse_err(e.message().replace('\n', " ")))?;
+        // Without overrides, parse the text itself so an error carries its line; with them, the
+        // edited table (the line is then that of the hand file as written, if any).
+        let hand: Hand = if overrides.is_empty() {
+            toml::from_str(text)
+                .map_err(|e: toml::de::Error| parse_err(crate::scenario::toml_message(&e, text)))?
+        } else {
+            toml::Value::Table(doc)
+                .try_into()
+                .map_err(|e: toml::de::Error| parse_err(e.message().replace('\n', " ")))?
+        };
         hand.validate(path)?;
         Ok(hand)
     }
@@ -274,6 +292,31 @@ impl Hand {
             if !f.height_mm.is_finite() {
                 return bad("finger.height_mm", format!("must be finite for {}", f.name));
             }
+        }
+        // The planner's graspable diameter range must exist: a finger whose phalanx 2 cannot
+        // reach back to any object resting on the palm wraps nothing (issue 16, item 1).
+        let range = crate::plan::kinematics::graspable_range(self);
+        if range.max_kinematic_mm.partial_cmp(&range.min_mm) != Some(std::cmp::Ordering::Greater) {
+            let what = if range.max_kinematic_mm == 0.0 {
+                "no object resting on the palm (up to 2 m across) is touched by both phalanges \
+                 within the joint ranges, so the hand can wrap nothing"
+                    .to_string()
+            } else {
+                format!(
+                    "the largest object both phalanges wrap ({:.1} mm) is not larger than the \
+                     smallest graspable diameter ({:.1} mm, thesis eq. 3.2), so the hand can wrap \
+                     nothing",
+                    range.max_kinematic_mm, range.min_mm
+                )
+            };
+            return bad(
+                "phalanx_1.length_mm",
+                format!(
+                    "{} mm with phalanx_2.length_mm {} mm and these joint ranges: {what}; shorten \
+                     phalanx 1, lengthen phalanx 2 or widen the joint ranges",
+                    self.phalanx_1.length_mm, self.phalanx_2.length_mm
+                ),
+            );
         }
         Ok(())
     }

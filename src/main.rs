@@ -32,6 +32,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         Some(cli::Command::Batch {
             inputs,
             template,
+            units,
             out,
             jobs,
             shard,
@@ -46,6 +47,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
             return batch(
                 &inputs,
                 template.as_deref(),
+                units.as_deref(),
                 out.as_deref(),
                 jobs,
                 shard.as_deref(),
@@ -80,27 +82,81 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         export_urdf: cli.export_urdf,
         report: cli.report,
     };
-    // Everything is run before anything is printed, so bad input anywhere leaves no partial output.
-    let mut reports = Vec::new();
-    for path in &cli.scenarios {
-        let scenario = Scenario::load(path)?;
-        let report = run(&scenario, &options)?;
-        reports.push((scenario, report));
+    // Output folders are checked before any work, so an unwritable one costs nothing.
+    for (flag, dir) in [
+        ("--report", &options.report),
+        ("--export-mjcf", &options.export_mjcf),
+        ("--export-urdf", &options.export_urdf),
+    ] {
+        if let Some(d) = dir {
+            check_writable_dir(d).context(flag)?;
+        }
     }
+    let mut template = grasp_sim::batch::default_template();
+    template.object.units = parse_units(&cli.units);
+    // Each input runs on its own: a bad one is reported on stderr and the others still run and
+    // print; the exit status is the worst (2 bad input, 1 an expectation not met, 0).
+    let mut status = 0u8;
     let mut out = std::io::stdout().lock();
-    let mut all_met = true;
-    for (_, report) in &reports {
+    for path in &cli.scenarios {
+        let item = if grasp_sim::mesh::MeshFormat::from_path(path).is_some() {
+            grasp_sim::batch::Item::Mesh(path.clone())
+        } else {
+            grasp_sim::batch::Item::Scenario(path.clone())
+        };
+        let report = match grasp_sim::batch::scenario_for(&item, &template)
+            .and_then(|s| run(&s, &options))
+        {
+            Ok(r) => r,
+            Err(e) => {
+                eprintln!("grasp-sim: error: {}", format!("{e:#}").replace('\n', " "));
+                status = 2;
+                continue;
+            }
+        };
         for w in &report.warnings {
             eprintln!("grasp-sim: warning: {w}");
         }
         if cli.json {
-            writeln!(out, "{}", serde_json::to_string(report)?)?;
+            writeln!(out, "{}", serde_json::to_string(&report)?)?;
         } else {
             write!(out, "{}", report.summary())?;
         }
-        all_met &= report.expect.met != Some(false);
+        out.flush()?;
+        if report.expect.met == Some(false) {
+            status = status.max(1);
+        }
     }
-    Ok(if all_met { 0 } else { 1 })
+    Ok(status)
+}
+
+/// Creates `dir` if needed and checks a file can be written in it.
+fn check_writable_dir(dir: &std::path::Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create folder", dir.display()))?;
+    let probe = dir.join(".grasp-sim-write-test");
+    std::fs::write(&probe, b"")
+        .and_then(|()| std::fs::remove_file(&probe))
+        .with_context(|| format!("{}: cannot write in this folder", dir.display()))
+}
+
+/// Checks that `file` can be written later: its folder exists and takes a file.
+fn check_writable_file(file: &std::path::Path) -> anyhow::Result<()> {
+    let dir = file
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "{}: cannot write: no folder {}",
+            file.display(),
+            dir.display()
+        );
+    }
+    let probe = dir.join(".grasp-sim-write-test");
+    std::fs::write(&probe, b"")
+        .and_then(|()| std::fs::remove_file(&probe))
+        .with_context(|| format!("{}: cannot write in {}", file.display(), dir.display()))
 }
 
 fn tune(
@@ -121,6 +177,7 @@ fn tune(
         None => batch::default_template(),
     };
     let items = batch::expand(inputs)?;
+    check_writable_dir(out).context("--out")?;
     let jobs = jobs.unwrap_or_else(default_jobs).max(1);
     let t0 = std::time::Instant::now();
     let result = tune::tune(&items, &template, &sweeps, candidates.max(1), jobs)?;
@@ -163,13 +220,24 @@ fn tune(
     Ok(0)
 }
 
+fn parse_units(s: &str) -> grasp_sim::mesh::LengthUnit {
+    use grasp_sim::mesh::LengthUnit;
+    match s {
+        "m" => LengthUnit::M,
+        "inch" => LengthUnit::Inch,
+        _ => LengthUnit::Mm,
+    }
+}
+
 fn default_jobs() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
+#[allow(clippy::too_many_arguments)]
 fn batch(
     inputs: &[std::path::PathBuf],
     template: Option<&std::path::Path>,
+    units: Option<&str>,
     out: Option<&std::path::Path>,
     jobs: Option<usize>,
     shard: Option<&str>,
@@ -177,10 +245,16 @@ fn batch(
 ) -> anyhow::Result<u8> {
     use grasp_sim::batch;
     use std::io::IsTerminal;
-    let template = match template {
+    let mut template = match template {
         Some(p) => Scenario::load(p)?,
         None => batch::default_template(),
     };
+    if let Some(u) = units {
+        template.object.units = parse_units(u);
+    }
+    if let Some(path) = out {
+        check_writable_file(path).context("--out")?;
+    }
     let mut items = batch::expand(inputs)?;
     if let Some(s) = shard {
         let (k, n) = batch::parse_shard(s).map_err(|m| anyhow::anyhow!("--shard: {m}"))?;
@@ -218,9 +292,13 @@ fn batch(
     }
     let mut text = String::new();
     let mut errors = 0;
+    let mut not_met = 0;
     for (item, r) in items.iter().zip(&results) {
         let line = match r {
-            Ok(rep) => serde_json::to_string(rep)?,
+            Ok(rep) => {
+                not_met += usize::from(rep.expect.met == Some(false));
+                serde_json::to_string(rep)?
+            }
             Err(e) => {
                 errors += 1;
                 eprintln!("grasp-sim: error: {e}");
@@ -239,7 +317,13 @@ fn batch(
         "{}",
         batch::summary(&results, t0.elapsed().as_secs_f64(), jobs)
     );
-    Ok(if errors > 0 { 2 } else { 0 })
+    Ok(if errors > 0 {
+        2
+    } else if not_met > 0 {
+        1
+    } else {
+        0
+    })
 }
 
 /// Writes `bytes` to `path` through a temporary file beside it, so a reader never sees half a
@@ -278,7 +362,7 @@ fn gen_assets(out: &std::path::Path) -> anyhow::Result<()> {
         let path = train.join(format!("{name}.stl"));
         write_atomically(&path, &mesh.to_binary_stl())?;
         let scenario = format!(
-            "# Tuning set (issue 6), generated by `grasp-sim gen-assets`. The expected outcome is the desired\n# one: `grasp-sim tune` ranks planner settings by how many of these objects end up held.\nname = \"train_{name}\"\n\n[object]\nmesh = \"{name}.stl\"\ndensity_kg_m3 = 500.0\nfriction = 0.3\n\n[hand]\nfile = \"../../hands/thesis.toml\"\n\n[expect]\noutcome = \"hold\"\n"
+            "# Tuning set (issue 6), generated by `grasp-sim gen-assets`. The expected outcome is the desired\n# one: `grasp-sim tune` ranks planner settings by how many of these objects end up held.\nname = \"train_{name}\"\n\n[object]\nmesh = \"{name}.stl\"\ndensity_kg_m3 = 500.0\nfriction = 0.3\n\n[hand]\nfile = \"thesis\"\n\n[expect]\noutcome = \"hold\"\n"
         );
         write_atomically(&train.join(format!("{name}.toml")), scenario.as_bytes())?;
         println!("{}: {} triangles", path.display(), mesh.triangles.len());

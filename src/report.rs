@@ -265,14 +265,34 @@ pub struct SimReport {
 }
 
 /// The `expect` part of the report.
+///
+/// A scenario without `[expect]` (and a bare mesh) keeps the same shape, so scripts reading
+/// `expect.met` need no change: `outcome` is `"none"`, `met` is `null`, and `details` says that
+/// no expectation was given.
 #[derive(Debug, Clone, Serialize)]
 pub struct ExpectReport {
-    /// The expected outcome.
+    /// The expected outcome, or `none` when the scenario states none.
     pub outcome: String,
-    /// True when every judged expectation held; `null` when nothing could be judged yet.
+    /// True when every judged expectation held; `null` when nothing was judged.
     pub met: Option<bool>,
     /// What was compared, or why nothing was.
     pub details: String,
+}
+
+impl ExpectReport {
+    /// The report when there is no expectation: nothing judged.
+    pub fn none() -> ExpectReport {
+        ExpectReport {
+            outcome: "none".to_string(),
+            met: None,
+            details: "no expectation given ([expect] absent): nothing judged".to_string(),
+        }
+    }
+
+    /// Returns true if and only if there was an expectation to judge.
+    pub fn is_given(&self) -> bool {
+        self.outcome != "none"
+    }
 }
 
 impl RunReport {
@@ -342,8 +362,8 @@ impl RunReport {
         };
         let _ = writeln!(
             s,
-            "  Plan        {plan_line}; {} candidates tried",
-            p.candidates_tried
+            "  Plan        {plan_line}; {} tried",
+            crate::batch::plural(p.candidates_tried, "candidate")
         );
         if let Some(g) = &p.grasp {
             let _ = writeln!(s, "  Grasp Parameter Set:");
@@ -360,8 +380,9 @@ impl RunReport {
             }
             let _ = writeln!(
                 s,
-                "    ApproachAngle = {:.0} deg  Palm_Pitch_Angle = {:.1} deg",
-                g.approach_angle_deg, g.palm_pitch_deg
+                "    ApproachAngle = {:.0} deg  Palm_Pitch_Angle = {} deg",
+                g.approach_angle_deg,
+                fmt_signed(g.palm_pitch_deg, 1)
             );
             let _ = writeln!(
                 s,
@@ -393,16 +414,72 @@ impl RunReport {
             (None, None) => self.sim.verdict.clone(),
         };
         let _ = writeln!(s, "  Sim         {sim_line}");
-        let met = match self.expect.met {
-            Some(true) => "met",
-            Some(false) => "NOT MET",
-            None => "not judged",
+        let _ = writeln!(s, "  Result      {}", self.result_sentence());
+        if self.expect.is_given() {
+            let met = match self.expect.met {
+                Some(true) => "met",
+                Some(false) => "NOT MET",
+                None => "not judged",
+            };
+            let _ = writeln!(
+                s,
+                "  Expect      {}: {met} ({})",
+                self.expect.outcome, self.expect.details
+            );
+        } else {
+            let _ = writeln!(s, "  Expect      none given: nothing judged");
+        }
+        s
+    }
+
+    /// One plain sentence: which grasp, whether it held, and why not when it did not.
+    pub fn result_sentence(&self) -> String {
+        let p = &self.plan;
+        let Some(g) = &p.grasp else {
+            return format!(
+                "no grasp found: {}",
+                p.reason
+                    .as_deref()
+                    .unwrap_or("the planner found no feasible grasp")
+            );
         };
-        let _ = writeln!(
-            s,
-            "  Expect      {}: {met} ({})",
-            self.expect.outcome, self.expect.details
+        let grasp = format!(
+            "grasp at approach {:.0} deg, Finger_1 index {} (Z {:.1} mm), palm pitch {} deg",
+            g.approach_angle_deg,
+            g.elevation_index,
+            g.elevation_mm,
+            fmt_signed(g.palm_pitch_deg, 1)
         );
+        let sim = &self.sim;
+        let moved = format!(
+            "{:.2} mm and {:.2} deg relative to the palm",
+            sim.translation_mm.unwrap_or(0.0),
+            sim.rotation_deg.unwrap_or(0.0)
+        );
+        match sim.verdict.as_str() {
+            "hold" => format!("{grasp}: HELD under gravity (moved {moved})"),
+            "slip" => format!(
+                "{grasp}: NOT held: the object slipped {moved}, beyond the hold limits, but stayed \
+                 in the hand"
+            ),
+            "drop" => format!("{grasp}: NOT held: the object fell out of the hand (moved {moved})"),
+            _ => format!(
+                "{grasp}; not checked in physics ({})",
+                sim.reason.as_deref().unwrap_or("not run")
+            ),
+        }
+    }
+}
+
+/// `v` with `digits` decimals, without the sign of a value that rounds to zero ("-0.0").
+pub fn fmt_signed(v: f64, digits: usize) -> String {
+    let s = format!("{v:.digits$}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        s.trim_start_matches('-').to_string()
+    } else {
         s
     }
 }
@@ -412,5 +489,19 @@ fn capitalise(name: &str) -> String {
     match c.next() {
         Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
         None => String::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt_signed;
+
+    #[test]
+    fn a_value_that_rounds_to_zero_has_no_sign() {
+        assert_eq!(fmt_signed(-0.0, 2), "0.00");
+        assert_eq!(fmt_signed(-0.004, 2), "0.00");
+        assert_eq!(fmt_signed(-0.006, 2), "-0.01");
+        assert_eq!(fmt_signed(7.25, 1), "7.2");
+        assert_eq!(fmt_signed(-6.2, 1), "-6.2");
     }
 }

@@ -1,8 +1,10 @@
 //! Scenario files (TOML): what to grasp, with which hand, planner and physics settings, and what
 //! outcome to expect (DESIGN.md section 6).
 //!
-//! Paths in a scenario are relative to the scenario file. Every section but `[object]` and
-//! `[hand]` is optional and defaults to the thesis's values. Unknown keys and wrong types are
+//! Paths in a scenario are relative to the scenario file. Every section but `[object]` is
+//! optional: `[hand]` defaults to the bundled thesis hand (and `file` may name a bundled hand,
+//! `"thesis"` or `"bh8"`), `[planner]` and `[sim]` to the thesis's values, and without `[expect]`
+//! the run reports what it found and judges nothing. Unknown keys and wrong types are
 //! errors naming the file, the line and the key. Units are in the key names: millimetres, degrees,
 //! kilograms, seconds, newton-metres.
 
@@ -63,8 +65,8 @@ pub struct Scenario {
     pub planner: PlannerParams,
     /// Physics check parameters.
     pub sim: SimParams,
-    /// What the run should show.
-    pub expect: Expect,
+    /// What the run should show; `None` when the scenario has no `[expect]` (nothing is judged).
+    pub expect: Option<Expect>,
 }
 
 /// The object to grasp.
@@ -286,12 +288,13 @@ struct RawScenario {
     name: Option<String>,
     description: Option<String>,
     object: RawObject,
+    #[serde(default)]
     hand: RawHand,
     #[serde(default)]
     planner: PlannerParams,
     #[serde(default)]
     sim: SimParams,
-    expect: Expect,
+    expect: Option<Expect>,
 }
 
 #[derive(Deserialize)]
@@ -310,10 +313,11 @@ fn default_friction() -> f64 {
     0.3
 }
 
-#[derive(Deserialize)]
+#[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct RawHand {
-    file: PathBuf,
+    /// A hand file relative to the scenario, or the name of a bundled hand; default `thesis`.
+    file: Option<PathBuf>,
     #[serde(default)]
     overrides: BTreeMap<String, f64>,
 }
@@ -391,9 +395,25 @@ impl Scenario {
                 format!("must be in (0, 2], got {}", o.friction),
             ));
         }
-        let hand_file = dir.join(&raw.hand.file);
         let overrides: Vec<(String, f64)> = raw.hand.overrides.into_iter().collect();
-        let hand = Hand::load(&hand_file, &overrides).map_err(|e| match e {
+        let file = raw.hand.file.unwrap_or_else(|| PathBuf::from("thesis"));
+        let bundled = file
+            .to_str()
+            .and_then(crate::hand::bundled)
+            .filter(|_| !dir.join(&file).is_file());
+        let (hand_file, loaded) = match bundled {
+            Some((name, text)) => {
+                let label = PathBuf::from(format!("<bundled hand {name}>"));
+                let hand = Hand::parse(text, &label, &overrides);
+                (label, hand)
+            }
+            None => {
+                let f = dir.join(&file);
+                let hand = Hand::load(&f, &overrides);
+                (f, hand)
+            }
+        };
+        let hand = loaded.map_err(|e| match e {
             // The override was written in the scenario: name the scenario.
             HandError::BadOverride {
                 path: hand,
@@ -487,7 +507,7 @@ impl Scenario {
                 return Err(invalid(key, format!("must be zero or positive, got {v}")));
             }
         }
-        if let Some(t) = &raw.expect.theta_deg {
+        if let Some(t) = raw.expect.as_ref().and_then(|e| e.theta_deg.as_ref()) {
             if t.len() != hand.finger_list.len() {
                 return Err(invalid(
                     "expect.theta_deg",
@@ -621,9 +641,22 @@ pub(crate) fn io_message(e: &std::io::Error) -> String {
     }
 }
 
-/// One line from a TOML error: `line N: `the line`: message`.
+/// The top-level sections of a scenario, for naming a missing one.
+const SECTIONS: [&str; 5] = ["object", "hand", "planner", "sim", "expect"];
+
+/// One line from a TOML error: `line N: `the line`: message`. A missing section is named
+/// as such rather than pinned on line 1.
 pub(crate) fn toml_message(e: &toml::de::Error, text: &str) -> String {
     let message = e.message().replace('\n', " ");
+    if let Some(field) = message
+        .strip_prefix("missing field `")
+        .and_then(|m| m.strip_suffix('`'))
+    {
+        let at_top = e.span().is_none_or(|s| s.start == 0);
+        if at_top && SECTIONS.contains(&field) {
+            return format!("missing section `[{field}]`");
+        }
+    }
     match e.span() {
         Some(span) => {
             let start = span.start.min(text.len());

@@ -11,7 +11,7 @@
 //! produce is simulated once (its physics does not depend on how it was found).
 
 use crate::batch::{scenario_for, Item};
-use crate::mesh::{align, load_stl, AlignedObject};
+use crate::mesh::{align, load_mesh, AlignedObject};
 use crate::plan::{self, Domain};
 use crate::scenario::{validate_planner, MassSpec, PlannerParams, Scenario};
 use crate::sim::{self, ObjectShape, SimHand, Verdict};
@@ -213,7 +213,7 @@ pub fn tune(
     let mut prepared = Vec::new();
     for item in items {
         let scenario = scenario_for(item, template)?;
-        let loaded = load_stl(&scenario.object.mesh, scenario.object.units)?;
+        let loaded = load_mesh(&scenario.object.mesh, scenario.object.units)?;
         let aligned = align(&loaded.mesh);
         let volume = aligned.original.volume_mm3;
         let shape = ObjectShape::from_mesh(&aligned.mesh, volume);

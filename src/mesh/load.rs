@@ -1,4 +1,9 @@
-//! Reading STL (binary or ASCII, through `stl_io`) into a validated [`Mesh`] in millimetres.
+//! Reading mesh files into a validated [`Mesh`] in millimetres: STL (binary or ASCII, through
+//! `stl_io`), Wavefront OBJ (through `tobj`: every object and group in the file is one mesh,
+//! polygons are fan-triangulated) and PLY (ASCII or binary, through `ply-rs-bw`: the `vertex`
+//! element's `x`, `y`, `z` and the `face` element's `vertex_indices` list, polygons
+//! fan-triangulated). The format is chosen by the file name's extension and checked against the
+//! content; every format goes through the same validation.
 //!
 //! Format detection does not trust the first five bytes: a binary file whose 80-byte header
 //! happens to begin with "solid" is common (several CAD exporters write one), so a file whose size
@@ -13,7 +18,7 @@ use std::path::Path;
 /// such values in the mass properties would lose all precision.
 const COORDINATE_LIMIT_MM: f64 = 1e9;
 
-/// The length unit of an STL file's coordinates.
+/// The length unit of a mesh file's coordinates.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LengthUnit {
@@ -50,8 +55,374 @@ pub struct LoadedMesh {
     pub topology: Topology,
     /// True if and only if the file was wound inside-out and grasp-sim flipped it.
     pub was_inverted: bool,
-    /// True if and only if the file was binary STL.
+    /// True if and only if the file was binary (STL or PLY).
     pub is_binary: bool,
+    /// The file's format.
+    pub format: MeshFormat,
+    /// The unit the file was read in.
+    pub unit: LengthUnit,
+}
+
+/// Objects smaller than this along their largest extent are implausible for a hand `[mm]`.
+const PLAUSIBLE_MIN_MM: f64 = 5.0;
+/// Objects larger than this along their largest extent are implausible for a hand `[mm]`.
+const PLAUSIBLE_MAX_MM: f64 = 2000.0;
+
+/// A mesh file format grasp-sim reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// STL, binary or ASCII.
+    Stl,
+    /// Wavefront OBJ.
+    Obj,
+    /// PLY (Stanford polygon format), ASCII or binary.
+    Ply,
+}
+
+impl MeshFormat {
+    /// The format named by `path`'s extension (case-insensitive), if grasp-sim reads it.
+    pub fn from_path(path: &Path) -> Option<MeshFormat> {
+        match path.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+            "stl" => Some(MeshFormat::Stl),
+            "obj" => Some(MeshFormat::Obj),
+            "ply" => Some(MeshFormat::Ply),
+            _ => None,
+        }
+    }
+
+    /// The lower-case extension.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            MeshFormat::Stl => "stl",
+            MeshFormat::Obj => "obj",
+            MeshFormat::Ply => "ply",
+        }
+    }
+}
+
+/// Reads and validates a mesh file (STL, OBJ or PLY, by extension), scaling its coordinates to
+/// millimetres.
+///
+/// # Errors
+/// Every [`MeshError`] names `path`: an unknown extension, content of another format, and the
+/// errors of [`load_stl`] and [`parse_mesh`].
+pub fn load_mesh(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> {
+    if path.is_dir() {
+        return Err(MeshError::IsDirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    let format = MeshFormat::from_path(path).ok_or_else(|| MeshError::UnknownFormat {
+        path: path.to_path_buf(),
+    })?;
+    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
+        path: path.to_path_buf(),
+        message: crate::scenario::io_message(&e),
+    })?;
+    parse_mesh(&bytes, path, format, unit)
+}
+
+/// Parses mesh bytes of the given format; `path` is only used in messages.
+///
+/// # Errors
+/// As [`load_mesh`]: the content must match `format`, and pass the same validation as STL.
+pub fn parse_mesh(
+    bytes: &[u8],
+    path: &Path,
+    format: MeshFormat,
+    unit: LengthUnit,
+) -> Result<LoadedMesh, MeshError> {
+    if bytes.is_empty() {
+        return Err(MeshError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    let looks = looks_like(bytes);
+    let mismatch = |found: &str| MeshError::FormatMismatch {
+        path: path.to_path_buf(),
+        named: format.as_str().to_string(),
+        found: found.to_string(),
+    };
+    match (format, looks) {
+        (MeshFormat::Stl, Some(MeshFormat::Stl) | None) => parse_stl(bytes, path, unit),
+        (MeshFormat::Obj, Some(MeshFormat::Obj) | None) => parse_obj(bytes, path, unit),
+        (MeshFormat::Ply, Some(MeshFormat::Ply)) => parse_ply(bytes, path, unit),
+        (MeshFormat::Ply, _) => Err(MeshError::Ply {
+            path: path.to_path_buf(),
+            detail: "does not begin with the `ply` line every PLY file starts with".to_string(),
+        }),
+        (_, Some(found)) => Err(mismatch(match found {
+            MeshFormat::Stl => "STL",
+            MeshFormat::Obj => "OBJ",
+            MeshFormat::Ply => "PLY",
+        })),
+    }
+}
+
+/// What the content looks like, when it is clear: PLY by its magic line, binary STL by its size,
+/// ASCII STL by "solid ... facet", OBJ by vertex and face lines.
+fn looks_like(bytes: &[u8]) -> Option<MeshFormat> {
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(4096)]);
+    let first = head.lines().next().unwrap_or("").trim();
+    if first == "ply" {
+        return Some(MeshFormat::Ply);
+    }
+    if bytes.len() >= 84 {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]);
+        if bytes.len() as u64 == 84 + 50 * u64::from(n) {
+            return Some(MeshFormat::Stl);
+        }
+    }
+    if head.trim_start().starts_with("solid") && head.contains("facet") {
+        return Some(MeshFormat::Stl);
+    }
+    let mut tokens = head.lines().filter_map(|l| l.split_whitespace().next());
+    if tokens.clone().any(|t| t == "v") && tokens.any(|t| t == "f") {
+        return Some(MeshFormat::Obj);
+    }
+    None
+}
+
+/// Checks OBJ text for what tobj reports without a line (a coordinate that is not a finite
+/// number, a face with an index past the vertex list or of 0), so the error can name the line.
+fn check_obj_lines(text: &str, path: &Path) -> Result<(), MeshError> {
+    let err = |line: usize, detail: String| MeshError::Obj {
+        path: path.to_path_buf(),
+        line: Some(line),
+        detail,
+    };
+    let total = text
+        .lines()
+        .filter(|l| l.split_whitespace().next() == Some("v"))
+        .count();
+    let mut seen = 0usize;
+    for (i, line) in text.lines().enumerate() {
+        let n = i + 1;
+        let mut t = line.split_whitespace();
+        match t.next() {
+            Some("v") => {
+                seen += 1;
+                let coords: Vec<&str> = t.take(3).collect();
+                if coords.len() < 3 {
+                    return Err(err(n, "a vertex needs three coordinates".to_string()));
+                }
+                for c in coords {
+                    match c.parse::<f64>() {
+                        Ok(v) if v.is_finite() => {}
+                        Ok(_) => {
+                            return Err(err(n, format!("vertex coordinate `{c}` is not finite")))
+                        }
+                        Err(_) => {
+                            return Err(err(n, format!("vertex coordinate `{c}` is not a number")))
+                        }
+                    }
+                }
+            }
+            Some("f") => {
+                let corners: Vec<&str> = t.collect();
+                if corners.len() < 3 {
+                    return Err(err(n, "a face needs at least three vertices".to_string()));
+                }
+                for c in corners {
+                    let v = c.split('/').next().unwrap_or("");
+                    let k: i64 = v
+                        .parse()
+                        .map_err(|_| err(n, format!("face vertex `{c}` is not an index")))?;
+                    let ok = match k {
+                        0 => false,
+                        k if k > 0 => (k as u64) <= total as u64,
+                        k => k.unsigned_abs() <= seen as u64,
+                    };
+                    if !ok {
+                        return Err(err(
+                            n,
+                            format!(
+                                "face refers to vertex {k}, but the file has {total} vertices \
+                                 (OBJ indices start at 1; negative ones count back from the \
+                                 last vertex so far)"
+                            ),
+                        ));
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+fn parse_obj(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| MeshError::Obj {
+        path: path.to_path_buf(),
+        line: Some(
+            bytes[..e.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1,
+        ),
+        detail: "not UTF-8 text".to_string(),
+    })?;
+    check_obj_lines(text, path)?;
+    let options = tobj::LoadOptions {
+        single_index: true,
+        triangulate: true,
+        ignore_points: true,
+        ignore_lines: true,
+    };
+    // Materials are not needed: a `mtllib` line is ignored rather than read from disk.
+    let (models, _) = tobj::load_obj_buf(&mut std::io::Cursor::new(text), &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| MeshError::Obj {
+        path: path.to_path_buf(),
+        line: None,
+        detail: e.to_string(),
+    })?;
+    let mut raw = Vec::new();
+    for m in &models {
+        let pos = &m.mesh.positions;
+        for tri in m.mesh.indices.chunks_exact(3) {
+            let mut corners = [[0f32; 3]; 3];
+            for (k, &i) in tri.iter().enumerate() {
+                let i = i as usize * 3;
+                let p = pos.get(i..i + 3).ok_or_else(|| MeshError::Obj {
+                    path: path.to_path_buf(),
+                    line: None,
+                    detail: "a face refers to a vertex the file does not have".to_string(),
+                })?;
+                corners[k] = [p[0], p[1], p[2]];
+            }
+            raw.push(corners);
+        }
+    }
+    build(raw, path, unit, false, MeshFormat::Obj)
+}
+
+fn parse_ply(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> {
+    use ply_rs_bw::parser::Parser;
+    use ply_rs_bw::ply::{DefaultElement, Encoding, Property};
+    let err = |detail: String| MeshError::Ply {
+        path: path.to_path_buf(),
+        detail: detail.split_whitespace().collect::<Vec<_>>().join(" "),
+    };
+    let parser = Parser::<DefaultElement>::new();
+    let mut reader = std::io::BufReader::new(std::io::Cursor::new(bytes));
+    let header = parser
+        .read_header(&mut reader)
+        .map_err(|e| err(format!("header: {e}")))?;
+    // A count larger than the file cannot be real: refuse it before anything is allocated for it.
+    for (name, def) in &header.elements {
+        if def.count > bytes.len() {
+            return Err(err(format!(
+                "header declares {} `{name}` elements in a file of {} bytes",
+                def.count,
+                bytes.len()
+            )));
+        }
+    }
+    let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
+        // ply-rs-bw's messages carry the offending line and a nested parser dump; keep the line.
+        let m = e
+            .to_string()
+            .split_whitespace()
+            .collect::<Vec<_>>()
+            .join(" ");
+        let eof = e.kind() == std::io::ErrorKind::UnexpectedEof || m.contains("UnexpectedEof");
+        if eof {
+            return err(format!(
+                "unexpected end of file (truncated?): {}",
+                m.split(" Error: ").next().unwrap_or(&m)
+            ));
+        }
+        match m
+            .split_once("String: '")
+            .and_then(|(_, r)| r.split_once('\''))
+        {
+            Some((line, _)) => err(format!(
+                "cannot read the element line `{}`: not numbers of the types the header declares",
+                line.trim()
+            )),
+            None => err(m.split(" Error: ").next().unwrap_or(&m).to_string()),
+        }
+    })?;
+    let is_binary = header.encoding != Encoding::Ascii;
+    let scalar = |p: Option<&Property>| -> Option<f64> {
+        Some(match p? {
+            Property::Float(v) => f64::from(*v),
+            Property::Double(v) => *v,
+            Property::Char(v) => f64::from(*v),
+            Property::UChar(v) => f64::from(*v),
+            Property::Short(v) => f64::from(*v),
+            Property::UShort(v) => f64::from(*v),
+            Property::Int(v) => f64::from(*v),
+            Property::UInt(v) => f64::from(*v),
+            _ => return None,
+        })
+    };
+    let vertices = payload
+        .get("vertex")
+        .ok_or_else(|| err("no `vertex` element".to_string()))?;
+    let mut points = Vec::with_capacity(vertices.len());
+    for (i, v) in vertices.iter().enumerate() {
+        let mut p = [0f32; 3];
+        for (k, key) in ["x", "y", "z"].iter().enumerate() {
+            let c = scalar(v.get(*key))
+                .ok_or_else(|| err(format!("vertex {i} has no numeric `{key}`")))?;
+            p[k] = c as f32;
+        }
+        points.push(p);
+    }
+    let faces = payload
+        .get("face")
+        .ok_or_else(|| err("no `face` element: a point cloud is not a surface".to_string()))?;
+    let mut raw = Vec::new();
+    for (f, face) in faces.iter().enumerate() {
+        let list = face
+            .get("vertex_indices")
+            .or_else(|| face.get("vertex_index"));
+        let idx: Vec<i64> = match list {
+            Some(Property::ListInt(v)) => v.iter().map(|&i| i64::from(i)).collect(),
+            Some(Property::ListUInt(v)) => v.iter().map(|&i| i64::from(i)).collect(),
+            Some(Property::ListShort(v)) => v.iter().map(|&i| i64::from(i)).collect(),
+            Some(Property::ListUShort(v)) => v.iter().map(|&i| i64::from(i)).collect(),
+            Some(Property::ListChar(v)) => v.iter().map(|&i| i64::from(i)).collect(),
+            Some(Property::ListUChar(v)) => v.iter().map(|&i| i64::from(i)).collect(),
+            _ => {
+                return Err(err(format!(
+                    "face {} has no integer list `vertex_indices`",
+                    f + 1
+                )))
+            }
+        };
+        if idx.len() < 3 {
+            return Err(err(format!(
+                "face {} has {} vertices; a face needs at least three",
+                f + 1,
+                idx.len()
+            )));
+        }
+        if let Some(&bad) = idx
+            .iter()
+            .find(|&&i| i < 0 || i as u64 >= points.len() as u64)
+        {
+            return Err(MeshError::FaceIndex {
+                path: path.to_path_buf(),
+                face: f + 1,
+                index: bad,
+                vertices: points.len(),
+            });
+        }
+        // Fan triangulation, as tobj does for OBJ polygons.
+        for k in 1..idx.len() - 1 {
+            raw.push([
+                points[idx[0] as usize],
+                points[idx[k] as usize],
+                points[idx[k + 1] as usize],
+            ]);
+        }
+    }
+    build(raw, path, unit, is_binary, MeshFormat::Ply)
 }
 
 impl LoadedMesh {
@@ -81,7 +452,55 @@ impl LoadedMesh {
         if self.was_inverted {
             w.push("triangles were wound inside-out (negative volume); flipped".to_string());
         }
+        if let Some(u) = self.units_warning() {
+            w.push(u);
+        }
         w
+    }
+
+    /// A warning when the object's size is implausible for a hand (under 5 mm or over 2 m along
+    /// its largest extent), naming the unit it was read in and the likely one.
+    pub fn units_warning(&self) -> Option<String> {
+        let (lo, hi) = self.mesh.bounds();
+        let size = (hi - lo).max();
+        let read = match self.unit {
+            LengthUnit::Mm => "mm",
+            LengthUnit::M => "m",
+            LengthUnit::Inch => "inch",
+        };
+        let in_unit = size / self.unit.to_mm();
+        let likely = |unit: &str, factor: f64| {
+            format!(
+                "the object is {} {read} across as read (units = \"{read}\"): implausible for a \
+                 hand; if the file is in {unit} (the object then {} mm across), set units = \
+                 \"{unit}\" in [object], or --units {unit} for a bare mesh",
+                fmt_size(in_unit),
+                fmt_size(size * factor)
+            )
+        };
+        if size < PLAUSIBLE_MIN_MM {
+            // Too small: the file is probably in metres.
+            match self.unit {
+                LengthUnit::Mm => Some(likely("m", 1000.0)),
+                LengthUnit::Inch => Some(likely("m", 1000.0 / 25.4)),
+                LengthUnit::M => Some(format!(
+                    "the object is {} across: implausibly small for a hand",
+                    fmt_mm(size)
+                )),
+            }
+        } else if size > PLAUSIBLE_MAX_MM {
+            // Too large: the file is probably in millimetres.
+            match self.unit {
+                LengthUnit::M => Some(likely("mm", 1.0 / 1000.0)),
+                LengthUnit::Inch => Some(likely("mm", 1.0 / 25.4)),
+                LengthUnit::Mm => Some(format!(
+                    "the object is {} across: implausibly large for a hand",
+                    fmt_mm(size)
+                )),
+            }
+        } else {
+            None
+        }
     }
 }
 
@@ -173,7 +592,7 @@ pub fn parse_stl(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMe
         });
     };
 
-    build(triangles, path, unit, is_binary)
+    build(triangles, path, unit, is_binary, MeshFormat::Stl)
 }
 
 fn read_triangles(
@@ -209,6 +628,7 @@ fn build(
     path: &Path,
     unit: LengthUnit,
     is_binary: bool,
+    format: MeshFormat,
 ) -> Result<LoadedMesh, MeshError> {
     let p = || path.to_path_buf();
     if raw.is_empty() {
@@ -289,5 +709,25 @@ fn build(
         topology,
         was_inverted,
         is_binary,
+        format,
+        unit,
     })
+}
+
+/// A length with three significant figures.
+fn fmt_size(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() {
+        return format!("{v}");
+    }
+    let digits = (2 - v.abs().log10().floor() as i32).max(0) as usize;
+    format!("{v:.digits$}")
+}
+
+/// A length in millimetres, or metres when over 10 m.
+fn fmt_mm(mm: f64) -> String {
+    if mm >= 10_000.0 {
+        format!("{} m", fmt_size(mm / 1000.0))
+    } else {
+        format!("{} mm", fmt_size(mm))
+    }
 }

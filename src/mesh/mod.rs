@@ -1,6 +1,8 @@
-//! Triangle meshes: loading and validating STL, mass properties, alignment with the principal axis.
+//! Triangle meshes: loading and validating STL, OBJ and PLY, mass properties, alignment with the
+//! principal axis.
 //!
-//! Input: an STL file (binary or ASCII) in some length unit. Output: a welded, validated [`Mesh`]
+//! Input: a mesh file (STL binary or ASCII, Wavefront OBJ, PLY ASCII or binary) in some length
+//! unit. Output: a welded, validated [`Mesh`]
 //! in millimetres, and from it an [`AlignedObject`] in the planner's frame (thesis 3.2.1): the
 //! principal axis with the smallest moment of inertia along +Z, the lowest point at Z = 0 and the
 //! centroid on the Z axis. The thesis asks the user to pre-align the mesh (its 6.2); grasp-sim does
@@ -14,7 +16,7 @@ mod load;
 mod mass;
 
 pub use align::{align, align_about, AlignedObject, GraspAxis};
-pub use load::{load_stl, parse_stl, LengthUnit, LoadedMesh};
+pub use load::{load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh, MeshFormat};
 pub use mass::{mass_properties, MassProperties};
 
 use nalgebra::{Point3, Vector3};
@@ -35,13 +37,13 @@ pub enum MeshError {
         message: String,
     },
     /// The path names a directory.
-    #[error("{path}: is a directory, not an STL file")]
+    #[error("{path}: is a directory, not a mesh file")]
     IsDirectory {
         /// The path.
         path: PathBuf,
     },
     /// The file is empty.
-    #[error("{path}: empty file, not an STL file")]
+    #[error("{path}: empty file, not a mesh file")]
     Empty {
         /// The file.
         path: PathBuf,
@@ -75,6 +77,52 @@ pub enum MeshError {
         declared: u32,
         /// Bytes past the last triangle.
         extra: u64,
+    },
+    /// The file name's extension is none of the formats grasp-sim reads.
+    #[error("{path}: unknown mesh format: the name must end in .stl, .obj or .ply")]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
+    /// The content is of another format than the file name says.
+    #[error("{path}: named .{named} but its content looks like {found}; rename it or convert it")]
+    FormatMismatch {
+        /// The file.
+        path: PathBuf,
+        /// The extension, lower case.
+        named: String,
+        /// What the content looks like.
+        found: String,
+    },
+    /// Wavefront OBJ that does not parse.
+    #[error("{path}: malformed OBJ{}: {detail}", line.map(|l| format!(" at line {l}")).unwrap_or_default())]
+    Obj {
+        /// The file.
+        path: PathBuf,
+        /// One-based line, where known.
+        line: Option<usize>,
+        /// What is wrong.
+        detail: String,
+    },
+    /// PLY that does not parse or lacks what a surface needs.
+    #[error("{path}: malformed PLY: {detail}")]
+    Ply {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        detail: String,
+    },
+    /// A face refers to a vertex the file does not have.
+    #[error("{path}: face {face} refers to vertex {index}, but the file has {vertices} vertices")]
+    FaceIndex {
+        /// The file.
+        path: PathBuf,
+        /// One-based face number.
+        face: usize,
+        /// The index as written in the file.
+        index: i64,
+        /// Vertices in the file.
+        vertices: usize,
     },
     /// ASCII STL that does not parse.
     #[error("{path}: malformed ASCII STL: {detail}")]

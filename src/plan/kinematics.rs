@@ -14,6 +14,12 @@
 //!   until its usable contact surface (offset by the finger offset from its centreline, between
 //!   its unusable lengths) first touches the circle; that angle must lie in the joint's range.
 //!   Both are reported; the kinematic one is used.
+//! - The largest circle is the top of the first interval of circles both phalanges wrap
+//!   ([`graspable_circle_radii`]), scanned from the smallest circle up: a hand whose phalanx 1 is
+//!   long against its phalanx 2 wraps no small circle (phalanx 2 starts past them and cannot
+//!   bend back), and the old scan, started at eq. 3.2's circle, stopped there and reported a
+//!   largest diameter of 0. A hand whose range is empty (it wraps no circle, or none larger than
+//!   eq. 3.2's) is refused when its hand file is read, with the reason.
 
 use crate::hand::Hand;
 use nalgebra::{Point2, Rotation2, Vector2};
@@ -38,12 +44,24 @@ impl GraspableRange {
 }
 
 /// The range for `hand`, with the thesis's magnify factor for the comparison value.
+///
+/// For a hand that wraps no circle (refused by the hand file's validation) the range is
+/// `[eq. 3.2, 0]`, which would grade every object ungraspable.
 pub fn graspable_range_with(hand: &Hand, magnify_factor: f64) -> GraspableRange {
-    let min = smallest_graspable_diameter(hand);
+    let eq32 = smallest_graspable_diameter(hand);
+    let (min, max) = match graspable_circle_radii(hand) {
+        // Eq. 3.2 stays the smallest (the thesis's rule, and the one that lets the prism's
+        // corners be grasped with tip contact where no circle of its size is wrapped); only a
+        // hand whose joint 1 cannot close past upright, where eq. 3.2 has no triangle, takes
+        // the smallest wrapped circle instead.
+        Some((_, hi)) if eq32 > 0.0 => (eq32, 2.0 * hi),
+        Some((lo, hi)) => (2.0 * lo, 2.0 * hi),
+        None => (eq32, 0.0),
+    };
     GraspableRange {
         min_mm: min,
-        max_kinematic_mm: largest_graspable_diameter(hand),
-        max_thesis_mm: magnify_factor * min,
+        max_kinematic_mm: max,
+        max_thesis_mm: magnify_factor * eq32,
     }
 }
 
@@ -100,7 +118,8 @@ pub fn smallest_graspable_diameter(hand: &Hand) -> f64 {
 
 /// Smallest bend from straight (radians, in `[0, π]`) at which the usable contact surface of a
 /// link pivoting at `pivot`, straight direction `straight`, first touches the circle of radius
-/// `r` about `c`. `None` if it never does.
+/// `r` about `c`. `None` if it never does, or if the straight link is already inside the
+/// circle.
 fn first_touch_bend(
     pivot: Point2<f64>,
     straight: Vector2<f64>,
@@ -125,12 +144,13 @@ fn first_touch_bend(
     let step = 2f64.to_radians();
     let mut lo = 0.0;
     if gap(lo) <= 0.0 {
-        return Some(0.0);
+        // Already in the object while straight: closing cannot make a first touch.
+        return None;
     }
     let mut hi = step;
     while hi <= std::f64::consts::PI + 1e-12 {
         if gap(hi) <= 0.0 {
-            for _ in 0..60 {
+            for _ in 0..40 {
                 let mid = 0.5 * (lo + hi);
                 if gap(mid) <= 0.0 {
                     hi = mid;
@@ -183,45 +203,61 @@ pub fn circle_contact_angles(hand: &Hand, r: f64) -> Option<[f64; 2]> {
     Some([180.0 - bend1.to_degrees(), 180.0 - bend2.to_degrees()])
 }
 
-/// Largest graspable diameter from the kinematics `[mm]`: the largest circle resting on the palm
-/// centre whose contact angles both lie in the joint ranges (scanned in 2 mm of radius, then
-/// bisected to 0.01 mm). Returns 0 if no circle is graspable.
-pub fn largest_graspable_diameter(hand: &Hand) -> f64 {
-    let in_range = |r: f64| -> bool {
-        match circle_contact_angles(hand, r) {
-            Some([t1, t2]) => {
-                let [a1, b1] = hand.joints.theta1_range_deg;
-                let [a2, b2] = hand.joints.theta2_range_deg;
-                (a1..=b1).contains(&t1) && (a2..=b2).contains(&t2)
+/// Returns true if and only if both phalanges of the +y finger touch the circle of radius `r`
+/// resting on the palm centre with joint angles inside their ranges.
+fn wraps_circle(hand: &Hand, r: f64) -> bool {
+    match circle_contact_angles(hand, r) {
+        Some([t1, t2]) => {
+            let [a1, b1] = hand.joints.theta1_range_deg;
+            let [a2, b2] = hand.joints.theta2_range_deg;
+            (a1..=b1).contains(&t1) && (a2..=b2).contains(&t2)
+        }
+        None => false,
+    }
+}
+
+/// Largest radius the scan looks at `[mm]`: a 2 m object is no object for a hand.
+const RADIUS_LIMIT_MM: f64 = 1000.0;
+
+/// The radii `[smallest, largest]` `[mm]` of the first interval of circles, resting on the palm
+/// centre, that both phalanges touch within their joint ranges (scanned in 1 mm of radius from
+/// 0.25 mm, both ends bisected to 1e-6 mm); `None` if the hand wraps no circle up to 1 m.
+pub fn graspable_circle_radii(hand: &Hand) -> Option<(f64, f64)> {
+    let step = 1.0;
+    let mut r = 0.25;
+    while r <= RADIUS_LIMIT_MM && !wraps_circle(hand, r) {
+        r += step;
+    }
+    if r > RADIUS_LIMIT_MM {
+        return None;
+    }
+    let bisect = |mut ok: f64, mut bad: f64| {
+        while (ok - bad).abs() > 1e-6 {
+            let mid = 0.5 * (ok + bad);
+            if wraps_circle(hand, mid) {
+                ok = mid;
+            } else {
+                bad = mid;
             }
-            None => false,
         }
+        ok
     };
-    let r_min = smallest_graspable_diameter(hand) / 2.0;
-    let limit = 1000.0;
-    let mut r = r_min.max(0.5);
-    let mut last_ok: Option<f64> = None;
-    while r < limit {
-        if in_range(r) {
-            last_ok = Some(r);
-        } else if last_ok.is_some() {
-            break;
-        }
-        r += 2.0;
+    let lo = if r > 0.25 { bisect(r, r - step) } else { r };
+    while r + step <= RADIUS_LIMIT_MM && wraps_circle(hand, r + step) {
+        r += step;
     }
-    let Some(mut lo) = last_ok else {
-        return 0.0;
+    let hi = if r + step <= RADIUS_LIMIT_MM {
+        bisect(r, r + step)
+    } else {
+        r
     };
-    let mut hi = lo + 2.0;
-    while hi - lo > 0.005 {
-        let mid = 0.5 * (lo + hi);
-        if in_range(mid) {
-            lo = mid;
-        } else {
-            hi = mid;
-        }
-    }
-    2.0 * lo
+    Some((lo, hi))
+}
+
+/// Largest graspable diameter from the kinematics `[mm]`: the top of
+/// [`graspable_circle_radii`], doubled; 0 if no circle is graspable.
+pub fn largest_graspable_diameter(hand: &Hand) -> f64 {
+    graspable_circle_radii(hand).map_or(0.0, |(_, hi)| 2.0 * hi)
 }
 
 #[cfg(test)]
@@ -292,5 +328,127 @@ mod tests {
             beyond.is_none_or(|b| b[0] > hi1 || b[1] > hi2),
             "just beyond the largest diameter is still in range: {beyond:?}"
         );
+    }
+
+    /// A hand file with the given numbers (the thesis hand's layout).
+    #[allow(clippy::too_many_arguments)]
+    fn hand_toml(
+        offset: f64,
+        lateral: f64,
+        setback: f64,
+        t1: [f64; 2],
+        t2: [f64; 2],
+        finger_offset: f64,
+        l1: f64,
+        l2: f64,
+    ) -> String {
+        format!(
+            "name = \"p\"\n[palm]\noffset_mm = {offset}\nmargin_mm = 7.0\nhalf_width_mm = {lateral}\n\
+             [joints]\nlateral_mm = {lateral}\nsetback_mm = {setback}\n\
+             theta1_range_deg = [{}, {}]\ntheta2_range_deg = [{}, {}]\n\
+             [fingers]\ngap_mm = 25.0\noffset_mm = {finger_offset}\ntip_thickness_mm = {}\n\
+             [phalanx_1]\nlength_mm = {l1}\nunusable_proximal_mm = {}\nunusable_distal_mm = {}\n\
+             [phalanx_2]\nlength_mm = {l2}\nunusable_proximal_mm = {}\nunusable_distal_mm = 0.0\n\
+             [[finger]]\nname = \"finger_1\"\nside = \"left\"\nheight_mm = 25.0\n\
+             [[finger]]\nname = \"finger_2\"\nside = \"right\"\nheight_mm = 0.0\n\
+             [[finger]]\nname = \"finger_3\"\nside = \"left\"\nheight_mm = -25.0\n",
+            t1[0],
+            t1[1],
+            t2[0],
+            t2[1],
+            finger_offset / 2.0,
+            l1 * 0.05,
+            l1 * 0.05,
+            l2 * 0.1,
+        )
+    }
+
+    #[test]
+    fn longer_first_phalanges_narrow_the_range_or_are_refused() {
+        // Issue 16, item 1: 90, 100 and 200 mm gave [17.4, 0.0] and graded everything too thick.
+        let base = include_str!("../../assets/hands/thesis.toml");
+        let path = std::path::Path::new("thesis.toml");
+        let mut last_min = 0.0;
+        for l1 in [61.0, 70.0, 80.0] {
+            let h = Hand::parse(base, path, &[("phalanx_1.length_mm".into(), l1)]).unwrap();
+            let r = graspable_range(&h);
+            assert!(
+                r.min_mm < r.max_kinematic_mm && r.min_mm >= last_min,
+                "phalanx 1 {l1} mm: {r:?}"
+            );
+            // The largest end is wrapped by both phalanges within the joint ranges.
+            let [t1, t2] = circle_contact_angles(&h, r.max_kinematic_mm / 2.0 - 0.01).unwrap();
+            assert!((45.0..=135.0).contains(&t1) && (45.0..=135.0).contains(&t2));
+            last_min = r.min_mm;
+        }
+        for l1 in [90.0, 100.0, 200.0] {
+            let e = Hand::parse(base, path, &[("phalanx_1.length_mm".into(), l1)])
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("phalanx_1.length_mm") && e.contains("wrap"),
+                "{l1}: {e}"
+            );
+        }
+    }
+
+    /// Property: every hand the hand file accepts has a non-empty graspable range whose ends are
+    /// wrapped by both phalanges; every other hand is refused with a reason. Hands drawn from a
+    /// fixed-seed generator (deterministic), over the validated bounds of each dimension.
+    #[test]
+    fn every_accepted_hand_has_a_graspable_range() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |lo: f64, hi: f64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            lo + (hi - lo) * ((state >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        let (mut accepted, mut refused) = (0, 0);
+        for _ in 0..40 {
+            let t1lo = next(20.0, 90.0);
+            let t2lo = next(20.0, 120.0);
+            let text = hand_toml(
+                next(1.0, 20.0),
+                next(10.0, 80.0),
+                next(0.0, 15.0),
+                [t1lo, next(t1lo + 5.0, 180.0)],
+                [t2lo, next(t2lo + 5.0, 180.0)],
+                next(2.0, 12.0),
+                next(15.0, 200.0),
+                next(8.0, 100.0),
+            );
+            match Hand::parse(&text, std::path::Path::new("p.toml"), &[]) {
+                Ok(h) => {
+                    accepted += 1;
+                    let r = graspable_range(&h);
+                    assert!(
+                        r.min_mm > 0.0 && r.min_mm < r.max_kinematic_mm,
+                        "{r:?} for\n{text}"
+                    );
+                    let (lo, hi) = graspable_circle_radii(&h).unwrap();
+                    assert!(wraps_circle(&h, lo) && wraps_circle(&h, hi), "{text}");
+                }
+                Err(e) => {
+                    refused += 1;
+                    let e = e.to_string();
+                    assert!(e.starts_with("p.toml: `") && e.len() > 40, "{e}");
+                }
+            }
+        }
+        assert!(
+            accepted > 5 && refused > 0,
+            "{accepted} accepted, {refused} refused"
+        );
+    }
+
+    #[test]
+    fn the_bh8_hand_has_a_range_sized_like_a_barretthand() {
+        let (_, text) = crate::hand::bundled("bh8").unwrap();
+        let h = Hand::parse(text, std::path::Path::new("bh8"), &[]).unwrap();
+        let r = graspable_range(&h);
+        // Wider than the thesis hand at both ends: its fingers are longer and further apart.
+        assert!(r.min_mm > 20.0 && r.min_mm < 40.0, "{r:?}");
+        assert!(r.max_kinematic_mm > 150.0, "{r:?}");
     }
 }

@@ -3,6 +3,7 @@
 mod batch;
 mod cli;
 mod export;
+mod formats;
 mod geometry;
 mod planner;
 mod sim;

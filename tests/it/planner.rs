@@ -219,3 +219,15 @@ fn chapter4_matches_the_thesis_qualitatively() {
         r.plan.largest_span_mm
     );
 }
+
+/// The BarrettHand-sized bundled hand plans and holds the thesis cup (issue 16, item 1).
+#[test]
+fn the_bh8_hand_grasps_and_holds_the_cup() {
+    let out = crate::succeed(crate::grasp_sim().args(["--json", "scenarios/hands/bh8_cup.toml"]));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["plan"]["status"], "feasible", "{v}");
+    assert_eq!(v["sim"]["verdict"], "hold", "{v}");
+    assert_eq!(v["expect"]["met"], true);
+    let [lo, hi] = [0, 1].map(|i| v["plan"]["graspable_diameter_mm"][i].as_f64().unwrap());
+    assert!(lo > 20.0 && hi > 150.0, "{lo}..{hi}");
+}
