@@ -101,7 +101,8 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
     let loaded = mesh::load_mesh(&scenario.object.mesh, scenario.object.units)?;
     timings.insert("load".to_string(), ms(t0));
     let t1 = Instant::now();
-    let aligned = mesh::align(&loaded.mesh);
+    let props = mesh::mass_properties(&loaded.mesh);
+    let aligned = mesh::align_with(&loaded.mesh, &props, mesh::GraspAxis::THESIS);
     timings.insert("align".to_string(), ms(t1));
 
     let volume = aligned.original.volume_mm3;
@@ -153,6 +154,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
     let checks_candidates = !options.no_sim && scenario.sim.override_angles.is_none();
     let selection = select::select(
         &loaded.mesh,
+        &props,
         &select::SelectParams {
             hand: &scenario.hand,
             planner: &scenario.planner,

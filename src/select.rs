@@ -14,7 +14,7 @@
 //! slipped, else the first checked), and every candidate checked is reported with its verdict.
 
 use crate::hand::Hand;
-use crate::mesh::{align_about, AlignedObject, GraspAxis, Mesh};
+use crate::mesh::{align_with, AlignedObject, GraspAxis, MassProperties, Mesh};
 use crate::plan::search::{search_with, Grasp, Rejection};
 use crate::plan::{self, GradedDomain, RuleSet};
 use crate::scenario::PlannerParams;
@@ -103,7 +103,12 @@ pub struct SelectParams<'a> {
 /// Plans across axes and rule sets, checking candidates when asked (see the module docs).
 ///
 /// `timings` receives the summed wall time of each planner stage `[ms]`.
-pub fn select(mesh: &Mesh, p: &SelectParams, timings: &mut BTreeMap<String, f64>) -> Selection {
+pub fn select(
+    mesh: &Mesh,
+    props: &MassProperties,
+    p: &SelectParams,
+    timings: &mut BTreeMap<String, f64>,
+) -> Selection {
     let mut sel = Selection {
         axes: Vec::new(),
         candidates: Vec::new(),
@@ -120,7 +125,7 @@ pub fn select(mesh: &Mesh, p: &SelectParams, timings: &mut BTreeMap<String, f64>
                 break;
             }
             let aligned = aligned_cache[k]
-                .get_or_insert_with(|| align_about(mesh, *axis))
+                .get_or_insert_with(|| align_with(mesh, props, *axis))
                 .clone();
             let mut t = BTreeMap::new();
             let graded = plan::grade_domain_with(

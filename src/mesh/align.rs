@@ -124,7 +124,13 @@ pub fn align(mesh: &Mesh) -> AlignedObject {
 /// rule; for another, X is the smaller-moment remaining axis (the object's widest direction
 /// across the grasp axis), signed by the same rule, and a flipped axis turns the object about X.
 pub fn align_about(mesh: &Mesh, which: GraspAxis) -> AlignedObject {
-    let props = mass_properties(mesh);
+    align_with(mesh, &mass_properties(mesh), which)
+}
+
+/// [`align_about`] with the mesh's mass properties already computed (they do not depend on the
+/// axis chosen).
+pub fn align_with(mesh: &Mesh, props: &MassProperties, which: GraspAxis) -> AlignedObject {
+    let props = *props;
     let eig = SymmetricEigen::new(props.inertia);
     // Sort eigenpairs by moment, ascending; ties broken by index for determinism.
     let mut order = [0usize, 1, 2];

@@ -51,8 +51,11 @@ pub struct LoadedMesh {
     pub triangles_read: usize,
     /// Zero-area triangles dropped.
     pub degenerate_dropped: usize,
-    /// Edge statistics of what was kept.
+    /// Edge statistics of what was kept, as the file has it (before small holes are closed).
     pub topology: Topology,
+    /// Holes closed because their boundary spans at most [`SMALL_HOLE_MM`]: a missing triangle,
+    /// a perforation, a scan's pinhole.
+    pub holes_filled: usize,
     /// True if and only if the file was wound inside-out and grasp-sim flipped it.
     pub was_inverted: bool,
     /// True if and only if the file was binary (STL or PLY).
@@ -62,6 +65,11 @@ pub struct LoadedMesh {
     /// The unit the file was read in.
     pub unit: LengthUnit,
 }
+
+/// A hole in the surface whose boundary spans at most this is closed at load time `[mm]`: the
+/// thesis hand's finger is 14 mm wide, so no finger enters it, and the slices then close (a
+/// larger opening, such as a cup's rim, stays open).
+pub const SMALL_HOLE_MM: f64 = 14.0;
 
 /// Objects smaller than this along their largest extent are implausible for a hand `[mm]`.
 const PLAUSIBLE_MIN_MM: f64 = 5.0;
@@ -439,8 +447,17 @@ impl LoadedMesh {
         if t.boundary_edges > 0 || t.non_manifold_edges > 0 {
             w.push(format!(
                 "surface is not a closed 2-manifold ({} boundary edges, {} non-manifold edges): \
-                 the thesis method assumes a closed shell, slices may be open",
-                t.boundary_edges, t.non_manifold_edges
+                 the thesis method assumes a closed shell, slices may be open{}",
+                t.boundary_edges,
+                t.non_manifold_edges,
+                if self.holes_filled > 0 {
+                    format!(
+                        "; {} holes under {SMALL_HOLE_MM} mm closed",
+                        self.holes_filled
+                    )
+                } else {
+                    String::new()
+                }
             ));
         }
         if t.misoriented_edges > 0 {
@@ -687,6 +704,12 @@ fn build(
         });
     }
 
+    let topology = mesh.topology();
+    let holes_filled = if topology.boundary_edges > 0 {
+        mesh.fill_small_holes(SMALL_HOLE_MM)
+    } else {
+        0
+    };
     let volume = super::mass_properties(&mesh).volume_mm3;
     let mut was_inverted = false;
     // A closed surface of any real size encloses a volume well above rounding noise.
@@ -701,12 +724,12 @@ fn build(
         mesh.flip();
         was_inverted = true;
     }
-    let topology = mesh.topology();
     Ok(LoadedMesh {
         mesh,
         triangles_read: raw.len(),
         degenerate_dropped: degenerate,
         topology,
+        holes_filled,
         was_inverted,
         is_binary,
         format,

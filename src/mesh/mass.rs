@@ -25,6 +25,94 @@ pub struct MassProperties {
 
 /// Computes the mass properties of `mesh` (which should be closed and outward-wound).
 pub fn mass_properties(mesh: &Mesh) -> MassProperties {
+    let exact = surface_mass_properties(mesh);
+    if mesh.shell_count() < 2 || exact.volume_mm3 <= 0.0 {
+        return exact;
+    }
+    // Several shells: the surface integral adds their volumes, counting any overlap twice. Where
+    // the union (integrated over slices) is smaller by more than the integration's own error,
+    // the shells overlap and the union is the object.
+    let union = sliced_mass_properties(mesh, UNION_SLICES);
+    if union.volume_mm3 < exact.volume_mm3 * (1.0 - OVERLAP_TOLERANCE) {
+        union
+    } else {
+        exact
+    }
+}
+
+/// Slices across the object for the union's mass properties: the midpoint rule's error on a box
+/// is nil, on a sphere 1/(2 n²) of the volume (3e-6 here); tests measure it on overlapping boxes
+/// and a box with a cylinder pushed into it.
+const UNION_SLICES: usize = 400;
+
+/// Shells whose summed volume exceeds their union by this share overlap.
+const OVERLAP_TOLERANCE: f64 = 1e-3;
+
+/// Mass properties (unit density) of the solid a mesh encloses, taken as the union of its
+/// shells: the areas and area moments of `n` horizontal slices (each the union of what the
+/// shells cut, [`crate::slice::slice`]) integrated along Z by the midpoint rule.
+pub fn sliced_mass_properties(mesh: &Mesh, n: usize) -> MassProperties {
+    let (lo, hi) = mesh.bounds();
+    let reference = nalgebra::center(&lo, &hi);
+    let dz = (hi.z - lo.z) / n as f64;
+    // ∫1, ∫x, ∫y, ∫z, ∫x², ∫y², ∫z², ∫xy, ∫yz, ∫zx about `reference`.
+    let mut m = [0.0f64; 10];
+    for k in 0..n {
+        let z_abs = lo.z + (k as f64 + 0.5) * dz;
+        let z = z_abs - reference.z;
+        let s = crate::slice::slice(mesh, &crate::slice::Plane::horizontal(z_abs));
+        let (mut a, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+        for c in s.contours.iter().filter(|c| c.is_closed) {
+            let np = c.points.len();
+            for i in 0..np {
+                let p = c.points[i] - reference.xy().coords;
+                let q = c.points[(i + 1) % np] - reference.xy().coords;
+                let cross = p.x * q.y - q.x * p.y;
+                a += cross / 2.0;
+                sx += (p.x + q.x) * cross / 6.0;
+                sy += (p.y + q.y) * cross / 6.0;
+                sxx += (p.x * p.x + p.x * q.x + q.x * q.x) * cross / 12.0;
+                syy += (p.y * p.y + p.y * q.y + q.y * q.y) * cross / 12.0;
+                sxy += (p.x * q.y + 2.0 * p.x * p.y + 2.0 * q.x * q.y + q.x * p.y) * cross / 24.0;
+            }
+        }
+        m[0] += a * dz;
+        m[1] += sx * dz;
+        m[2] += sy * dz;
+        m[3] += a * z * dz;
+        m[4] += sxx * dz;
+        m[5] += syy * dz;
+        // A slab's own thickness adds dz²/12 to ∫z² per unit of area.
+        m[6] += a * (z * z + dz * dz / 12.0) * dz;
+        m[7] += sxy * dz;
+        m[8] += sy * z * dz;
+        m[9] += sx * z * dz;
+    }
+    let v = m[0];
+    if v <= 0.0 {
+        return MassProperties {
+            volume_mm3: 0.0,
+            centroid: reference,
+            inertia: Matrix3::zeros(),
+        };
+    }
+    let c = Vector3::new(m[1], m[2], m[3]) / v;
+    let xx = m[5] + m[6] - v * (c.y * c.y + c.z * c.z);
+    let yy = m[4] + m[6] - v * (c.z * c.z + c.x * c.x);
+    let zz = m[4] + m[5] - v * (c.x * c.x + c.y * c.y);
+    let xy = -(m[7] - v * c.x * c.y);
+    let yz = -(m[8] - v * c.y * c.z);
+    let zx = -(m[9] - v * c.z * c.x);
+    MassProperties {
+        volume_mm3: v,
+        centroid: reference + c,
+        inertia: Matrix3::new(xx, xy, zx, xy, yy, yz, zx, yz, zz),
+    }
+}
+
+/// Mass properties by the divergence theorem over the surface (exact for one closed shell; for
+/// several shells the sum of theirs).
+pub fn surface_mass_properties(mesh: &Mesh) -> MassProperties {
     let (lo, hi) = mesh.bounds();
     let reference = nalgebra::center(&lo, &hi);
     let mut intg = [0.0f64; 10];

@@ -15,9 +15,9 @@ mod align;
 mod load;
 mod mass;
 
-pub use align::{align, align_about, AlignedObject, GraspAxis};
+pub use align::{align, align_about, align_with, AlignedObject, GraspAxis};
 pub use load::{load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh, MeshFormat};
-pub use mass::{mass_properties, MassProperties};
+pub use mass::{mass_properties, sliced_mass_properties, surface_mass_properties, MassProperties};
 
 use nalgebra::{Point3, Vector3};
 use std::collections::HashMap;
@@ -300,6 +300,108 @@ impl Mesh {
             }
         }
         t
+    }
+
+    /// The number of shells: sets of triangles connected through shared vertices.
+    pub fn shell_count(&self) -> usize {
+        let mut parent: Vec<u32> = (0..self.vertices.len() as u32).collect();
+        fn find(parent: &mut [u32], mut i: u32) -> u32 {
+            while parent[i as usize] != i {
+                parent[i as usize] = parent[parent[i as usize] as usize];
+                i = parent[i as usize];
+            }
+            i
+        }
+        for t in &self.triangles {
+            for k in 1..3 {
+                let (a, b) = (find(&mut parent, t[0]), find(&mut parent, t[k]));
+                if a != b {
+                    parent[a.max(b) as usize] = a.min(b);
+                }
+            }
+        }
+        let mut used = vec![false; self.vertices.len()];
+        for t in &self.triangles {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+        (0..self.vertices.len() as u32)
+            .filter(|&v| used[v as usize] && find(&mut parent, v) == v)
+            .count()
+    }
+
+    /// Closes every hole whose boundary loop spans at most `max_extent_mm` (the largest distance
+    /// between two of its vertices) with a fan of triangles about the loop's centroid, wound to
+    /// match the surface. Returns the number of holes closed. Only simple loops are closed (each
+    /// boundary vertex on one boundary edge in and one out); larger openings (a cup's rim, a cut
+    /// made on purpose) are left as they are.
+    pub fn fill_small_holes(&mut self, max_extent_mm: f64) -> usize {
+        // Directed edges of the triangles; a boundary edge has no reverse twin.
+        let mut directed: HashMap<(u32, u32), usize> = HashMap::new();
+        for tri in &self.triangles {
+            for k in 0..3 {
+                *directed.entry((tri[k], tri[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        let mut next: HashMap<u32, Vec<u32>> = HashMap::new();
+        let mut boundary: Vec<(u32, u32)> = directed
+            .keys()
+            .filter(|(a, b)| !directed.contains_key(&(*b, *a)))
+            .copied()
+            .collect();
+        boundary.sort_unstable();
+        for &(a, b) in &boundary {
+            next.entry(a).or_default().push(b);
+        }
+        let mut used: std::collections::HashSet<(u32, u32)> = Default::default();
+        let mut filled = 0;
+        for &(a0, b0) in &boundary {
+            if used.contains(&(a0, b0)) {
+                continue;
+            }
+            // Follow the boundary from a0 -> b0 until it returns to a0.
+            let mut lp = vec![a0];
+            let mut cur = (a0, b0);
+            let mut ok = true;
+            loop {
+                used.insert(cur);
+                let (_, b) = cur;
+                if b == a0 {
+                    break;
+                }
+                lp.push(b);
+                match next.get(&b).map(Vec::as_slice) {
+                    Some([c]) if !used.contains(&(b, *c)) && lp.len() <= 10_000 => cur = (b, *c),
+                    _ => {
+                        ok = false;
+                        break;
+                    }
+                }
+            }
+            if !ok || lp.len() < 3 {
+                continue;
+            }
+            let pts: Vec<Point3<f64>> = lp.iter().map(|&v| self.vertices[v as usize]).collect();
+            let extent = pts
+                .iter()
+                .flat_map(|p| pts.iter().map(move |q| (p - q).norm()))
+                .fold(0.0, f64::max);
+            if extent > max_extent_mm {
+                continue;
+            }
+            let centre =
+                Point3::from(pts.iter().map(|p| p.coords).sum::<Vector3<f64>>() / pts.len() as f64);
+            self.vertices.push(centre);
+            let c = (self.vertices.len() - 1) as u32;
+            // The surface runs a -> b along the loop; the patch runs the other way.
+            for i in 0..lp.len() {
+                let (a, b) = (lp[i], lp[(i + 1) % lp.len()]);
+                self.triangles.push([b, a, c]);
+            }
+            filled += 1;
+        }
+        filled
     }
 
     /// Applies `f` to every vertex.

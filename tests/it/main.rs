@@ -6,6 +6,7 @@ mod export;
 mod formats;
 mod geometry;
 mod planner;
+mod real_meshes;
 mod sim;
 mod thesis_table;
 mod tune;

@@ -1,0 +1,427 @@
+//! Real meshes (issue 13): several shells, open and perforated meshes, every principal axis.
+//! Each fixture is built here, written as STL, and run through the whole pipeline.
+
+use grasp_sim::mesh::{mass_properties, Mesh};
+use grasp_sim::plan::{Relaxation, RuleSet};
+use grasp_sim::report::RunReport;
+use grasp_sim::scenario::Scenario;
+use grasp_sim::slice::{slice, Plane};
+use grasp_sim::{run, RunOptions};
+use nalgebra::{Point3, Rotation3, Vector3};
+use std::f64::consts::TAU;
+
+type Tri = [Point3<f64>; 3];
+
+/// An axis-aligned box `[mm]`: centre and full sizes.
+pub fn cuboid(c: [f64; 3], size: [f64; 3]) -> Vec<Tri> {
+    let h = [size[0] / 2.0, size[1] / 2.0, size[2] / 2.0];
+    let p = |sx: f64, sy: f64, sz: f64| {
+        Point3::new(c[0] + sx * h[0], c[1] + sy * h[1], c[2] + sz * h[2])
+    };
+    let quads = [
+        [
+            p(-1., -1., -1.),
+            p(-1., 1., -1.),
+            p(1., 1., -1.),
+            p(1., -1., -1.),
+        ], // bottom, facing -z
+        [
+            p(-1., -1., 1.),
+            p(1., -1., 1.),
+            p(1., 1., 1.),
+            p(-1., 1., 1.),
+        ], // top
+        [
+            p(-1., -1., -1.),
+            p(1., -1., -1.),
+            p(1., -1., 1.),
+            p(-1., -1., 1.),
+        ], // -y
+        [
+            p(1., 1., -1.),
+            p(-1., 1., -1.),
+            p(-1., 1., 1.),
+            p(1., 1., 1.),
+        ], // +y
+        [
+            p(-1., 1., -1.),
+            p(-1., -1., -1.),
+            p(-1., -1., 1.),
+            p(-1., 1., 1.),
+        ], // -x
+        [
+            p(1., -1., -1.),
+            p(1., 1., -1.),
+            p(1., 1., 1.),
+            p(1., -1., 1.),
+        ], // +x
+    ];
+    quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect()
+}
+
+/// A closed cylinder about Z with `n` facets, bottom centre `c`.
+pub fn cylinder(c: [f64; 3], r: f64, h: f64, n: usize) -> Vec<Tri> {
+    let at = |k: usize, z: f64| {
+        let t = TAU * (k % n) as f64 / n as f64;
+        Point3::new(c[0] + r * t.cos(), c[1] + r * t.sin(), c[2] + z)
+    };
+    let (b, t) = (
+        Point3::new(c[0], c[1], c[2]),
+        Point3::new(c[0], c[1], c[2] + h),
+    );
+    let mut v = Vec::new();
+    for k in 0..n {
+        v.push([at(k, 0.0), at(k + 1, 0.0), at(k + 1, h)]);
+        v.push([at(k, 0.0), at(k + 1, h), at(k, h)]);
+        v.push([b, at(k + 1, 0.0), at(k, 0.0)]);
+        v.push([t, at(k, h), at(k + 1, h)]);
+    }
+    v
+}
+
+/// A tube about Z (inner and outer radius, height), `n` facets around and rings every
+/// `ring_mm`; the wall quads `(k, j)` (facet, ring) in `holes` are left out of both walls.
+pub fn perforated_tube(
+    ri: f64,
+    ro: f64,
+    h: f64,
+    n: usize,
+    ring_mm: f64,
+    holes: &[(usize, usize)],
+) -> Vec<Tri> {
+    let rings = (h / ring_mm).round() as usize;
+    let at = |r: f64, k: usize, j: usize| {
+        let t = TAU * (k % n) as f64 / n as f64;
+        Point3::new(r * t.cos(), r * t.sin(), j as f64 * h / rings as f64)
+    };
+    let mut v = Vec::new();
+    for k in 0..n {
+        for j in 0..rings {
+            if holes.contains(&(k, j)) {
+                continue;
+            }
+            v.push([at(ro, k, j), at(ro, k + 1, j), at(ro, k + 1, j + 1)]);
+            v.push([at(ro, k, j), at(ro, k + 1, j + 1), at(ro, k, j + 1)]);
+            v.push([at(ri, k, j), at(ri, k + 1, j + 1), at(ri, k + 1, j)]);
+            v.push([at(ri, k, j), at(ri, k, j + 1), at(ri, k + 1, j + 1)]);
+        }
+        // Annular bottom and top.
+        v.push([at(ri, k, 0), at(ro, k + 1, 0), at(ro, k, 0)]);
+        v.push([at(ri, k, 0), at(ri, k + 1, 0), at(ro, k + 1, 0)]);
+        v.push([at(ri, k, rings), at(ro, k, rings), at(ro, k + 1, rings)]);
+        v.push([at(ri, k, rings), at(ro, k + 1, rings), at(ri, k + 1, rings)]);
+    }
+    v
+}
+
+pub fn mesh(soup: &[Tri]) -> Mesh {
+    Mesh::from_triangles(soup).0
+}
+
+/// Writes `soup` as a binary STL and a scenario for it (no `[expect]`: `outcome = "hold"` is
+/// given only so that scenario parsing works on every branch) and runs it.
+pub fn run_soup(soup: &[Tri], sim: bool) -> RunReport {
+    let dir = tempfile::tempdir().unwrap();
+    let stl = dir.path().join("object.stl");
+    std::fs::write(&stl, mesh(soup).to_binary_stl()).unwrap();
+    let s = dir.path().join("object.toml");
+    std::fs::write(
+        &s,
+        format!(
+            "[object]\nmesh = \"{}\"\n[hand]\nfile = \"{}\"\n[expect]\noutcome = \"hold\"\n",
+            stl.display(),
+            crate::root().join("assets/hands/thesis.toml").display()
+        ),
+    )
+    .unwrap();
+    let scenario = Scenario::load(&s).unwrap();
+    run(
+        &scenario,
+        &RunOptions {
+            no_sim: !sim,
+            ..RunOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+fn rotate_z(soup: &[Tri], deg: f64) -> Vec<Tri> {
+    let r = Rotation3::from_axis_angle(&Vector3::z_axis(), deg.to_radians());
+    soup.iter().map(|t| t.map(|p| r * p)).collect()
+}
+
+#[test]
+fn overlapping_boxes_have_the_union_volume_and_one_contour() {
+    // Two 40 x 40 x 80 boxes, the second shifted 20 mm along X: the union is 60 x 40 x 80.
+    let mut soup = cuboid([0.0, 0.0, 40.0], [40.0, 40.0, 80.0]);
+    soup.extend(cuboid([20.0, 0.0, 40.0], [40.0, 40.0, 80.0]));
+    let m = mesh(&soup);
+    assert_eq!(m.shell_count(), 2);
+    let props = mass_properties(&m);
+    let want = 60.0 * 40.0 * 80.0;
+    let err = (props.volume_mm3 - want).abs() / want;
+    assert!(
+        err < 1e-3,
+        "union volume {} mm^3, expected {want} (sum of shells 256000)",
+        props.volume_mm3
+    );
+    assert!(
+        (props.centroid.x - 10.0).abs() < 0.05,
+        "centroid x {}",
+        props.centroid.x
+    );
+    // Inertia of the union about its centroid: a 60 x 40 x 80 block.
+    let izz = want * (60.0f64.powi(2) + 40.0f64.powi(2)) / 12.0;
+    assert!(
+        (props.inertia[(2, 2)] - izz).abs() / izz < 2e-3,
+        "Izz {} expected {izz}",
+        props.inertia[(2, 2)]
+    );
+    let s = slice(&m, &Plane::horizontal(40.0));
+    assert_eq!(s.contours.len(), 1, "{:?}", s.contours.len());
+    assert!((s.contours[0].signed_area() - 2400.0).abs() < 1e-6);
+    // The vertical slice through both boxes: one 60 x 80 outline, not two overlapping ones.
+    let v = slice(&m, &Plane::vertical(0.0));
+    assert_eq!(v.contours.len(), 1);
+    assert!((v.contours[0].signed_area() - 4800.0).abs() < 1e-6);
+}
+
+#[test]
+fn a_box_with_a_cylinder_pushed_half_in_is_one_solid() {
+    // A 60 x 60 x 30 box and a cylinder (r 15, 40 high) standing 20 mm deep in it.
+    let n = 144;
+    let mut soup = cuboid([0.0, 0.0, 15.0], [60.0, 60.0, 30.0]);
+    soup.extend(cylinder([0.0, 0.0, 10.0], 15.0, 40.0, n));
+    let m = mesh(&soup);
+    let facet_area = 0.5 * n as f64 * 15.0f64.powi(2) * (TAU / n as f64).sin();
+    let want = 60.0 * 60.0 * 30.0 + facet_area * 20.0;
+    let props = mass_properties(&m);
+    let err = (props.volume_mm3 - want).abs() / want;
+    assert!(err < 1e-3, "volume {} expected {want}", props.volume_mm3);
+    // Inside the box the cylinder adds nothing to the slice; above it the slice is the circle.
+    let s = slice(&m, &Plane::horizontal(20.0));
+    assert_eq!(s.contours.len(), 1);
+    assert!((s.contours[0].signed_area() - 3600.0).abs() < 1e-6);
+    let s = slice(&m, &Plane::horizontal(40.0));
+    assert_eq!(s.contours.len(), 1);
+    assert!((s.contours[0].signed_area() - facet_area).abs() < 1e-6);
+}
+
+#[test]
+fn a_mesh_with_one_missing_triangle_slices_closed_and_plans_as_whole() {
+    let whole = cylinder([0.0, 0.0, 0.0], 20.0, 124.0, 144);
+    // Leave out one side triangle (facet 10, lower half).
+    let mut holed = whole.clone();
+    holed.remove(40);
+    let m = mesh(&holed);
+    assert_eq!(m.topology().boundary_edges, 3);
+    for z in [10.0, 60.0, 110.0] {
+        let s = slice(&m, &Plane::horizontal(z));
+        assert!(
+            s.contours.iter().all(|c| c.is_closed),
+            "open slice at z {z}"
+        );
+        assert_eq!(s.contours.len(), 1);
+    }
+    let a = run_soup(&whole, false);
+    let b = run_soup(&holed, false);
+    assert_eq!(b.plan.status, "feasible", "{:?}", b.plan.reason);
+    assert_eq!(a.plan.grades.diameter, b.plan.grades.diameter);
+    let (ga, gb) = (a.plan.grasp.unwrap(), b.plan.grasp.unwrap());
+    assert_eq!(ga.elevation_index, gb.elevation_index);
+    assert_eq!(gb.rules, grasp_sim::plan::RuleSet::Thesis);
+}
+
+#[test]
+fn a_perforated_tube_keeps_its_elevations() {
+    // A 40/50 mm tube, 110 mm high, with a row of twelve 3 x 3 facet holes (6.5 x 7.3 mm,
+    // narrower than a 14 mm finger) through the wall at mid-height.
+    let (n, ring) = (72, 2.5);
+    let mut holes = Vec::new();
+    for h in 0..12 {
+        for dk in 0..3 {
+            for dj in 0..3 {
+                holes.push((h * 6 + dk, 21 + dj));
+            }
+        }
+    }
+    let whole = perforated_tube(20.0, 25.0, 110.0, n, ring, &[]);
+    let holed = perforated_tube(20.0, 25.0, 110.0, n, ring, &holes);
+    let m = mesh(&holed);
+    assert!(m.topology().boundary_edges > 0);
+    let a = run_soup(&whole, false);
+    let b = run_soup(&holed, false);
+    for a in &b.plan.axes {
+        println!(
+            "  {} {:?} {} {} {} {} {:?}",
+            a.axis_name,
+            a.rules,
+            a.indexed_elevations,
+            a.sorted_indices,
+            a.candidates_tried,
+            a.grasps_found,
+            a.reason
+        );
+    }
+    println!("{:?}", b.plan.rejections);
+    let graded = |r: &RunReport| {
+        r.plan
+            .grades
+            .combined
+            .iter()
+            .filter(|g| g.is_some())
+            .count()
+    };
+    assert_eq!(b.plan.indexed_elevations, a.plan.indexed_elevations);
+    assert_eq!(
+        graded(&b),
+        graded(&a),
+        "graded elevations: perforated {:?}\nwhole {:?}",
+        b.plan.grades.combined,
+        a.plan.grades.combined
+    );
+    assert_eq!(b.plan.status, "feasible", "{:?}", b.plan.reason);
+}
+
+#[test]
+fn a_box_is_feasible_whatever_its_turn_about_the_axis() {
+    // Issue 14: a 30 x 30 x 70 box was ungraspable turned 3 or 52.2 deg (the AngularStep grid
+    // never met its faces square); the flat faces' normals are now tried too.
+    let base = cuboid([0.0, 0.0, 35.0], [30.0, 30.0, 70.0]);
+    for deg in [0.0, 3.0, 5.0, 15.0, 30.0, 45.0, 52.2, 77.7] {
+        let r = run_soup(&rotate_z(&base, deg), false);
+        let g = r
+            .plan
+            .grasp
+            .unwrap_or_else(|| panic!("turned {deg} deg: {:?}", r.plan.reason));
+        assert_eq!(g.rules, grasp_sim::plan::RuleSet::Thesis, "turned {deg}");
+        println!(
+            "box turned {deg}: approach {} deg, index {}",
+            g.approach_angle_deg, g.elevation_index
+        );
+    }
+}
+
+fn soup_of(m: &Mesh) -> Vec<Tri> {
+    (0..m.triangles.len()).map(|t| m.corners(t)).collect()
+}
+
+fn check_names(r: &RunReport) -> Vec<String> {
+    r.plan
+        .grasps
+        .iter()
+        .filter_map(|g| g.check.as_ref().map(|c| c.verdict.clone()))
+        .collect()
+}
+
+#[test]
+fn a_flat_disc_is_wrapped_across_its_faces() {
+    // A 45 x 25 mm disc: its least moment is about a diameter (m (3 r^2 + h^2) / 12 = 179 m
+    // against m r^2 / 2 = 253 m about its own axis), so the thesis's axis already wraps the
+    // fingers across its faces and rim; it is 45 mm long there, shorter than the 50 mm between
+    // the outer fingers, so only the extended rules (outer fingers on its edges) find it. About
+    // its own axis it is 25 mm thick: the outer fingers, 25 mm above and below the middle one,
+    // are entirely off it, which no rule allows.
+    let disc = cylinder([0.0, 0.0, 0.0], 22.5, 25.0, 144);
+    let r = run_soup(&disc, true);
+    let g = r.plan.grasp.as_ref().expect("the disc gets a grasp");
+    assert_eq!(g.rules, RuleSet::Extended);
+    assert!(g
+        .relaxations
+        .contains(&Relaxation::OuterFingerBeyondElevation));
+    assert!(
+        g.axis[2].abs() < 1e-6,
+        "wrapped about a diameter, got axis {:?}",
+        g.axis
+    );
+    assert!(r
+        .plan
+        .axes
+        .iter()
+        .filter(|a| a.rules == RuleSet::Thesis)
+        .all(|a| a.grasps_found == 0));
+    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim.translation_mm);
+}
+
+#[test]
+fn a_60_mm_sphere_is_held_under_the_extended_rules() {
+    // No wall within 12 deg of vertical and 46 mm of effective elevation against the 50 mm
+    // between the outer fingers: the thesis rejects a ball everywhere, a hand wraps it.
+    let sphere = soup_of(&grasp_sim::objects::uv_sphere(30.0, 72));
+    let r = run_soup(&sphere, true);
+    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
+    let g = r.plan.grasp.as_ref().expect("the sphere gets a grasp");
+    assert_eq!(g.rules, RuleSet::Extended);
+    for rule in [
+        Relaxation::OuterFingerBeyondElevation,
+        Relaxation::CurvatureGraded,
+    ] {
+        assert!(
+            g.relaxations.contains(&rule),
+            "{rule:?} not in {:?}",
+            g.relaxations
+        );
+    }
+    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim.translation_mm);
+}
+
+#[test]
+fn a_rounded_figurine_is_held_under_the_extended_rules() {
+    // A solid of revolution like a figurine: a body and a head, 90 mm tall, 24 to 46 mm across,
+    // with no wall within the Vertical Deviation Range: graded by curvature, not rejected.
+    let profile: Vec<(f64, f64)> = (0..=60)
+        .map(|i| {
+            let z = i as f64 * 1.5;
+            let t = z / 90.0 * std::f64::consts::PI;
+            (
+                z,
+                2.0 * (12.0 + 9.0 * (2.0 * t).sin().abs() + 2.0 * t.sin()),
+            )
+        })
+        .collect();
+    let fig = soup_of(&grasp_sim::objects::revolved(&profile));
+    let r = run_soup(&fig, true);
+    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
+    let g = r.plan.grasp.as_ref().expect("the figurine gets a grasp");
+    assert_eq!(g.rules, RuleSet::Extended);
+    assert!(
+        g.relaxations.contains(&Relaxation::CurvatureGraded),
+        "{:?}",
+        g.relaxations
+    );
+    assert_eq!(
+        r.sim.verdict,
+        "hold",
+        "{:?} {:?}",
+        r.sim.translation_mm,
+        check_names(&r)
+    );
+}
+
+#[test]
+fn a_bar_with_bosses_is_held_with_the_palm_backed_off() {
+    // A 30 x 30 x 120 mm bar with a 12 mm boss on every face at mid-height: wherever the palm
+    // lands by the thesis's rule, a boss in a finger plane pokes into it. The palm stops at its
+    // first contact in every plane instead.
+    let mut bar = cuboid([0.0, 0.0, 60.0], [30.0, 30.0, 120.0]);
+    for (x, y) in [(1.0, 0.0), (-1.0, 0.0), (0.0, 1.0), (0.0, -1.0)] {
+        let size = [
+            if x != 0.0 { 8.0 } else { 12.0 },
+            if y != 0.0 { 8.0 } else { 12.0 },
+            12.0,
+        ];
+        bar.extend(cuboid([x * 18.0, y * 18.0, 60.0], size));
+    }
+    let r = run_soup(&bar, true);
+    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
+    let g = r.plan.grasp.as_ref().expect("the bar gets a grasp");
+    assert!(
+        g.relaxations.contains(&Relaxation::PalmBackedOff),
+        "{:?}",
+        g.relaxations
+    );
+    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim.translation_mm);
+}
