@@ -286,9 +286,7 @@ fn run_sim(
     if options.no_sim {
         return Ok((not_run("--no-sim"), None));
     }
-    let out = sim::check(&case);
-    let payload =
-        (options.payload && out.verdict == sim::Verdict::Hold).then(|| sim::payload_bracket(&case));
+    let (out, payload) = sim::check_with_payload(&case, options.payload);
     let poses = out.final_poses.clone();
     let report = SimReport {
         verdict: out.verdict.as_str().to_string(),

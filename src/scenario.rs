@@ -139,12 +139,27 @@ pub enum GravityMode {
     Six,
 }
 
+/// How the physics check runs the hold test (docs/SIM.md, "Protocols").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Protocol {
+    /// Close the hand once, branch a copy of the closed scene per gravity direction and payload
+    /// multiplier, end each direction as soon as its verdict can no longer change, and run the
+    /// directions in parallel.
+    Fast,
+    /// The reference: a fresh scene closed again for every direction and payload multiplier,
+    /// each direction held for the whole `duration_s`, one after another.
+    Full,
+}
+
 /// Physics check parameters (DESIGN.md section 5); used by the physics check.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SimParams {
     /// Gravity direction(s).
     pub gravity: GravityMode,
+    /// `fast` (default) or `full`, the reference protocol the fast one is compared with.
+    pub protocol: Protocol,
     /// Hold time per gravity direction `[s]`.
     pub duration_s: f64,
     /// Physics timestep `[s]`.
@@ -190,6 +205,7 @@ impl Default for SimParams {
     fn default() -> Self {
         SimParams {
             gravity: GravityMode::Down,
+            protocol: Protocol::Fast,
             duration_s: 2.0,
             timestep_s: 1.0 / 960.0,
             squeeze_deg: 10.0,
