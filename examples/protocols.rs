@@ -2,8 +2,11 @@
 //! `fast` (the default), and prints a Markdown table of their verdicts, numbers and wall times
 //! (docs/SIM.md, "Fast against full").
 //!
-//!     cargo run --release --example protocols -- [--six] [--payload] [--jsonl FILE] SCENARIO...
+//!     cargo run --release --example protocols -- [--six] [--payload] [--jsonl FILE]
+//!         [--set KEY=VALUE ...] [--only fast|full] SCENARIO...
 //!
+//! `--set` changes a `[sim]` key of every scenario (a TOML value: `--set timestep_s=0.002`),
+//! `--only` runs one protocol (then nothing is compared).
 //! Exits 1 if a verdict differs, a held object's translation differs by more than 0.5 mm and
 //! 10 %, or a payload margin differs by more than the search's 5 % step.
 
@@ -17,12 +20,27 @@ fn main() {
     let mut payload = false;
     let mut jsonl: Option<std::fs::File> = None;
     let mut files = Vec::new();
+    let mut sets: Vec<(String, toml::Value)> = Vec::new();
+    let mut only: Option<Protocol> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--six" => six = true,
             "--payload" => payload = true,
             "--jsonl" => jsonl = Some(std::fs::File::create(args.next().expect("FILE")).unwrap()),
+            "--set" => {
+                let kv = args.next().expect("KEY=VALUE");
+                let (k, v) = kv.split_once('=').expect("KEY=VALUE");
+                let v: toml::Table = toml::from_str(&format!("v = {v}")).expect("a TOML value");
+                sets.push((k.to_string(), v["v"].clone()));
+            }
+            "--only" => {
+                only = Some(match args.next().as_deref() {
+                    Some("fast") => Protocol::Fast,
+                    Some("full") => Protocol::Full,
+                    _ => panic!("--only fast|full"),
+                })
+            }
             _ => files.push(a),
         }
     }
@@ -38,7 +56,18 @@ fn main() {
     let mut failed = Vec::new();
     let (mut wall_full, mut wall_fast) = (0.0, 0.0);
     for f in &files {
-        let mut s = match Scenario::load(std::path::Path::new(f)) {
+        let path = std::path::Path::new(f);
+        let mut table: toml::Table =
+            toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        if !sets.is_empty() {
+            let sim = table
+                .entry("sim")
+                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+            for (k, v) in &sets {
+                sim.as_table_mut().unwrap().insert(k.clone(), v.clone());
+            }
+        }
+        let mut s = match Scenario::parse(&toml::to_string(&table).unwrap(), path) {
             Ok(s) => s,
             Err(e) => {
                 eprintln!("{f}: {e}");
@@ -61,6 +90,23 @@ fn main() {
             }
             r.sim
         };
+        if let Some(p) = only {
+            let r = by(p);
+            println!(
+                "| {} | {} | {:.3} | {:.3} | {:.2} | {} | {} |",
+                s.name,
+                r.verdict,
+                r.translation_mm.unwrap_or(f64::NAN),
+                r.rotation_deg.unwrap_or(f64::NAN),
+                r.directions
+                    .iter()
+                    .map(|d| d.decided_at_s)
+                    .fold(0.0f64, f64::max),
+                r.payload_margin.map_or("—".into(), |m| format!("{m:.2}x")),
+                r.wall_ms.map_or("".into(), |w| format!("{w:.0}")),
+            );
+            continue;
+        }
         let full = by(Protocol::Full);
         let fast = by(Protocol::Fast);
         if full.verdict == "not_run" {
@@ -110,7 +156,8 @@ fn main() {
 /// translations (of what is still in the hand) within 0.5 mm or 10 %; payload margins within
 /// the search's 5 % step either way.
 fn agree(full: &SimReport, fast: &SimReport) -> bool {
-    let close = |a: f64, b: f64| (a - b).abs() <= 0.5 || (a - b).abs() <= 0.1 * a.abs().max(b.abs());
+    let close =
+        |a: f64, b: f64| (a - b).abs() <= 0.5 || (a - b).abs() <= 0.1 * a.abs().max(b.abs());
     full.verdict == fast.verdict
         && full.directions.len() == fast.directions.len()
         && full

@@ -160,6 +160,12 @@ pub struct SimParams {
     pub gravity: GravityMode,
     /// `fast` (default) or `full`, the reference protocol the fast one is compared with.
     pub protocol: Protocol,
+    /// `fast` protocol: the window over which the object's motion relative to the palm is
+    /// measured before a direction can be decided `hold` early, and the least hold time `[s]`.
+    pub rest_window_s: f64,
+    /// `fast` protocol: the fastest motion of that window is projected to the end of the hold
+    /// at this many times its speed.
+    pub rest_safety: f64,
     /// Hold time per gravity direction `[s]`.
     pub duration_s: f64,
     /// Physics timestep `[s]`.
@@ -206,6 +212,8 @@ impl Default for SimParams {
         SimParams {
             gravity: GravityMode::Down,
             protocol: Protocol::Fast,
+            rest_window_s: 0.5,
+            rest_safety: 2.0,
             duration_s: 2.0,
             timestep_s: 1.0 / 960.0,
             squeeze_deg: 10.0,
@@ -437,6 +445,8 @@ impl Scenario {
             ("sim.finger_density_kg_m3", s.finger_density_kg_m3),
             ("sim.contact_stiffness_hz", s.contact_stiffness_hz),
             ("sim.open_margin_deg", s.open_margin_deg),
+            ("sim.rest_window_s", s.rest_window_s),
+            ("sim.rest_safety", s.rest_safety),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(invalid(key, format!("must be positive, got {v}")));

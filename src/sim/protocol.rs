@@ -101,34 +101,36 @@ pub struct SimOutcome {
 /// Standard gravity `[m/s²]`.
 const G: f64 = 9.81;
 
-/// The early-decision rule of the `fast` protocol (docs/SIM.md, "Deciding early"): its
-/// constants, in one place.
+/// The early-decision rule of the `fast` protocol (docs/SIM.md, "Deciding early").
 #[derive(Debug, Clone, Copy)]
 pub struct EarlyDecision {
-    /// The relative pose is sampled this often `[s]`.
+    /// The object's pose relative to the palm is sampled this often `[s]`.
     pub sample_s: f64,
-    /// No `rest` decision before this much of the hold has passed `[s]`.
-    pub min_hold_s: f64,
-    /// The window over which the motion's rate is measured `[s]`.
+    /// The window over which its motion is measured, and the least time held before a `rest`
+    /// decision `[s]`.
     pub window_s: f64,
-    /// The rate seen in the window is multiplied by this before it is projected to the end.
+    /// The fastest motion seen in the window is projected to the end of the hold at this many
+    /// times its speed.
     pub safety: f64,
-    /// The projected further motion must also stay below this `[mm]` and this `[deg]`, so the
-    /// numbers reported at the decision stay close to the full protocol's.
-    pub max_projected_mm: f64,
-    /// See `max_projected_mm` `[deg]`.
-    pub max_projected_deg: f64,
+    /// The projected further motion must also stay within what the numbers reported at the
+    /// decision may differ from the full protocol's: this `[mm]` ...
+    pub report_mm: f64,
+    /// ... or `[deg]` ...
+    pub report_deg: f64,
+    /// ... or this fraction of the value reported, whichever is larger.
+    pub report_fraction: f64,
 }
 
-impl Default for EarlyDecision {
-    fn default() -> Self {
+impl EarlyDecision {
+    /// The rule with the scenario's `rest_window_s` and `rest_safety`.
+    pub fn from_params(params: &SimParams) -> EarlyDecision {
         EarlyDecision {
             sample_s: 1.0 / 48.0,
-            min_hold_s: 0.25,
-            window_s: 0.25,
-            safety: 2.0,
-            max_projected_mm: 0.25,
-            max_projected_deg: 0.25,
+            window_s: params.rest_window_s,
+            safety: params.rest_safety,
+            report_mm: 0.5,
+            report_deg: 0.5,
+            report_fraction: 0.1,
         }
     }
 }
@@ -252,7 +254,7 @@ fn check_full(case: &Case) -> SimOutcome {
 /// direction on its own copy of the closed scene, decided early, in parallel.
 pub fn check_closed(closed: &Closed, case: &Case, k: f64, t0: Instant) -> SimOutcome {
     let params = case.params;
-    let rule = EarlyDecision::default();
+    let rule = EarlyDecision::from_params(params);
     let runs: Vec<(DirectionOutcome, usize, Vec<super::BodyPose>)> = directions(params.gravity)
         .into_par_iter()
         .map(|g| {
@@ -406,9 +408,9 @@ fn hold(
     scene.world.gravity = Vector::new(g.x as f32, g.y as f32, g.z as f32);
     let judged = |full: f64, tilt: f64| if is_revolution { tilt } else { full };
     let sample_every = early.map_or(usize::MAX, |r| ((r.sample_s / dt).round() as usize).max(1));
-    // Samples of (translation, judged orientation axis or rotation) for the rest rule.
+    // Samples of the object's pose relative to the palm, for the rest rule.
     let mut samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)> = Vec::new();
-    let mut decided: Option<(usize, &'static str, Vector3<f64>)> = None;
+    let mut decided: Option<Decision> = None;
     let mut steps = 0;
     while steps < hold_steps {
         scene.world.step();
@@ -420,55 +422,67 @@ fn hold(
         let (p, q) = relative(scene);
         samples.push((p, q));
         let remaining_s = (hold_steps - steps) as f64 * dt;
-        let held_s = steps as f64 * dt;
         // Drop: the object has left the hand's reach and its free flight never brings it back.
         if let Some(p_end) = out_of_reach(scene, g, params, hold_steps - steps) {
-            decided = Some((steps, "out_of_reach", p_end));
+            decided = Some(Decision::OutOfReach(steps, p_end));
             break;
         }
-        // Hold: at rest relative to the palm long enough that the motion still present,
-        // projected to the end of the hold, stays within the thresholds.
-        let window = (rule.window_s / rule.sample_s).round() as usize;
-        if held_s + 1e-9 >= rule.min_hold_s && samples.len() > window {
+        // Hold: the motion of the last window (its mean drift, and the spread of the poses
+        // about it), at `safety` times its size, continued to the end of the hold, keeps the
+        // object within the thresholds and the numbers reported now within what they may
+        // differ from the full protocol's.
+        let window = ((rule.window_s / (sample_every as f64 * dt)).round() as usize).max(1);
+        if samples.len() > window {
             let recent = &samples[samples.len() - window - 1..];
-            let interval = sample_every as f64 * dt;
-            let mut rate_mm = 0.0f64;
-            let mut rate_deg = 0.0f64;
-            for w in recent.windows(2) {
-                rate_mm = rate_mm.max((w[1].0 - w[0].0).norm() / interval);
-                let (full, tilt) = rotations(&w[0].1, &w[1].1);
-                rate_deg = rate_deg.max(judged(full, tilt) / interval);
+            let window_s = window as f64 * sample_every as f64 * dt;
+            let (first, last) = (recent[0], recent[window]);
+            let mut spread_mm = 0.0f64;
+            let mut spread_deg = 0.0f64;
+            for (i, a) in recent.iter().enumerate() {
+                for b in &recent[i + 1..] {
+                    spread_mm = spread_mm.max((a.0 - b.0).norm());
+                    let (full, tilt) = rotations(&a.1, &b.1);
+                    spread_deg = spread_deg.max(judged(full, tilt));
+                }
             }
-            let more_mm = rule.safety * rate_mm * remaining_s;
-            let more_deg = rule.safety * rate_deg * remaining_s;
+            let drift_mm = (last.0 - first.0).norm() / window_s;
+            let (full, tilt) = rotations(&first.1, &last.1);
+            let drift_deg = judged(full, tilt) / window_s;
             let (full, tilt) = rotations(&qc, &q);
             let now_mm = (p - pc).norm();
-            if more_mm <= rule.max_projected_mm
-                && more_deg <= rule.max_projected_deg
-                && now_mm + more_mm <= params.hold_translation_mm
-                && judged(full, tilt) + more_deg <= params.hold_rotation_deg
+            let now_deg = judged(full, tilt);
+            let more_mm = rule.safety * (drift_mm * remaining_s + spread_mm);
+            let more_deg = rule.safety * (drift_deg * remaining_s + spread_deg);
+            if now_mm + more_mm <= params.hold_translation_mm
+                && now_deg + more_deg <= params.hold_rotation_deg
+                && more_mm <= rule.report_mm.max(rule.report_fraction * now_mm)
+                && more_deg <= rule.report_deg.max(rule.report_fraction * now_deg)
             {
-                decided = Some((steps, "rest", p));
+                decided = Some(Decision::Rest(steps));
                 break;
             }
         }
     }
     let (pe, qe) = relative(scene);
     let (rotation_deg, tilt_deg) = rotations(&qc, &qe);
-    let judged_rotation = judged(rotation_deg, tilt_deg);
     let at_decision_mm = (pe - pc).norm();
-    let (decided_at_s, decided_by, translation_mm, in_contact) = match decided {
-        Some((n, "out_of_reach", p_end)) => {
-            (n as f64 * dt, "out_of_reach", (p_end - pc).norm(), false)
+    let mut translation_mm = at_decision_mm;
+    let mut in_contact = false;
+    let (decided_at_s, decided_by) = match decided {
+        Some(Decision::OutOfReach(n, p_end)) => {
+            translation_mm = (p_end - pc).norm();
+            (n as f64 * dt, "out_of_reach")
         }
-        Some((n, by, _)) => (n as f64 * dt, by, at_decision_mm, touches_hand(scene)),
-        None => (
-            hold_steps as f64 * dt,
-            "end",
-            at_decision_mm,
-            touches_hand(scene),
-        ),
+        Some(Decision::Rest(n)) => {
+            in_contact = touches_hand(scene);
+            (n as f64 * dt, "rest")
+        }
+        None => {
+            in_contact = touches_hand(scene);
+            (hold_steps as f64 * dt, "end")
+        }
     };
+    let judged_rotation = judged(rotation_deg, tilt_deg);
     let verdict = if decided_by == "out_of_reach" {
         Verdict::Drop
     } else if translation_mm <= params.hold_translation_mm
@@ -500,6 +514,15 @@ fn hold(
     )
 }
 
+/// How a direction was decided before the end of the hold.
+enum Decision {
+    /// Left the hand's reach for good at this step; where its free flight ends (palm frame)
+    /// `[mm]`.
+    OutOfReach(usize, Vector3<f64>),
+    /// At rest relative to the palm at this step.
+    Rest(usize),
+}
+
 /// If the object is out of the hand's reach and its free flight under `g` `[m/s²]` for the
 /// remaining `steps` keeps it out, its translation relative to the palm at the end of that
 /// flight (relative position, palm frame) `[mm]`; `None` otherwise.
@@ -524,8 +547,7 @@ fn out_of_reach(
     let palm_at = v3(palm.translation);
     let com0 = v3(obj.center_of_mass());
     let ip = &scene.world.integration_parameters;
-    let clearance =
-        scene.reach_m + scene.object_radius_m + f64::from(ip.prediction_distance());
+    let clearance = scene.reach_m + scene.object_radius_m + f64::from(ip.prediction_distance());
     if (com0 - palm_at).norm() <= clearance {
         return None;
     }
