@@ -6,15 +6,16 @@
 //!   triangles.
 //! - `plan/*`: the whole kinematic planner (align, stages 1–3, search) on each thesis object.
 //! - `plan_scaling/*`: the planner on the cup as AngularStep and HeightStep change.
-//! - `sim/*`: the physics check of the planned D40 grasp, `down` and `six`.
+//! - `sim/*`: the physics check of the planned D40 grasp: `down`, `six` and `payload` (fast
+//!   protocol), `full_down` and `full_six` (the full-length reference).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use grasp_sim::hand::Hand;
 use grasp_sim::mesh::{align, mass_properties};
 use grasp_sim::objects;
 use grasp_sim::plan::plan;
-use grasp_sim::scenario::{GravityMode, PlannerParams, SimParams};
-use grasp_sim::sim::{check, Case, ObjectShape, SimHand};
+use grasp_sim::scenario::{GravityMode, PlannerParams, Protocol, SimParams};
+use grasp_sim::sim::{check_with_payload, Case, ObjectShape, SimHand};
 use grasp_sim::slice::{slice, Plane};
 use std::collections::BTreeMap;
 use std::hint::black_box;
@@ -106,9 +107,19 @@ fn bench_sim(c: &mut Criterion) {
     let mass = 500.0 * mass_properties(&a.mesh).volume_mm3 * 1e-9;
     let mut g = c.benchmark_group("sim");
     g.sample_size(10);
-    for (name, gravity) in [("down", GravityMode::Down), ("six", GravityMode::Six)] {
+    // `down`, `six` and `payload` (the check and its payload search) under the default `fast`
+    // protocol; `full_down` and `full_six` are the full-length reference (the figures before
+    // issue 15).
+    for (name, gravity, protocol, payload) in [
+        ("down", GravityMode::Down, Protocol::Fast, false),
+        ("six", GravityMode::Six, Protocol::Fast, false),
+        ("payload", GravityMode::Down, Protocol::Fast, true),
+        ("full_down", GravityMode::Down, Protocol::Full, false),
+        ("full_six", GravityMode::Six, Protocol::Full, false),
+    ] {
         let params = SimParams {
             gravity,
+            protocol,
             ..SimParams::default()
         };
         g.bench_function(name, |b| {
@@ -120,7 +131,7 @@ fn bench_sim(c: &mut Criterion) {
                 friction: 0.3,
                 params: &params,
             };
-            b.iter(|| check(&case))
+            b.iter(|| check_with_payload(&case, payload))
         });
     }
     g.finish();

@@ -42,19 +42,26 @@ def main(argv):
     for line in run.stdout.splitlines():
         d = json.loads(line)
         rapier[d["scenario"]] = d["sim"]
-    print("| scenario | rapier | translation [mm] | rotation [deg] | MuJoCo | translation [mm] | rotation [deg] | agree |")
-    print("|---|---|---|---|---|---|---|---|")
+    print(
+        "| scenario | rapier | translation [mm] | rotation [deg] | MuJoCo | translation [mm] "
+        "| rotation [deg] | agree | rapier [ms] | MuJoCo [ms] | ratio |"
+    )
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     failed = []
     for name, sim in rapier.items():
         scene = out_dir / name
         if not (scene / "scene.xml").is_file():
-            print(f"| {name} | {sim['verdict']} | | | (no grasp to export) | | | |")
+            print(f"| {name} | {sim['verdict']} | | | (no grasp to export) | | | | | | |")
             continue
         m = mujoco_replay.replay(scene)
         agree = m["verdict"] == sim["verdict"]
+        # Wall times of the same check, in the same run: rapier's whole check (closing and every
+        # direction) against MuJoCo's simulation loop (no Python start-up, no model loading).
+        ratio = sim["wall_ms"] / m["wall_ms"] if m["wall_ms"] > 0 else float("nan")
         print(
             f"| {name} | {sim['verdict']} | {sim['translation_mm']:.2f} | {sim['rotation_deg']:.2f} "
-            f"| {m['verdict']} | {m['translation_mm']:.2f} | {m['rotation_deg']:.2f} | {'yes' if agree else 'no'} |"
+            f"| {m['verdict']} | {m['translation_mm']:.2f} | {m['rotation_deg']:.2f} | {'yes' if agree else 'no'} "
+            f"| {sim['wall_ms']:.1f} | {m['wall_ms']:.1f} | {ratio:.3f} |"
         )
         if name in required and not agree:
             failed.append(name)

@@ -337,12 +337,14 @@ fn run_sim(
         return Ok((not_run("--no-sim"), None));
     }
     // The candidate search already checked the chosen grasp: the same case, the same outcome.
-    let out = match done {
-        Some(out) => out,
-        None => sim::check(&case),
+    let (out, payload) = match done {
+        Some(out) => {
+            let payload = (options.payload && out.verdict == sim::Verdict::Hold)
+                .then(|| sim::payload_bracket(&case));
+            (out, payload)
+        }
+        None => sim::check_with_payload(&case, options.payload),
     };
-    let payload =
-        (options.payload && out.verdict == sim::Verdict::Hold).then(|| sim::payload_bracket(&case));
     let poses = out.final_poses.clone();
     let report = SimReport {
         verdict: out.verdict.as_str().to_string(),

@@ -141,12 +141,33 @@ pub enum GravityMode {
     Six,
 }
 
+/// How the physics check runs the hold test (docs/SIM.md, "Protocols").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Protocol {
+    /// Close the hand once, branch a copy of the closed scene per gravity direction and payload
+    /// multiplier, end each direction as soon as its verdict can no longer change, and run the
+    /// directions in parallel.
+    Fast,
+    /// The reference: a fresh scene closed again for every direction and payload multiplier,
+    /// each direction held for the whole `duration_s`, one after another.
+    Full,
+}
+
 /// Physics check parameters (DESIGN.md section 5); used by the physics check.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SimParams {
     /// Gravity direction(s).
     pub gravity: GravityMode,
+    /// `fast` (default) or `full`, the reference protocol the fast one is compared with.
+    pub protocol: Protocol,
+    /// `fast` protocol: the window over which the object's motion relative to the palm is
+    /// measured before a direction can be decided `hold` early, and the least hold time `[s]`.
+    pub rest_window_s: f64,
+    /// `fast` protocol: the fastest motion of that window is projected to the end of the hold
+    /// at this many times its speed.
+    pub rest_safety: f64,
     /// Hold time per gravity direction `[s]`.
     pub duration_s: f64,
     /// Physics timestep `[s]`.
@@ -195,6 +216,9 @@ impl Default for SimParams {
     fn default() -> Self {
         SimParams {
             gravity: GravityMode::Down,
+            protocol: Protocol::Fast,
+            rest_window_s: 0.5,
+            rest_safety: 2.0,
             duration_s: 2.0,
             timestep_s: 1.0 / 960.0,
             squeeze_deg: 10.0,
@@ -445,6 +469,8 @@ impl Scenario {
             ("sim.finger_density_kg_m3", s.finger_density_kg_m3),
             ("sim.contact_stiffness_hz", s.contact_stiffness_hz),
             ("sim.open_margin_deg", s.open_margin_deg),
+            ("sim.rest_window_s", s.rest_window_s),
+            ("sim.rest_safety", s.rest_safety),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(invalid(key, format!("must be positive, got {v}")));

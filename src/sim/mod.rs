@@ -29,7 +29,10 @@ pub mod convert;
 pub mod protocol;
 pub mod scene;
 
-pub use protocol::{check, payload_bracket, payload_margin, DirectionOutcome, SimOutcome, Verdict};
+pub use protocol::{
+    check, check_closed, check_with_payload, payload_bracket, payload_margin, Closed,
+    DirectionOutcome, EarlyDecision, SimOutcome, Verdict,
+};
 pub use scene::{Case, ObjectShape, SimHand};
 
 /// A body's pose: position `[m]` and orientation, aligned object frame.

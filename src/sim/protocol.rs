@@ -1,10 +1,18 @@
 //! The hold test: close, gravity on, hold, measure, judge.
+//!
+//! Two protocols (`[sim] protocol`, docs/SIM.md): `full`, the reference, builds and closes a
+//! fresh scene for every gravity direction and payload multiplier and holds each direction for
+//! the whole `duration_s`; `fast` (the default) closes once, continues every direction and
+//! payload multiplier from a copy of the closed scene ([`Scene::branch`]), ends a direction as
+//! soon as its verdict can no longer change ([`EarlyDecision`]), and runs the directions in
+//! parallel (each on its own copy, so the result does not depend on the number of threads).
 
 use super::convert;
 use super::scene::{build, Case, Scene};
-use crate::scenario::{GravityMode, SimParams};
-use nalgebra::Vector3;
+use crate::scenario::{GravityMode, Protocol, SimParams};
+use nalgebra::{UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
+use rayon::prelude::*;
 use std::time::Instant;
 
 /// The verdict of the hold test.
@@ -53,8 +61,19 @@ pub struct DirectionOutcome {
     pub joint_error_deg: f64,
     /// Per finger, the two joints' bend after closing minus the planned bend `[deg]`.
     pub joint_errors_deg: Vec<[f64; 2]>,
-    /// True if and only if the object touches the hand at the end.
+    /// True if and only if the object touches the hand at the end (at the decision, for a
+    /// direction decided early).
     pub in_contact: bool,
+    /// Time into the hold at which the verdict was decided `[s]`: `duration_s` when the
+    /// direction ran to the end.
+    pub decided_at_s: f64,
+    /// What decided it: `end` (ran the whole hold), `rest` (at rest relative to the palm, the
+    /// remaining motion cannot cross the thresholds) or `out_of_reach` (left the hand's reach
+    /// for good).
+    pub decided_by: &'static str,
+    /// Object translation relative to the palm at the decision `[mm]`. For `out_of_reach`,
+    /// `translation_mm` is this continued in free flight to the end of the hold.
+    pub translation_at_decision_mm: f64,
 }
 
 /// The physics check's result.
@@ -82,16 +101,43 @@ pub struct SimOutcome {
 /// Standard gravity `[m/s²]`.
 const G: f64 = 9.81;
 
-/// Runs the hold test for every gravity direction of `params.gravity`.
-///
-/// The rotation judged is the full rotation relative to the palm, except for an object that is
-/// (inertially) a body of revolution about its principal axis (`object.is_revolution`): a spin
-/// about that axis leaves it occupying the same space in the hand, so only the tilt of the axis
-/// counts.
-pub fn check(case: &Case) -> SimOutcome {
-    let params = case.params;
-    let t0 = Instant::now();
-    let directions: Vec<Vector3<f64>> = match params.gravity {
+/// The early-decision rule of the `fast` protocol (docs/SIM.md, "Deciding early").
+#[derive(Debug, Clone, Copy)]
+pub struct EarlyDecision {
+    /// The object's pose relative to the palm is sampled this often `[s]`.
+    pub sample_s: f64,
+    /// The window over which its motion is measured, and the least time held before a `rest`
+    /// decision `[s]`.
+    pub window_s: f64,
+    /// The fastest motion seen in the window is projected to the end of the hold at this many
+    /// times its speed.
+    pub safety: f64,
+    /// The projected further motion must also stay within what the numbers reported at the
+    /// decision may differ from the full protocol's: this `[mm]` ...
+    pub report_mm: f64,
+    /// ... or `[deg]` ...
+    pub report_deg: f64,
+    /// ... or this fraction of the value reported, whichever is larger.
+    pub report_fraction: f64,
+}
+
+impl EarlyDecision {
+    /// The rule with the scenario's `rest_window_s` and `rest_safety`.
+    pub fn from_params(params: &SimParams) -> EarlyDecision {
+        EarlyDecision {
+            sample_s: 1.0 / 48.0,
+            window_s: params.rest_window_s,
+            safety: params.rest_safety,
+            report_mm: 0.5,
+            report_deg: 0.5,
+            report_fraction: 0.1,
+        }
+    }
+}
+
+/// The gravity directions of `mode` (unit, aligned frame).
+fn directions(mode: GravityMode) -> Vec<Vector3<f64>> {
+    match mode {
         GravityMode::Down => vec![-Vector3::z()],
         GravityMode::Six => vec![
             Vector3::x(),
@@ -101,34 +147,149 @@ pub fn check(case: &Case) -> SimOutcome {
             Vector3::z(),
             -Vector3::z(),
         ],
-    };
+    }
+}
+
+/// Where the closing left the object, and how it got there.
+#[derive(Debug, Clone)]
+struct Closing {
+    /// Object translation relative to the palm at the start `[mm]`.
+    p0: Vector3<f64>,
+    /// ... and after closing `[mm]`.
+    pc: Vector3<f64>,
+    /// Object rotation relative to the palm after closing.
+    qc: UnitQuaternion<f64>,
+    /// Per finger, joint bend after closing minus the plan `[deg]`.
+    joint_errors_deg: Vec<[f64; 2]>,
+    /// Steps taken.
+    steps: usize,
+}
+
+/// A scene with the hand closed on the object and gravity still off: the state every gravity
+/// direction and payload multiplier of the `fast` protocol continues from.
+pub struct Closed {
+    scene: Scene,
+    closing: Closing,
+}
+
+impl Closed {
+    /// Builds the scene of `case` and closes the hand.
+    pub fn new(case: &Case) -> Closed {
+        let mut scene = build(case);
+        let closing = close(&mut scene, case.params);
+        Closed { scene, closing }
+    }
+
+    /// The steps the closing took.
+    pub fn steps(&self) -> usize {
+        self.closing.steps
+    }
+}
+
+/// Runs the hold test for every gravity direction of `params.gravity`, by `params.protocol`.
+///
+/// The rotation judged is the full rotation relative to the palm, except for an object that is
+/// (inertially) a body of revolution about its principal axis (`object.is_revolution`): a spin
+/// about that axis leaves it occupying the same space in the hand, so only the tilt of the axis
+/// counts.
+pub fn check(case: &Case) -> SimOutcome {
+    match case.params.protocol {
+        Protocol::Full => check_full(case),
+        Protocol::Fast => {
+            let t0 = Instant::now();
+            let closed = Closed::new(case);
+            check_closed(&closed, case, 1.0, t0)
+        }
+    }
+}
+
+/// The physics check and, if `payload`, the payload search of [`payload_bracket`] (only when
+/// the grasp holds), sharing one closing under the `fast` protocol.
+pub fn check_with_payload(case: &Case, payload: bool) -> (SimOutcome, Option<(f64, Option<f64>)>) {
+    match case.params.protocol {
+        Protocol::Full => {
+            let out = check_full(case);
+            let bracket = (payload && out.verdict == Verdict::Hold).then(|| payload_bracket(case));
+            (out, bracket)
+        }
+        Protocol::Fast => {
+            let t0 = Instant::now();
+            let closed = Closed::new(case);
+            let out = check_closed(&closed, case, 1.0, t0);
+            let bracket = (payload && out.verdict == Verdict::Hold).then(|| payload_bracket(case));
+            (out, bracket)
+        }
+    }
+}
+
+/// The `full` protocol: a fresh scene per direction, closed, held for the whole `duration_s`.
+fn check_full(case: &Case) -> SimOutcome {
+    let params = case.params;
+    let t0 = Instant::now();
     let mut outcomes = Vec::new();
     let mut steps = 0;
     let mut final_poses = Vec::new();
-    for g in directions {
+    for g in directions(params.gravity) {
         let mut scene = build(case);
-        let (o, n) = run_one(&mut scene, g, params, case.object.is_revolution);
+        let closing = close(&mut scene, params);
+        let (o, n) = hold(
+            &mut scene,
+            g,
+            params,
+            &closing,
+            case.object.is_revolution,
+            None,
+        );
         if final_poses.is_empty() {
-            let mut handles = vec![scene.palm];
-            for &(b1, b2, _, _) in &scene.fingers {
-                handles.push(b1);
-                handles.push(b2);
-            }
-            handles.push(scene.object);
-            final_poses = handles
-                .iter()
-                .map(|h| {
-                    let p = scene.world.bodies[*h].position();
-                    (
-                        convert::vector_mm(p.translation) * convert::M_PER_MM,
-                        convert::unit_quaternion(p.rotation),
-                    )
-                })
-                .collect();
+            final_poses = poses(&scene);
         }
         outcomes.push(o);
-        steps += n;
+        steps += closing.steps + n;
     }
+    summarise(outcomes, steps, params, t0, final_poses)
+}
+
+/// The `fast` protocol from a closed scene, with the object's mass multiplied by `k`: each
+/// direction on its own copy of the closed scene, decided early, in parallel.
+pub fn check_closed(closed: &Closed, case: &Case, k: f64, t0: Instant) -> SimOutcome {
+    let params = case.params;
+    let rule = EarlyDecision::from_params(params);
+    let runs: Vec<(DirectionOutcome, usize, Vec<super::BodyPose>)> = directions(params.gravity)
+        .into_par_iter()
+        .map(|g| {
+            let mut scene = closed.scene.branch();
+            if k != 1.0 {
+                scene.set_object_mass(case.mass_kg * k);
+            }
+            let (o, n) = hold(
+                &mut scene,
+                g,
+                params,
+                &closed.closing,
+                case.object.is_revolution,
+                Some(&rule),
+            );
+            (o, n, poses(&scene))
+        })
+        .collect();
+    let steps = closed.closing.steps + runs.iter().map(|r| r.1).sum::<usize>();
+    let final_poses = runs[0].2.clone();
+    summarise(
+        runs.into_iter().map(|r| r.0).collect(),
+        steps,
+        params,
+        t0,
+        final_poses,
+    )
+}
+
+fn summarise(
+    outcomes: Vec<DirectionOutcome>,
+    steps: usize,
+    params: &SimParams,
+    t0: Instant,
+    final_poses: Vec<super::BodyPose>,
+) -> SimOutcome {
     let worst = outcomes
         .iter()
         .max_by(|a, b| {
@@ -150,8 +311,28 @@ pub fn check(case: &Case) -> SimOutcome {
     }
 }
 
+/// The palm, phalanx 1 and 2 of each finger, then the object (aligned frame, metres).
+fn poses(scene: &Scene) -> Vec<super::BodyPose> {
+    let mut handles = vec![scene.palm];
+    for &(b1, b2, _, _) in &scene.fingers {
+        handles.push(b1);
+        handles.push(b2);
+    }
+    handles.push(scene.object);
+    handles
+        .iter()
+        .map(|h| {
+            let p = scene.world.bodies[*h].position();
+            (
+                convert::vector_mm(p.translation) * convert::M_PER_MM,
+                convert::unit_quaternion(p.rotation),
+            )
+        })
+        .collect()
+}
+
 /// The object's pose relative to the palm: (translation in mm, rotation).
-fn relative(scene: &Scene) -> (Vector3<f64>, nalgebra::UnitQuaternion<f64>) {
+fn relative(scene: &Scene) -> (Vector3<f64>, UnitQuaternion<f64>) {
     let palm = scene.world.bodies[scene.palm].position();
     let obj = scene.world.bodies[scene.object].position();
     let rel = palm.inverse() * *obj;
@@ -161,17 +342,11 @@ fn relative(scene: &Scene) -> (Vector3<f64>, nalgebra::UnitQuaternion<f64>) {
     )
 }
 
-fn run_one(
-    scene: &mut Scene,
-    gravity: Vector3<f64>,
-    params: &SimParams,
-    is_revolution: bool,
-) -> (DirectionOutcome, usize) {
+/// Closes the hand, gravity off: joint 1 first, joint 2 from halfway through the closing time.
+fn close(scene: &mut Scene, params: &SimParams) -> Closing {
     let dt = params.timestep_s;
     let close_steps = (params.close_duration_s / dt).round() as usize;
-    let hold_steps = (params.duration_s / dt).round() as usize;
-    let (p0, q0) = relative(scene);
-    // Joint 1 closes first; joint 2 follows halfway through the closing time.
+    let (p0, _) = relative(scene);
     for i in 0..close_steps {
         if i == close_steps / 2 {
             scene.release_joint2();
@@ -179,22 +354,18 @@ fn run_one(
         scene.world.step();
     }
     let (pc, qc) = relative(scene);
-    let joint_errors_deg = joint_errors(scene);
-    let joint_error_deg = joint_errors_deg
-        .iter()
-        .flatten()
-        .copied()
-        .fold(0.0f64, |w, e| if e.abs() > w.abs() { e } else { w });
-    let g = gravity * G;
-    scene.world.gravity = Vector::new(g.x as f32, g.y as f32, g.z as f32);
-    for _ in 0..hold_steps {
-        scene.world.step();
+    Closing {
+        p0,
+        pc,
+        qc,
+        joint_errors_deg: joint_errors(scene),
+        steps: close_steps,
     }
-    let (pe, qe) = relative(scene);
-    let translation_mm = (pe - pc).norm();
-    let rotation_deg = qc.angle_to(&qe).to_degrees();
-    let tilt_deg = (qc * Vector3::z()).angle(&(qe * Vector3::z())).to_degrees();
-    let in_contact = scene
+}
+
+/// True if and only if the object touches the hand.
+fn touches_hand(scene: &Scene) -> bool {
+    scene
         .world
         .narrow_phase
         .contact_pairs_with(scene.object_collider)
@@ -202,13 +373,118 @@ fn run_one(
             pair.has_any_active_contact()
                 && (scene.hand_colliders.contains(&pair.collider1)
                     || scene.hand_colliders.contains(&pair.collider2))
-        });
-    let judged_rotation = if is_revolution {
-        tilt_deg
-    } else {
-        rotation_deg
+        })
+}
+
+/// The object's judged rotation and its parts: (full rotation, tilt of the principal axis),
+/// both `[deg]`, relative to `qc`.
+fn rotations(qc: &UnitQuaternion<f64>, q: &UnitQuaternion<f64>) -> (f64, f64) {
+    let full = qc.angle_to(q).to_degrees();
+    let tilt = (qc * Vector3::z()).angle(&(q * Vector3::z())).to_degrees();
+    (full, tilt)
+}
+
+/// Turns gravity on along `gravity` and holds: to the end of `duration_s`, or with `early`
+/// until the verdict can no longer change. Returns the outcome and the steps taken.
+fn hold(
+    scene: &mut Scene,
+    gravity: Vector3<f64>,
+    params: &SimParams,
+    closing: &Closing,
+    is_revolution: bool,
+    early: Option<&EarlyDecision>,
+) -> (DirectionOutcome, usize) {
+    let dt = params.timestep_s;
+    let hold_steps = (params.duration_s / dt).round() as usize;
+    let Closing { p0, pc, qc, .. } = closing.clone();
+    let joint_errors_deg = closing.joint_errors_deg.clone();
+    let joint_error_deg = joint_errors_deg
+        .iter()
+        .flatten()
+        .copied()
+        .fold(0.0f64, |w, e| if e.abs() > w.abs() { e } else { w });
+    let g = gravity * G;
+    scene.world.gravity = Vector::new(g.x as f32, g.y as f32, g.z as f32);
+    let judged = |full: f64, tilt: f64| if is_revolution { tilt } else { full };
+    let sample_every = early.map_or(usize::MAX, |r| ((r.sample_s / dt).round() as usize).max(1));
+    // Samples of the object's pose relative to the palm, for the rest rule.
+    let mut samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)> = Vec::new();
+    let mut decided: Option<Decision> = None;
+    let mut steps = 0;
+    while steps < hold_steps {
+        scene.world.step();
+        steps += 1;
+        let Some(rule) = early else { continue };
+        if steps % sample_every != 0 {
+            continue;
+        }
+        let (p, q) = relative(scene);
+        samples.push((p, q));
+        let remaining_s = (hold_steps - steps) as f64 * dt;
+        // Drop: the object has left the hand's reach and its free flight never brings it back.
+        if let Some(p_end) = out_of_reach(scene, g, params, hold_steps - steps) {
+            decided = Some(Decision::OutOfReach(steps, p_end));
+            break;
+        }
+        // Hold: the motion of the last window (its mean drift, and the spread of the poses
+        // about it), at `safety` times its size, continued to the end of the hold, keeps the
+        // object within the thresholds and the numbers reported now within what they may
+        // differ from the full protocol's.
+        let window = ((rule.window_s / (sample_every as f64 * dt)).round() as usize).max(1);
+        if samples.len() > window {
+            let recent = &samples[samples.len() - window - 1..];
+            let window_s = window as f64 * sample_every as f64 * dt;
+            let (first, last) = (recent[0], recent[window]);
+            let mut spread_mm = 0.0f64;
+            let mut spread_deg = 0.0f64;
+            for (i, a) in recent.iter().enumerate() {
+                for b in &recent[i + 1..] {
+                    spread_mm = spread_mm.max((a.0 - b.0).norm());
+                    let (full, tilt) = rotations(&a.1, &b.1);
+                    spread_deg = spread_deg.max(judged(full, tilt));
+                }
+            }
+            let drift_mm = (last.0 - first.0).norm() / window_s;
+            let (full, tilt) = rotations(&first.1, &last.1);
+            let drift_deg = judged(full, tilt) / window_s;
+            let (full, tilt) = rotations(&qc, &q);
+            let now_mm = (p - pc).norm();
+            let now_deg = judged(full, tilt);
+            let more_mm = rule.safety * (drift_mm * remaining_s + spread_mm);
+            let more_deg = rule.safety * (drift_deg * remaining_s + spread_deg);
+            if now_mm + more_mm <= params.hold_translation_mm
+                && now_deg + more_deg <= params.hold_rotation_deg
+                && more_mm <= rule.report_mm.max(rule.report_fraction * now_mm)
+                && more_deg <= rule.report_deg.max(rule.report_fraction * now_deg)
+            {
+                decided = Some(Decision::Rest(steps));
+                break;
+            }
+        }
+    }
+    let (pe, qe) = relative(scene);
+    let (rotation_deg, tilt_deg) = rotations(&qc, &qe);
+    let at_decision_mm = (pe - pc).norm();
+    let mut translation_mm = at_decision_mm;
+    let mut in_contact = false;
+    let (decided_at_s, decided_by) = match decided {
+        Some(Decision::OutOfReach(n, p_end)) => {
+            translation_mm = (p_end - pc).norm();
+            (n as f64 * dt, "out_of_reach")
+        }
+        Some(Decision::Rest(n)) => {
+            in_contact = touches_hand(scene);
+            (n as f64 * dt, "rest")
+        }
+        None => {
+            in_contact = touches_hand(scene);
+            (hold_steps as f64 * dt, "end")
+        }
     };
-    let verdict = if translation_mm <= params.hold_translation_mm
+    let judged_rotation = judged(rotation_deg, tilt_deg);
+    let verdict = if decided_by == "out_of_reach" {
+        Verdict::Drop
+    } else if translation_mm <= params.hold_translation_mm
         && judged_rotation <= params.hold_rotation_deg
     {
         Verdict::Hold
@@ -217,7 +493,6 @@ fn run_one(
     } else {
         Verdict::Drop
     };
-    let _ = (p0, q0);
     (
         DirectionOutcome {
             gravity: [gravity.x, gravity.y, gravity.z],
@@ -230,9 +505,79 @@ fn run_one(
             joint_error_deg,
             joint_errors_deg,
             in_contact,
+            decided_at_s,
+            decided_by,
+            translation_at_decision_mm: at_decision_mm,
         },
-        close_steps + hold_steps,
+        steps,
     )
+}
+
+/// How a direction was decided before the end of the hold.
+enum Decision {
+    /// Left the hand's reach for good at this step; where its free flight ends (palm frame)
+    /// `[mm]`.
+    OutOfReach(usize, Vector3<f64>),
+    /// At rest relative to the palm at this step.
+    Rest(usize),
+}
+
+/// If the object is out of the hand's reach and its free flight under `g` `[m/s²]` for the
+/// remaining `steps` keeps it out, its translation relative to the palm at the end of that
+/// flight (relative position, palm frame) `[mm]`; `None` otherwise.
+///
+/// Out of reach: the sphere about the object's centre of mass that holds the object does not
+/// meet the sphere about the palm origin that holds the hand at any joint angle, with rapier's
+/// prediction distance to spare. Nothing else is in the scene, so out of reach the object flies
+/// freely: rapier's integration (per substep: velocity plus gravity, capped at the largest
+/// linear velocity, then position plus velocity) is continued here to the end of the hold, and
+/// the spheres must stay apart at every substep, with the distance one substep can travel to
+/// spare.
+fn out_of_reach(
+    scene: &Scene,
+    g: Vector3<f64>,
+    params: &SimParams,
+    steps: usize,
+) -> Option<Vector3<f64>> {
+    let bodies = &scene.world.bodies;
+    let palm = bodies[scene.palm].position();
+    let obj = &bodies[scene.object];
+    let v3 = |v: Vector| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z));
+    let palm_at = v3(palm.translation);
+    let com0 = v3(obj.center_of_mass());
+    let ip = &scene.world.integration_parameters;
+    let clearance = scene.reach_m + scene.object_radius_m + f64::from(ip.prediction_distance());
+    if (com0 - palm_at).norm() <= clearance {
+        return None;
+    }
+    if touches_hand(scene) {
+        return None;
+    }
+    let substeps = params.solver_iterations.max(1);
+    let h = params.timestep_s / substeps as f64;
+    let v_max = f64::from(ip.max_linear_velocity());
+    let mut v = v3(obj.linvel());
+    let mut x = com0;
+    for _ in 0..steps * substeps {
+        v += g * h;
+        let speed = v.norm();
+        if speed > v_max {
+            v *= v_max / speed;
+        }
+        x += v * h;
+        if (x - palm_at).norm() <= clearance + v_max.min(speed) * h {
+            return None;
+        }
+    }
+    // The body frame moves with the centre of mass (its rotation at the decision is kept).
+    let body_end = v3(obj.position().translation) + (x - com0);
+    let rel = palm.rotation.inverse()
+        * rapier3d::math::Vector::new(
+            (body_end.x - palm_at.x) as f32,
+            (body_end.y - palm_at.y) as f32,
+            (body_end.z - palm_at.z) as f32,
+        );
+    Some(convert::vector_mm(rel))
 }
 
 /// Per finger, each joint's bend minus its planned bend `[deg]`.
@@ -264,9 +609,18 @@ pub fn payload_margin(case: &Case) -> f64 {
 
 /// The payload search of [`payload_margin`], with the bracket it ends on: the largest
 /// multiplier seen to hold and the one seen to fail just above it (within 5 %), or `None` if
-/// the grasp held at 64×.
+/// the grasp held at 64×. Every multiplier builds and closes a fresh scene with the heavier
+/// object, under either protocol: continuing every multiplier from one closing with the
+/// scenario's mass was tried and gave other margins (chapter 4: 45× against 27×), because a
+/// heavier object, though weightless while the fingers close, resists their pushes and ends
+/// seated differently (docs/SIM.md).
 pub fn payload_bracket(case: &Case) -> (f64, Option<f64>) {
-    let holds = |k: f64| check(&case.heavier(k)).verdict == Verdict::Hold;
+    search(|k| check(&case.heavier(k)).verdict)
+}
+
+/// Doubling from 2× until `verdict` is not `hold` (or 64× holds), then bisection to 5 %.
+fn search(verdict: impl Fn(f64) -> Verdict) -> (f64, Option<f64>) {
+    let holds = |k: f64| verdict(k) == Verdict::Hold;
     let mut lo = 1.0;
     let mut hi = None;
     let mut k = 2.0;

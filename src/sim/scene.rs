@@ -106,9 +106,55 @@ pub struct Scene {
     motor_gains: (f32, f32),
     /// Torque that holds a locked joint 1 `[N·m]`.
     lock_torque: f32,
+    /// Radius about the palm origin of a sphere that holds every hand collider at any joint
+    /// angle `[m]`: nothing outside it can touch the hand.
+    pub reach_m: f64,
+    /// Radius about the object's centre of mass of a sphere that holds the object `[m]`.
+    pub object_radius_m: f64,
+}
+
+/// A copy of `w` that continues bit for bit as `w` would: every part of rapier's state, with
+/// fresh pipelines (they hold only workspace: rapier's docs, and its snapshot test restores
+/// into fresh ones; `tests/it/sim.rs` checks it for this scene).
+pub fn copy_world(w: &PhysicsWorld) -> PhysicsWorld {
+    PhysicsWorld {
+        gravity: w.gravity,
+        integration_parameters: w.integration_parameters,
+        physics_pipeline: PhysicsPipeline::new(),
+        collision_pipeline: CollisionPipeline::new(),
+        islands: w.islands.clone(),
+        broad_phase: w.broad_phase.clone(),
+        narrow_phase: w.narrow_phase.clone(),
+        bodies: w.bodies.clone(),
+        colliders: w.colliders.clone(),
+        impulse_joints: w.impulse_joints.clone(),
+        multibody_joints: w.multibody_joints.clone(),
+        soft_bodies: w.soft_bodies.clone(),
+        ccd_solver: w.ccd_solver.clone(),
+    }
 }
 
 impl Scene {
+    /// A copy of the scene in its present state, to continue from (a gravity direction, a
+    /// payload multiplier) while this one stays as it is.
+    pub fn branch(&self) -> Scene {
+        Scene {
+            world: copy_world(&self.world),
+            hand_colliders: self.hand_colliders.clone(),
+            fingers: self.fingers.clone(),
+            joint2: self.joint2.clone(),
+            joint1: self.joint1.clone(),
+            ..*self
+        }
+    }
+
+    /// Sets the object's mass `[kg]` (its inertia follows, at the same density distribution).
+    pub fn set_object_mass(&mut self, mass_kg: f64) {
+        if let Some(c) = self.world.colliders.get_mut(self.object_collider) {
+            c.set_mass(mass_kg as f32);
+        }
+    }
+
     /// Locks joint 1 where it stopped and lets joint 2 close to its target: thesis 3.6.2 fixes
     /// phalanx 1 before phalanx 2, and a Barrett finger (TorqueSwitch) closes joint 1 until it
     /// stalls, after which its worm drive, which cannot be back-driven, holds it while joint 2
@@ -403,6 +449,25 @@ pub fn build(case: &Case) -> Scene {
         object_body,
         &mut world.bodies,
     );
+    // Reach: the palm box's farthest corner, or a finger's joint 1 plus phalanx 1 plus the
+    // farthest point of phalanx 2 (or its tip) from joint 2, whichever is larger; the finger
+    // boxes are 2 × offset thick and wide.
+    let mut reach_mm = Vector3::new(
+        hand.palm.offset_mm,
+        hand.palm.half_width_mm,
+        z_lo.abs().max(z_hi.abs()),
+    )
+    .norm();
+    for f in &hand.finger_list {
+        let anchor = Vector3::new(hand.joints.setback_mm, hand.joints.lateral_mm, f.height_mm);
+        let finger = anchor.norm() + l1 + (l2 * l2 + 2.0 * o * o).sqrt();
+        reach_mm = reach_mm.max(finger);
+    }
+    let object_radius_m = {
+        let sphere = object.shape.compute_local_bounding_sphere();
+        let com = object.shape.mass_properties(1.0).local_com;
+        f64::from(sphere.radius() + (sphere.center() - com).length())
+    };
     Scene {
         world,
         palm,
@@ -417,5 +482,7 @@ pub fn build(case: &Case) -> Scene {
             params.motor_stiffness_nm_per_rad as f32,
             params.motor_damping_nms_per_rad as f32,
         ),
+        reach_m: reach_mm * convert::M_PER_MM,
+        object_radius_m,
     }
 }

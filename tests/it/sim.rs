@@ -187,8 +187,11 @@ fn a_cylinder_spinning_about_its_axis_is_judged_by_its_tilt() {
 
 #[test]
 fn payload_margin_is_found_by_bisection() {
+    // The full protocol: every multiplier is a fresh scene closed on the heavier object, so a
+    // fresh check at either end of the bracket repeats what the search saw.
     let path = crate::root().join("scenarios/cylinder_d60.toml");
-    let s = Scenario::load(&path).unwrap();
+    let mut s = Scenario::load(&path).unwrap();
+    s.sim.protocol = grasp_sim::scenario::Protocol::Full;
     let opts = RunOptions {
         payload: true,
         ..RunOptions::default()
@@ -214,4 +217,145 @@ fn payload_margin_is_found_by_bisection() {
     };
     assert_eq!(check(m), "hold");
     assert_ne!(check(failed), "hold");
+}
+
+/// The D40 cylinder's planned grasp as a physics case, for the tests of the protocol itself.
+fn d40_case<R>(
+    params: grasp_sim::scenario::SimParams,
+    f: impl FnOnce(&grasp_sim::sim::Case) -> R,
+) -> R {
+    use grasp_sim::sim::{Case, ObjectShape, SimHand};
+    let hand =
+        grasp_sim::hand::Hand::load(&crate::root().join("assets/hands/thesis.toml"), &[]).unwrap();
+    let mesh = grasp_sim::objects::cylinder(40.0, 124.0);
+    let aligned = grasp_sim::mesh::align(&mesh);
+    let (_, found) = grasp_sim::plan::plan(
+        &aligned.mesh,
+        &hand,
+        &grasp_sim::scenario::PlannerParams::default(),
+        0.3,
+        1,
+        &mut std::collections::BTreeMap::new(),
+    );
+    let pose = SimHand::from_grasp(&found.grasps[0]);
+    let volume = grasp_sim::mesh::mass_properties(&aligned.mesh).volume_mm3;
+    let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
+    f(&Case {
+        hand: &hand,
+        pose: &pose,
+        object: &shape,
+        mass_kg: 500.0 * volume * 1e-9,
+        friction: 0.3,
+        params: &params,
+    })
+}
+
+#[test]
+fn a_copied_scene_continues_bit_for_bit() {
+    // The fast protocol continues every gravity direction from a copy of the closed scene: the
+    // copy must go on exactly as the original would, every body's pose and velocity to the bit.
+    use grasp_sim::sim::scene::build;
+    let bits = |s: &grasp_sim::sim::scene::Scene| -> Vec<u32> {
+        let mut handles: Vec<_> = s.world.bodies.iter().map(|(h, _)| h).collect();
+        handles.sort_by_key(|h| h.into_raw_parts());
+        handles
+            .iter()
+            .flat_map(|h| {
+                let b = &s.world.bodies[*h];
+                let p = b.position();
+                let mut v = p.translation.to_array().to_vec();
+                v.extend(p.rotation.to_array());
+                v.extend(b.linvel().to_array());
+                v.extend(b.angvel().to_array());
+                v.into_iter().map(f32::to_bits).collect::<Vec<_>>()
+            })
+            .collect()
+    };
+    d40_case(Default::default(), |case| {
+        let mut original = build(case);
+        // Part of the closing, joint 2 released, then a copy.
+        for i in 0..300 {
+            if i == 240 {
+                original.release_joint2();
+            }
+            original.world.step();
+        }
+        let mut copy = original.branch();
+        for s in [&mut original.world, &mut copy.world] {
+            s.gravity = rapier3d::math::Vector::new(0.0, 0.0, -9.81);
+        }
+        for step in 0..400 {
+            original.world.step();
+            copy.world.step();
+            assert_eq!(
+                bits(&original),
+                bits(&copy),
+                "the copy diverged at step {step}"
+            );
+        }
+    });
+}
+
+#[test]
+fn directions_in_parallel_give_the_sequential_result() {
+    // Six gravity directions on one thread and on two: the same numbers to the bit.
+    let params = grasp_sim::scenario::SimParams {
+        gravity: grasp_sim::scenario::GravityMode::Six,
+        ..Default::default()
+    };
+    d40_case(params, |case| {
+        let on = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let out = pool.install(|| grasp_sim::sim::check(case));
+            (out.directions, out.steps, out.final_poses)
+        };
+        let one = on(1);
+        assert_eq!(one.0.len(), 6);
+        assert_eq!(one, on(2));
+    });
+}
+
+#[test]
+fn fast_and_full_protocols_agree_on_the_bundled_scenarios() {
+    // The fast protocol (close once, decide early) against the full-length reference: the
+    // same verdict in every direction, translations within 0.5 mm or 10 %.
+    use grasp_sim::scenario::Protocol;
+    let mut dir: Vec<_> = std::fs::read_dir(crate::root().join("scenarios"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
+        .collect();
+    dir.sort();
+    let mut compared = 0;
+    for path in dir {
+        let mut s = Scenario::load(&path).unwrap();
+        let mut by = |p| {
+            s.sim.protocol = p;
+            run(&s, &with_sim()).unwrap().sim
+        };
+        let full = by(Protocol::Full);
+        let fast = by(Protocol::Fast);
+        assert_eq!(full.verdict, fast.verdict, "{}", path.display());
+        if full.verdict == "not_run" {
+            continue;
+        }
+        for (a, b) in full.directions.iter().zip(&fast.directions) {
+            assert_eq!(a.verdict, b.verdict, "{}", path.display());
+            let d = (a.translation_mm - b.translation_mm).abs();
+            assert!(
+                d <= 0.5 || d <= 0.1 * a.translation_mm.abs(),
+                "{}: translation {} mm (full) against {} mm (fast)",
+                path.display(),
+                a.translation_mm,
+                b.translation_mm
+            );
+            assert!(b.decided_at_s <= a.decided_at_s);
+        }
+        assert!(fast.steps.unwrap() <= full.steps.unwrap());
+        compared += 1;
+    }
+    assert!(compared >= 10, "only {compared} scenarios checked");
 }
