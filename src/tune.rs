@@ -11,7 +11,7 @@
 //! produce is simulated once (its physics does not depend on how it was found).
 
 use crate::batch::{scenario_for, Item};
-use crate::mesh::{align, load_mesh, AlignedObject};
+use crate::mesh::{load_mesh, AlignedObject};
 use crate::plan::{self, Domain};
 use crate::scenario::{validate_planner, MassSpec, PlannerParams, Scenario};
 use crate::sim::{self, ObjectShape, SimHand, Verdict};
@@ -176,9 +176,62 @@ pub struct TuneResult {
 
 struct Prepared {
     scenario: Scenario,
+    /// The mesh as loaded (original frame), for planning on every axis.
+    mesh: crate::mesh::Mesh,
+    props: crate::mesh::MassProperties,
     aligned: AlignedObject,
     shape: ObjectShape,
     mass_kg: f64,
+}
+
+/// Simulated grasps by (axis, fingerprint): verdict, translation, payload margin of a hold, and
+/// the outcome.
+type SimCache =
+    HashMap<(crate::mesh::GraspAxis, Vec<u64>), (Verdict, f64, Option<f64>, sim::SimOutcome)>;
+
+/// The object's collider about `a`'s axis (the thesis axis's is prepared; others made once).
+fn shape_for(
+    p: &Prepared,
+    a: &AlignedObject,
+    shapes: &std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>>,
+) -> ObjectShape {
+    if a.axis == p.aligned.axis {
+        return p.shape.clone();
+    }
+    shapes
+        .borrow_mut()
+        .entry(a.axis)
+        .or_insert_with(|| ObjectShape::from_mesh(&a.mesh, p.props.volume_mm3))
+        .clone()
+}
+
+/// The physics check of a pose (and its payload margin when it holds), cached by `key`.
+fn simulate(
+    p: &Prepared,
+    pose: &SimHand,
+    shape: &ObjectShape,
+    key: (crate::mesh::GraspAxis, Vec<u64>),
+    sims: &mut SimCache,
+    counters: &mut TuneCounters,
+) -> (Verdict, f64, Option<f64>, sim::SimOutcome) {
+    if let Some(o) = sims.get(&key) {
+        counters.sim_reused += 1;
+        return o.clone();
+    }
+    let case = sim::Case {
+        hand: &p.scenario.hand,
+        pose,
+        object: shape,
+        mass_kg: p.mass_kg,
+        friction: p.scenario.object.friction,
+        params: &p.scenario.sim,
+    };
+    let out = sim::check(&case);
+    counters.sim_runs += 1;
+    let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
+    let o = (out.verdict, out.translation_mm, margin, out);
+    sims.insert(key, o.clone());
+    o
 }
 
 /// What identifies a grasp for the physics check: its palm pose and joint angles, bit for bit.
@@ -214,7 +267,8 @@ pub fn tune(
     for item in items {
         let scenario = scenario_for(item, template)?;
         let loaded = load_mesh(&scenario.object.mesh, scenario.object.units)?;
-        let aligned = align(&loaded.mesh);
+        let props = crate::mesh::mass_properties(&loaded.mesh);
+        let aligned = crate::mesh::align_with(&loaded.mesh, &props, crate::mesh::GraspAxis::THESIS);
         let volume = aligned.original.volume_mm3;
         let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
         let mass_kg = match scenario.object.mass {
@@ -223,6 +277,8 @@ pub fn tune(
         };
         prepared.push(Prepared {
             scenario,
+            mesh: loaded.mesh,
+            props,
             aligned,
             shape,
             mass_kg,
@@ -305,7 +361,9 @@ fn run_object(
 ) -> PerObject {
     let mut counters = TuneCounters::default();
     let mut domains: HashMap<(u64, u64), Domain> = HashMap::new();
-    let mut sims: HashMap<Vec<u64>, (Verdict, f64, Option<f64>)> = HashMap::new();
+    let mut sims: SimCache = HashMap::new();
+    let shapes: std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>> =
+        Default::default();
     let hand = &p.scenario.hand;
     let friction = p.scenario.object.friction;
     let mut results = Vec::with_capacity(settings.len());
@@ -325,86 +383,102 @@ fn run_object(
             });
             continue;
         }
-        let key = (
-            params.angular_step_deg.to_bits(),
-            params.height_step_mm.to_bits(),
-        );
-        let domain = domains
-            .entry(key)
-            .or_insert_with(|| {
-                counters.domains_built += 1;
-                Domain::build(&p.aligned.mesh, &params, hand)
-            })
-            .clone();
-        let mut t = BTreeMap::new();
-        let graded = plan::grade_built(domain, hand, &params, friction, &mut t);
         let s = &p.scenario.sim;
         // A scenario that fixes the joint angles (`[sim] override_angles`) is checked with them,
         // as `grasp-sim scenario.toml` does: its outcome does not depend on the planner.
-        let (status, poses) = if let Some(angles) = &s.override_angles {
-            match crate::override_pose(&p.aligned.mesh, hand, &graded, s, angles) {
-                Ok(pose) => ("override_angles", vec![pose]),
-                Err(_) => ("override_angles", Vec::new()),
-            }
-        } else {
-            let found = plan::search::search(&p.aligned.mesh, hand, &graded, &params, candidates);
-            counters.plans += 1;
-            let poses: Vec<SimHand> = found.grasps.iter().map(SimHand::from_grasp).collect();
-            (
-                if poses.is_empty() {
-                    "ungraspable"
-                } else {
-                    "feasible"
-                },
-                poses,
-            )
-        };
-        if poses.is_empty() {
+        if let Some(angles) = &s.override_angles {
+            let key = (
+                params.angular_step_deg.to_bits(),
+                params.height_step_mm.to_bits(),
+            );
+            let domain = domains
+                .entry(key)
+                .or_insert_with(|| {
+                    counters.domains_built += 1;
+                    Domain::build(&p.aligned.mesh, &params, hand)
+                })
+                .clone();
+            let mut t = BTreeMap::new();
+            let graded = plan::grade_built(domain, hand, &params, friction, &mut t);
+            let pose = crate::override_pose(&p.aligned.mesh, hand, &graded, s, angles);
+            let outcome = pose.ok().map(|pose| {
+                let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
+                simulate(p, &pose, &p.shape, key, &mut sims, &mut counters)
+            });
             results.push(ObjectResult {
                 scenario: name,
-                status: status.to_string(),
+                status: "override_angles".to_string(),
+                verdict: outcome
+                    .as_ref()
+                    .map_or("not_run", |o| o.0.as_str())
+                    .to_string(),
+                translation_mm: outcome.as_ref().map(|o| o.1),
+                payload_margin: outcome.as_ref().and_then(|o| o.2),
+            });
+            continue;
+        }
+        // As a run plans and chooses (every axis, the extended rules when the thesis's find
+        // nothing, candidates checked until one holds): the grasp a setting leads to. A grasp
+        // two settings share is simulated once.
+        let sims_cell = std::cell::RefCell::new(std::mem::take(&mut sims));
+        let counters_cell = std::cell::RefCell::new(std::mem::take(&mut counters));
+        let check = |a: &AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
+            let pose = SimHand::from_grasp(g);
+            let shape = shape_for(p, a, &shapes);
+            let key = (a.axis, fingerprint(&pose));
+            let o = simulate(
+                p,
+                &pose,
+                &shape,
+                key,
+                &mut sims_cell.borrow_mut(),
+                &mut counters_cell.borrow_mut(),
+            );
+            sim::SimOutcome {
+                verdict: o.0,
+                translation_mm: o.1,
+                ..o.3.clone()
+            }
+        };
+        let mut t = BTreeMap::new();
+        let selection = crate::select::select(
+            &p.mesh,
+            &p.props,
+            &crate::select::SelectParams {
+                hand,
+                planner: &params,
+                friction,
+                collect: candidates,
+                max_checked: Some(s.max_checked.max(1)),
+                check: &check,
+            },
+            &mut t,
+        );
+        sims = sims_cell.into_inner();
+        counters = counters_cell.into_inner();
+        counters.plans += 1;
+        let chosen = selection.chosen().and_then(|c| {
+            let a = &selection.axes[c.axis_plan].aligned;
+            let pose = SimHand::from_grasp(&c.grasp);
+            sims.get(&(a.axis, fingerprint(&pose))).cloned()
+        });
+        let Some(best) = chosen else {
+            results.push(ObjectResult {
+                scenario: name,
+                status: if selection.chosen.is_some() {
+                    "feasible"
+                } else {
+                    "ungraspable"
+                }
+                .to_string(),
                 verdict: "not_run".to_string(),
                 translation_mm: None,
                 payload_margin: None,
             });
             continue;
-        }
-        // The best of the candidates by simulation: hold before slip before drop, then the
-        // smaller translation; the first in search order on a tie.
-        let mut best: Option<(Verdict, f64, Option<f64>)> = None;
-        for pose in &poses {
-            let key = fingerprint(pose);
-            let outcome = match sims.get(&key) {
-                Some(o) => {
-                    counters.sim_reused += 1;
-                    *o
-                }
-                None => {
-                    let case = sim::Case {
-                        hand,
-                        pose,
-                        object: &p.shape,
-                        mass_kg: p.mass_kg,
-                        friction,
-                        params: s,
-                    };
-                    let out = sim::check(&case);
-                    counters.sim_runs += 1;
-                    let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
-                    let o = (out.verdict, out.translation_mm, margin);
-                    sims.insert(key, o);
-                    o
-                }
-            };
-            let better = match best {
-                None => true,
-                Some(b) => (outcome.0, outcome.1) < (b.0, b.1),
-            };
-            if better {
-                best = Some(outcome);
-            }
-        }
-        let (verdict, translation, margin) = best.expect("at least one grasp");
+        };
+        let status = "feasible";
+        let (verdict, translation, margin) = (best.0, best.1, best.2);
         results.push(ObjectResult {
             scenario: name,
             status: status.to_string(),
