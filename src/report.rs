@@ -99,6 +99,9 @@ pub struct PlanReport {
     pub grasps: Vec<GraspReport>,
     /// Candidates the physics check ran on, in search order until one held.
     pub candidates_checked: usize,
+    /// Vertical slices (of the axis reported) with a contour that stays open after its ends
+    /// were joined: an open mesh's gaps wider than the joining tolerance.
+    pub open_slices: usize,
     /// Each principal axis and rule set the planner tried, in order.
     pub axes: Vec<AxisReport>,
     /// Per-stage wall times `[ms]`.

@@ -288,7 +288,7 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
     // A closed single-shell mesh never takes this path, so its slices are exactly the cut.
     let mut repaired = false;
     if contours.iter().any(|c| !c.is_closed) {
-        let tol = join_tolerance(mesh, segments.iter().map(|s| s.triangle));
+        let tol = join_tolerance(&contours);
         repaired = join_open(&mut contours, tol);
     }
     if repaired || has_overlapping_outers(&contours) {
@@ -414,23 +414,28 @@ impl Contour {
     }
 }
 
-/// How far apart two open ends of a slice may be and still be joined `[mm]`: twice the median
-/// longest edge of the triangles the plane cut. A missing triangle leaves a gap no wider than
-/// its own edges, which are of the size of its neighbours'; a real opening (a cup's rim, a cut
-/// made on purpose) is many edges wide.
-fn join_tolerance(mesh: &Mesh, cut: impl Iterator<Item = usize>) -> f64 {
-    let mut longest: Vec<f64> = cut
-        .map(|t| {
-            let [a, b, c] = mesh.corners(t);
-            (b - a).norm().max((c - b).norm()).max((a - c).norm())
+/// How far apart two open ends of a slice may be and still be joined `[mm]`: twice the upper
+/// quartile of the slice's own segment lengths, the mesh's resolution in this plane (a quad cut
+/// through its diagonal gives one long and one short segment, hence the quartile rather than
+/// the median). A missing triangle leaves a gap about one segment long; a real opening (a cup's
+/// rim, a slot cut on purpose) is many segments wide. (A triangle's edges are no measure here: a
+/// cylinder's side triangles may be as tall as the object.)
+fn join_tolerance(contours: &[Contour]) -> f64 {
+    let mut lengths: Vec<f64> = contours
+        .iter()
+        .flat_map(|c| {
+            (0..c.segment_count()).map(move |i| {
+                let (a, b) = c.segment(i);
+                (b - a).norm()
+            })
         })
         .collect();
-    if longest.is_empty() {
+    if lengths.is_empty() {
         return 0.0;
     }
-    let mid = longest.len() / 2;
-    let (_, median, _) = longest.select_nth_unstable_by(mid, f64::total_cmp);
-    2.0 * *median
+    let q = (3 * lengths.len()) / 4;
+    let (_, quartile, _) = lengths.select_nth_unstable_by(q, f64::total_cmp);
+    2.0 * *quartile
 }
 
 /// Joins open contours end to start where an end lies within `tol` of a start (its own start
