@@ -27,6 +27,9 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 REAL = ROOT / "assets" / "real"
 BEGIN = "<!-- BEGIN GENERATED: scripts/real_objects_eval.py -->"
 END = "<!-- END GENERATED -->"
+# A run that takes longer than this is reported as a timeout (one object of the set, a book of
+# 33 shells, plans for minutes: see docs/REAL_OBJECTS.md).
+TIMEOUT_S = 300
 
 
 def scenario_text(path, gravity):
@@ -44,7 +47,10 @@ def run_one(binary, scenario, gravity, tmp, mjcf_dir):
     if mjcf_dir is not None:
         cmd[1:1] = ["--export-mjcf", str(mjcf_dir)]
     t0 = time.monotonic()
-    p = subprocess.run(cmd, capture_output=True, text=True)
+    try:
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT_S)
+    except subprocess.TimeoutExpired:
+        return {"error": f"timeout: no result within {TIMEOUT_S} s", "wall_s": TIMEOUT_S}
     wall = time.monotonic() - t0
     if p.returncode == 2 or not p.stdout.strip():
         return {"error": p.stderr.strip().splitlines()[-1] if p.stderr.strip() else "no output",
@@ -56,7 +62,7 @@ def run_one(binary, scenario, gravity, tmp, mjcf_dir):
 
 def summary_of(r):
     if "error" in r:
-        return {"status": "error", "reason": r["error"]}
+        return {"status": "error", "reason": r["error"], "verdict": "not_run", "wall_s": r["wall_s"]}
     plan, sim = r["plan"], r["sim"]
     g = plan.get("grasp")
     out = {
@@ -125,8 +131,11 @@ def main():
         for name, r in results.items():
             scene = mjcf / name
             if r["down"].get("verdict") in ("hold", "slip", "drop") and (scene / "scene.xml").is_file():
-                m = mujoco_replay.replay(scene)
-                r["mujoco"] = {k: m[k] for k in ("verdict", "translation_mm", "rotation_deg")}
+                try:
+                    m = mujoco_replay.replay(scene)
+                    r["mujoco"] = {k: m[k] for k in ("verdict", "translation_mm", "rotation_deg")}
+                except Exception as e:  # noqa: BLE001 - a scene MuJoCo refuses is a finding
+                    r["mujoco"] = {"verdict": f"error: {str(e).splitlines()[0][:80]}"}
     (out / "results.json").write_text(json.dumps(results, indent=1, sort_keys=True))
     doc = table(results, a.no_mujoco)
     print(doc)
