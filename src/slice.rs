@@ -581,8 +581,10 @@ impl Slice {
     /// shrunk back, so concave corners get a fillet of that radius and convex ones stay). A
     /// finger cannot enter a perforation or a slot narrower than itself, so for the planner it
     /// is solid. A slice in one closed piece is returned unchanged.
-    pub fn bridged(&self, gap_mm: f64) -> Slice {
-        let mut contours = self.contours.clone();
+    pub fn bridged(self, gap_mm: f64) -> Slice {
+        let plane = self.plane;
+        let outermost = self.outermost;
+        let mut contours = self.contours;
         let joined = join_open(&mut contours, gap_mm);
         let pieces = contours
             .iter()
@@ -590,12 +592,16 @@ impl Slice {
             .count();
         if pieces < 2 || gap_mm.is_nan() || gap_mm <= 0.0 {
             return if joined {
-                finish(self.plane, union_closed(contours))
+                finish(plane, union_closed(contours))
             } else {
-                self.clone()
+                Slice {
+                    plane,
+                    contours,
+                    outermost,
+                }
             };
         }
-        finish(self.plane, close_gaps(contours, 0.5 * gap_mm))
+        finish(plane, close_gaps(contours, 0.5 * gap_mm))
     }
 }
 
