@@ -93,6 +93,7 @@ fn bench_plan(c: &mut Criterion) {
                         collect: 1,
                         max_checked: None,
                         check: &never,
+                        domains: None,
                     },
                     &mut t,
                 )

@@ -167,6 +167,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
                     .max(1),
             ),
             check: &check,
+            domains: None,
         },
         &mut timings,
     );

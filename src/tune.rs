@@ -362,6 +362,7 @@ fn run_object(
     let mut counters = TuneCounters::default();
     let mut domains: HashMap<(u64, u64), Domain> = HashMap::new();
     let mut sims: SimCache = HashMap::new();
+    let select_domains: crate::select::DomainCache = Default::default();
     let shapes: std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>> =
         Default::default();
     let hand = &p.scenario.hand;
@@ -451,11 +452,13 @@ fn run_object(
                 collect: candidates,
                 max_checked: Some(s.max_checked.max(1)),
                 check: &check,
+                domains: Some(&select_domains),
             },
             &mut t,
         );
         sims = sims_cell.into_inner();
         counters = counters_cell.into_inner();
+        counters.domains_built = domains.len() + select_domains.borrow().len();
         counters.plans += 1;
         let chosen = selection.chosen().and_then(|c| {
             let a = &selection.axes[c.axis_plan].aligned;
