@@ -104,9 +104,14 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         } else {
             grasp_sim::batch::Item::Scenario(path.clone())
         };
-        let report = match grasp_sim::batch::scenario_for(&item, &template)
-            .and_then(|s| run(&s, &options))
-        {
+        let report = match grasp_sim::batch::scenario_for(&item, &template).and_then(|s| {
+            let spinner = progress_spinner(&s, &options);
+            let r = run(&s, &options);
+            if let Some(b) = spinner {
+                b.finish_and_clear();
+            }
+            r
+        }) {
             Ok(r) => r,
             Err(e) => {
                 eprintln!("grasp-sim: error: {}", format!("{e:#}").replace('\n', " "));
@@ -128,6 +133,32 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         }
     }
     Ok(status)
+}
+
+/// A spinner with the elapsed time on stderr while one scenario runs, only when stderr is a
+/// terminal (piped or redirected output stays clean) and the run does the physics check (the
+/// plan alone takes milliseconds; `six` and `--payload` take seconds to tens of seconds).
+fn progress_spinner(s: &Scenario, options: &RunOptions) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if options.no_sim || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let mut what = vec!["planning".to_string(), "physics check".to_string()];
+    if s.sim.gravity == grasp_sim::scenario::GravityMode::Six {
+        what[1] = "physics check (gravity six)".to_string();
+    }
+    if options.payload {
+        what.push("payload search".to_string());
+    }
+    let b = indicatif::ProgressBar::new_spinner();
+    b.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    b.set_message(format!("{}: {}", s.name, what.join(", ")));
+    b.enable_steady_tick(std::time::Duration::from_millis(120));
+    b.tick();
+    Some(b)
 }
 
 /// Creates `dir` if needed and checks a file can be written in it.
@@ -168,6 +199,7 @@ fn tune(
     jobs: Option<usize>,
 ) -> anyhow::Result<u8> {
     use grasp_sim::{batch, tune};
+    use std::io::IsTerminal;
     let sweeps = params
         .iter()
         .map(|p| tune::parse_sweep(p).map_err(|m| anyhow::anyhow!("--param {m}")))
@@ -180,7 +212,36 @@ fn tune(
     check_writable_dir(out).context("--out")?;
     let jobs = jobs.unwrap_or_else(default_jobs).max(1);
     let t0 = std::time::Instant::now();
-    let result = tune::tune(&items, &template, &sweeps, candidates.max(1), jobs)?;
+    // A progress bar over objects x settings, on a terminal only (as batch's).
+    let total = items.len() * tune::grid(&sweeps).len();
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new(total as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} tune: {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b.set_message("loading objects");
+        b.tick();
+        b
+    });
+    let progress = |name: &str| {
+        if let Some(b) = &bar {
+            b.set_message(format!("{name} done at one setting"));
+            b.inc(1);
+        }
+    };
+    let result = tune::tune_with_progress(
+        &items,
+        &template,
+        &sweeps,
+        candidates.max(1),
+        jobs,
+        &progress,
+    );
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let result = result?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot create folder", out.display()))?;
     write_atomically(&out.join("tune.csv"), tune::to_csv(&result).as_bytes())?;

@@ -138,6 +138,66 @@ pub struct GraspReport {
     pub check: Option<CandidateCheck>,
 }
 
+impl GraspReport {
+    /// Returns true if and only if `other` is the same grasp: the same axis, rules, approach,
+    /// elevation, pitch and joint angles.
+    pub fn is_same_grasp(&self, other: &GraspReport) -> bool {
+        self.axis_name == other.axis_name
+            && self.rules == other.rules
+            && self.approach_angle_deg == other.approach_angle_deg
+            && self.elevation_index == other.elevation_index
+            && self.palm_pitch_deg == other.palm_pitch_deg
+            && self
+                .fingers
+                .iter()
+                .zip(&other.fingers)
+                .all(|(a, b)| a.theta1_deg == b.theta1_deg && a.theta2_deg == b.theta2_deg)
+    }
+
+    /// The grasp in one line: axis and rules (with relaxations), approach, elevation, pitch,
+    /// joint angles, and the physics check's verdict when it ran on this grasp.
+    pub fn one_line(&self) -> String {
+        let rules = match serde_json::to_value(self.rules) {
+            Ok(serde_json::Value::String(r)) => r,
+            _ => String::new(),
+        };
+        let relaxed: Vec<String> = self
+            .relaxations
+            .iter()
+            .filter_map(|r| match serde_json::to_value(r) {
+                Ok(serde_json::Value::String(r)) => Some(r),
+                _ => None,
+            })
+            .collect();
+        let rules = if relaxed.is_empty() {
+            rules
+        } else {
+            format!("{rules}: {}", relaxed.join(", "))
+        };
+        let thetas: Vec<String> = self
+            .fingers
+            .iter()
+            .map(|f| format!("{:.1}/{:.1}", f.theta1_deg, f.theta2_deg))
+            .collect();
+        let check = match &self.check {
+            Some(c) => format!(
+                "; check: {} ({:.2} mm, {:.2} deg)",
+                c.verdict, c.translation_mm, c.rotation_deg
+            ),
+            None => "; not checked".to_string(),
+        };
+        format!(
+            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{check}",
+            self.axis_name,
+            self.approach_angle_deg,
+            self.elevation_index,
+            self.elevation_mm,
+            fmt_signed(self.palm_pitch_deg, 1),
+            thetas.join(", ")
+        )
+    }
+}
+
 /// The physics check's verdict on one candidate grasp.
 #[derive(Debug, Clone, Serialize)]
 pub struct CandidateCheck {
@@ -360,11 +420,33 @@ impl RunReport {
             Some(r) => format!("{} ({r})", p.status),
             None => p.status.clone(),
         };
+        let checked = if p.candidates_checked > 0 {
+            format!(", {} checked", p.candidates_checked)
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             s,
-            "  Plan        {plan_line}; {} tried",
+            "  Plan        {plan_line}; {} tried{checked}",
             crate::batch::plural(p.candidates_tried, "candidate")
         );
+        if p.grasps.len() > 1 {
+            let _ = writeln!(
+                s,
+                "  Candidates  {} collected, in search order (* the one reported below):",
+                p.grasps.len()
+            );
+            for (k, g) in p.grasps.iter().enumerate() {
+                let chosen = p.grasp.as_ref().is_some_and(|c| c.is_same_grasp(g));
+                let _ = writeln!(
+                    s,
+                    "   {}{:>2}. {}",
+                    if chosen { "*" } else { " " },
+                    k + 1,
+                    g.one_line()
+                );
+            }
+        }
         if let Some(g) = &p.grasp {
             let _ = writeln!(s, "  Grasp Parameter Set:");
             let _ = writeln!(s, "    GraspCondition -> Passed");

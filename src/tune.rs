@@ -209,6 +209,22 @@ pub fn tune(
     candidates: usize,
     jobs: usize,
 ) -> Result<TuneResult, Error> {
+    tune_with_progress(items, template, sweeps, candidates, jobs, &|_| {})
+}
+
+/// [`tune`], calling `progress` with the object's scenario name each time one object is done at
+/// one setting (objects × settings calls in all, from the worker threads).
+///
+/// # Errors
+/// A bad scenario or mesh among the items.
+pub fn tune_with_progress(
+    items: &[Item],
+    template: &Scenario,
+    sweeps: &[Sweep],
+    candidates: usize,
+    jobs: usize,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<TuneResult, Error> {
     let settings = grid(sweeps);
     let mut prepared = Vec::new();
     for item in items {
@@ -231,7 +247,7 @@ pub fn tune(
     let work = || -> Vec<PerObject> {
         prepared
             .par_iter()
-            .map(|p| run_object(p, sweeps, &settings, candidates))
+            .map(|p| run_object(p, sweeps, &settings, candidates, progress))
             .collect()
     };
     let per_object = match rayon::ThreadPoolBuilder::new()
@@ -302,6 +318,7 @@ fn run_object(
     sweeps: &[Sweep],
     settings: &[Vec<f64>],
     candidates: usize,
+    progress: &(dyn Fn(&str) + Sync),
 ) -> PerObject {
     let mut counters = TuneCounters::default();
     let mut domains: HashMap<(u64, u64), Domain> = HashMap::new();
@@ -310,6 +327,9 @@ fn run_object(
     let friction = p.scenario.object.friction;
     let mut results = Vec::with_capacity(settings.len());
     for values in settings {
+        if !results.is_empty() {
+            progress(&p.scenario.name);
+        }
         let mut params = p.scenario.planner.clone();
         for (s, v) in sweeps.iter().zip(values) {
             apply(&mut params, &s.name, *v);
@@ -412,6 +432,9 @@ fn run_object(
             translation_mm: Some(translation),
             payload_margin: margin,
         });
+    }
+    if !results.is_empty() {
+        progress(&p.scenario.name);
     }
     PerObject { results, counters }
 }
