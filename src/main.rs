@@ -251,6 +251,23 @@ fn tune(
     )?;
     let plots = tune::plot(&result, out).map_err(|m| anyhow::anyhow!(m))?;
     print!("{}", tune::to_table(&result));
+    let invalid = result
+        .settings
+        .iter()
+        .filter(|s| s.invalid.is_some())
+        .count();
+    if invalid == result.settings.len() {
+        anyhow::bail!(
+            "--param: every setting is invalid, nothing to rank ({})",
+            result.settings[0].invalid.as_deref().unwrap_or("")
+        );
+    }
+    if invalid > 0 {
+        eprintln!(
+            "tune: {} invalid (not run, not ranked; the table says why)",
+            grasp_sim::batch::plural(invalid, "setting")
+        );
+    }
     let best = &result.settings[result.best];
     let setting: Vec<String> = sweeps
         .iter()
@@ -258,25 +275,31 @@ fn tune(
         .map(|(s, v)| format!("{}={v}", s.name))
         .collect();
     println!(
-        "best: {} (hold rate {:.3}, mean payload margin {:.2}, mean translation {} mm) over {} objects",
+        "best: {} (hold rate {:.3}, mean payload margin {:.2}, mean translation {} mm) over {}",
         setting.join(" "),
         best.hold_rate,
         best.mean_payload_margin,
-        best.mean_translation_mm.map_or("-".to_string(), |t| format!("{t:.2}")),
-        items.len()
+        best.mean_translation_mm
+            .map_or("-".to_string(), |t| format!("{t:.2}")),
+        batch::plural(items.len(), "object")
     );
     let c = &result.counters;
     eprintln!(
-        "tune: {} settings x {} objects in {:.1} s ({jobs} jobs); loaded {} objects, built {} domains, ran {} plans and {} physics checks ({} reused); wrote {}",
-        result.settings.len(),
-        items.len(),
+        "tune: {} x {} in {:.1} s ({}); loaded {}, built {}, ran {} and {} ({} reused); wrote {}",
+        batch::plural(result.settings.len(), "setting"),
+        batch::plural(items.len(), "object"),
         t0.elapsed().as_secs_f64(),
-        c.objects_loaded,
-        c.domains_built,
-        c.plans,
-        c.sim_runs,
+        batch::plural(jobs, "job"),
+        batch::plural(c.objects_loaded, "object"),
+        batch::plural(c.domains_built, "domain"),
+        batch::plural(c.plans, "plan"),
+        batch::plural(c.sim_runs, "physics check"),
         c.sim_reused,
-        plots.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+        plots
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     Ok(0)
 }
