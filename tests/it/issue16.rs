@@ -150,3 +150,91 @@ fn an_invalid_setting_is_ranked_below_none_of_the_valid_ones() {
     assert!(r.settings[0].invalid.is_some(), "{:?}", r.settings[0]);
     assert_eq!(r.best, 1);
 }
+
+#[test]
+fn a_mistyped_key_gets_a_did_you_mean() {
+    let dir = tempfile::tempdir().unwrap();
+    let cup = crate::root().join("assets/objects/cup.stl");
+    let write = |name: &str, text: String| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, text).unwrap();
+        p
+    };
+    let err = |p: &std::path::Path| {
+        let out = grasp_sim().arg(p).output().unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let mesh = cup.display();
+    // A scenario key, a section name, a hand-file key and an override key.
+    let p = write(
+        "a.toml",
+        format!("[object]\nmesh = \"{mesh}\"\ndensty_kg_m3 = 3\n"),
+    );
+    assert!(
+        err(&p).contains("did you mean `density_kg_m3`?"),
+        "{}",
+        err(&p)
+    );
+    let p = write("b.toml", format!("[object]\nmesh = \"{mesh}\"\n[planer]\n"));
+    assert!(err(&p).contains("did you mean `planner`?"), "{}", err(&p));
+    let hand = std::fs::read_to_string(crate::root().join("assets/hands/thesis.toml")).unwrap();
+    write(
+        "h.toml",
+        hand.replacen("\nmargin_mm = ", "\nmargn_mm = ", 1),
+    );
+    let p = write(
+        "c.toml",
+        format!("[object]\nmesh = \"{mesh}\"\n[hand]\nfile = \"h.toml\"\n"),
+    );
+    let e = err(&p);
+    assert!(
+        e.contains("h.toml: line ") && e.contains("did you mean `margin_mm`?"),
+        "{e}"
+    );
+    let p = write(
+        "d.toml",
+        format!(
+            "[object]\nmesh = \"{mesh}\"\n[hand]\noverrides = {{ \"phalanx_2.lenght_mm\" = 18.0 }}\n"
+        ),
+    );
+    assert!(
+        err(&p).contains("did you mean `phalanx_2.length_mm`?"),
+        "{}",
+        err(&p)
+    );
+    // Nothing near: no guess.
+    let p = write(
+        "e.toml",
+        format!("[object]\nmesh = \"{mesh}\"\ncolour = 3\n"),
+    );
+    assert!(!err(&p).contains("did you mean"), "{}", err(&p));
+}
+
+#[test]
+fn a_malformed_ascii_stl_names_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 x\nendloop\nendfacet\nendsolid\n",
+            "line 6 (`vertex 0 1 x`): expected `vertex x y z`",
+        ),
+        (
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n",
+            "line 6 (end of file): expected `vertex`",
+        ),
+        (
+            "\nsolid t\n  facet normal 0 0 1\n  outer lop\n",
+            "line 4 (`outer lop`): expected `outer loop`",
+        ),
+    ];
+    for (k, (text, needle)) in cases.iter().enumerate() {
+        let p = dir.path().join(format!("m{k}.stl"));
+        std::fs::write(&p, text).unwrap();
+        let out = grasp_sim().arg(&p).output().unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+}
