@@ -39,6 +39,11 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
             no_sim,
             payload,
         }) => {
+            if no_sim && payload {
+                eprintln!(
+                    "grasp-sim: warning: --payload is ignored with --no-sim (the payload search is part of the physics check)"
+                );
+            }
             let options = RunOptions {
                 no_sim,
                 payload,
@@ -92,6 +97,11 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
             check_writable_dir(d).context(flag)?;
         }
     }
+    if cli.no_sim && cli.payload {
+        eprintln!(
+            "grasp-sim: warning: --payload is ignored with --no-sim (the payload search is part of the physics check)"
+        );
+    }
     let mut template = grasp_sim::batch::default_template();
     template.object.units = parse_units(&cli.units);
     // Each input runs on its own: a bad one is reported on stderr and the others still run and
@@ -123,7 +133,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
             eprintln!("grasp-sim: warning: {w}");
         }
         if cli.json {
-            writeln!(out, "{}", serde_json::to_string(&report)?)?;
+            writeln!(out, "{}", grasp_sim::report::to_rounded_json(&report)?)?;
         } else {
             write!(out, "{}", report.summary())?;
         }
@@ -247,7 +257,7 @@ fn tune(
     write_atomically(&out.join("tune.csv"), tune::to_csv(&result).as_bytes())?;
     write_atomically(
         &out.join("tune.json"),
-        serde_json::to_string_pretty(&result)?.as_bytes(),
+        grasp_sim::report::to_rounded_json_pretty(&result)?.as_bytes(),
     )?;
     let plots = tune::plot(&result, out).map_err(|m| anyhow::anyhow!(m))?;
     print!("{}", tune::to_table(&result));
@@ -381,7 +391,7 @@ fn batch(
         let line = match r {
             Ok(rep) => {
                 not_met += usize::from(rep.expect.met == Some(false));
-                serde_json::to_string(rep)?
+                grasp_sim::report::to_rounded_json(rep)?
             }
             Err(e) => {
                 errors += 1;

@@ -748,7 +748,7 @@ fn build(
         }
         soup.push(corners);
     }
-    let (mut mesh, mut degenerate) = Mesh::from_triangles(&soup);
+    let (mut mesh, mut degenerate) = Mesh::from_triangles_welded(&soup);
     if mesh.triangles.is_empty() {
         return Err(MeshError::AllDegenerate {
             path: p(),

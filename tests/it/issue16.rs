@@ -238,3 +238,106 @@ fn a_malformed_ascii_stl_names_its_line() {
         assert_eq!(err.lines().count(), 1, "{err}");
     }
 }
+
+#[test]
+fn payload_without_the_physics_check_says_it_is_ignored() {
+    let out = succeed(grasp_sim().args(["scenarios/cup.toml", "--no-sim", "--payload"]));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--payload is ignored with --no-sim"), "{err}");
+    let out = succeed(grasp_sim().args(["scenarios/cup.toml", "--no-sim"]));
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("--payload"));
+}
+
+/// A closed box as ASCII STL in metres, one corner written as 1e-18 in some of its triangles
+/// and as 0 in the others.
+fn box_with_a_noisy_seam() -> String {
+    let (a, b, c) = (0.04f64, 0.05f64, 0.11f64);
+    let v = |i: usize, noisy: bool| -> [f64; 3] {
+        let p = [
+            if i & 1 == 1 { a } else { 0.0 },
+            if i & 2 == 2 { b } else { 0.0 },
+            if i & 4 == 4 { c } else { 0.0 },
+        ];
+        if i == 0 && noisy {
+            [1e-18, 1e-18, 0.0]
+        } else {
+            p
+        }
+    };
+    // Outward-wound quads of the box (corners by bit: x = 1, y = 2, z = 4).
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let mut s = String::from("solid box\n");
+    for (k, q) in quads.iter().enumerate() {
+        for tri in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+            s.push_str("facet normal 0 0 0\nouter loop\n");
+            for i in tri {
+                let p = v(i, k == 2);
+                s.push_str(&format!("vertex {:e} {:e} {:e}\n", p[0], p[1], p[2]));
+            }
+            s.push_str("endloop\nendfacet\n");
+        }
+    }
+    s.push_str("endsolid box\n");
+    s
+}
+
+#[test]
+fn a_seam_off_by_rounding_is_welded() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("box.stl");
+    std::fs::write(&p, box_with_a_noisy_seam()).unwrap();
+    let out = succeed(
+        grasp_sim()
+            .args(["--json", "--no-sim", "--units", "m"])
+            .arg(&p),
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["object"]["boundary_edges"], 0, "{}", v["object"]);
+    assert_eq!(v["object"]["triangles"], 12);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("boundary"), "{err}");
+    // Distinct vertices a file can tell apart stay apart: the thesis objects keep their counts.
+    let loaded = grasp_sim::mesh::load_mesh(
+        &crate::root().join("assets/objects/cup.stl"),
+        grasp_sim::mesh::LengthUnit::Mm,
+    )
+    .unwrap();
+    assert_eq!(loaded.topology.boundary_edges, 0);
+    assert_eq!(loaded.mesh.triangles.len(), 576);
+}
+
+#[test]
+fn json_figures_carry_no_float_noise() {
+    let out = succeed(grasp_sim().args(["--json", "--no-sim", "scenarios/chapter4.toml"]));
+    let text = String::from_utf8_lossy(&out.stdout);
+    // Every number outside strings has at most 12 significant digits and none is a tiny
+    // leftover of a cancellation (3.6e-16 mm) or a negative zero.
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    fn walk(v: &serde_json::Value, bad: &mut Vec<String>) {
+        match v {
+            serde_json::Value::Number(n) => {
+                if let Some(x) = n.as_f64().filter(|_| n.is_f64()) {
+                    let rounded = grasp_sim::report::round_significant(x, 12);
+                    if rounded != x || (x != 0.0 && x.abs() < 1e-10) || n.to_string() == "-0.0" {
+                        bad.push(n.to_string());
+                    }
+                }
+            }
+            serde_json::Value::Array(a) => a.iter().for_each(|x| walk(x, bad)),
+            serde_json::Value::Object(o) => o.values().for_each(|x| walk(x, bad)),
+            _ => {}
+        }
+    }
+    let mut bad = Vec::new();
+    walk(&v, &mut bad);
+    assert!(bad.is_empty(), "{bad:?}");
+    // Field order is the contract's (scenario first), not alphabetical.
+    assert!(text.starts_with("{\"scenario\":"), "{}", &text[..40]);
+}
