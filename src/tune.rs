@@ -129,6 +129,9 @@ pub struct ObjectResult {
     pub translation_mm: Option<f64>,
     /// Payload margin (held objects only).
     pub payload_margin: Option<f64>,
+    /// Why the setting is `invalid` for this object's hand.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 /// One setting's results and score.
@@ -144,6 +147,11 @@ pub struct SettingResult {
     pub mean_translation_mm: Option<f64>,
     /// Per object.
     pub objects: Vec<ObjectResult>,
+    /// Why the setting is invalid (it breaks a rule for an object's hand, e.g. a HeightStep
+    /// that does not divide the finger gap): such a setting is not run and not ranked, and its
+    /// scores are 0. Absent for a valid setting.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub invalid: Option<String>,
 }
 
 /// Counters that show which work was shared.
@@ -168,7 +176,7 @@ pub struct TuneResult {
     pub sweeps: Vec<Sweep>,
     /// Every setting, in grid order.
     pub settings: Vec<SettingResult>,
-    /// Index into `settings` of the best one.
+    /// Index into `settings` of the best valid one (0 when every setting is invalid).
     pub best: usize,
     /// Work counters.
     pub counters: TuneCounters,
@@ -262,6 +270,22 @@ pub fn tune(
     candidates: usize,
     jobs: usize,
 ) -> Result<TuneResult, Error> {
+    tune_with_progress(items, template, sweeps, candidates, jobs, &|_| {})
+}
+
+/// [`tune`], calling `progress` with the object's scenario name each time one object is done at
+/// one setting (objects × settings calls in all, from the worker threads).
+///
+/// # Errors
+/// A bad scenario or mesh among the items.
+pub fn tune_with_progress(
+    items: &[Item],
+    template: &Scenario,
+    sweeps: &[Sweep],
+    candidates: usize,
+    jobs: usize,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<TuneResult, Error> {
     let settings = grid(sweeps);
     let mut prepared = Vec::new();
     for item in items {
@@ -287,7 +311,7 @@ pub fn tune(
     let work = || -> Vec<PerObject> {
         prepared
             .par_iter()
-            .map(|p| run_object(p, sweeps, &settings, candidates))
+            .map(|p| run_object(p, sweeps, &settings, candidates, progress))
             .collect()
     };
     let per_object = match rayon::ThreadPoolBuilder::new()
@@ -317,6 +341,7 @@ pub fn tune(
         })
         .collect();
     let best = (0..results.len())
+        .filter(|&k| results[k].invalid.is_none())
         .min_by(|&a, &b| rank(&results[a], &results[b]).then(a.cmp(&b)))
         .unwrap_or(0);
     Ok(TuneResult {
@@ -340,6 +365,9 @@ pub fn rank(a: &SettingResult, b: &SettingResult) -> std::cmp::Ordering {
 }
 
 fn score(values: Vec<f64>, objects: Vec<ObjectResult>) -> SettingResult {
+    let invalid = objects
+        .iter()
+        .find_map(|o| o.reason.as_ref().map(|r| format!("{}: {r}", o.scenario)));
     let n = objects.len().max(1) as f64;
     let held: Vec<&ObjectResult> = objects.iter().filter(|o| o.verdict == "hold").collect();
     let mean_translation_mm = (!held.is_empty())
@@ -347,9 +375,15 @@ fn score(values: Vec<f64>, objects: Vec<ObjectResult>) -> SettingResult {
     SettingResult {
         values,
         hold_rate: held.len() as f64 / n,
-        mean_payload_margin: objects.iter().filter_map(|o| o.payload_margin).sum::<f64>() / n,
+        // Folded from +0.0: an empty f64 sum is -0.0, printed "-0.00".
+        mean_payload_margin: objects
+            .iter()
+            .filter_map(|o| o.payload_margin)
+            .fold(0.0, |a, m| a + m)
+            / n,
         mean_translation_mm,
         objects,
+        invalid,
     }
 }
 
@@ -358,6 +392,7 @@ fn run_object(
     sweeps: &[Sweep],
     settings: &[Vec<f64>],
     candidates: usize,
+    progress: &(dyn Fn(&str) + Sync),
 ) -> PerObject {
     let mut counters = TuneCounters::default();
     let mut domains: HashMap<(u64, u64), Domain> = HashMap::new();
@@ -369,18 +404,22 @@ fn run_object(
     let friction = p.scenario.object.friction;
     let mut results = Vec::with_capacity(settings.len());
     for values in settings {
+        if !results.is_empty() {
+            progress(&p.scenario.name);
+        }
         let mut params = p.scenario.planner.clone();
         for (s, v) in sweeps.iter().zip(values) {
             apply(&mut params, &s.name, *v);
         }
         let name = p.scenario.name.clone();
-        if validate_planner(&params, hand, friction).is_err() {
+        if let Err((key, why)) = validate_planner(&params, hand, friction) {
             results.push(ObjectResult {
                 scenario: name,
                 status: "invalid".to_string(),
                 verdict: "not_run".to_string(),
                 translation_mm: None,
                 payload_margin: None,
+                reason: Some(format!("{key} {why}")),
             });
             continue;
         }
@@ -477,6 +516,7 @@ fn run_object(
                 verdict: "not_run".to_string(),
                 translation_mm: None,
                 payload_margin: None,
+                reason: None,
             });
             continue;
         };
@@ -488,7 +528,11 @@ fn run_object(
             verdict: verdict.as_str().to_string(),
             translation_mm: Some(translation),
             payload_margin: margin,
+            reason: None,
         });
+    }
+    if !results.is_empty() {
+        progress(&p.scenario.name);
     }
     PerObject { results, counters }
 }
@@ -500,10 +544,19 @@ pub fn to_csv(r: &TuneResult) -> String {
         s.push_str(&sw.name);
         s.push(',');
     }
-    s.push_str("hold_rate,mean_payload_margin,mean_translation_mm,held,feasible,objects\n");
+    s.push_str("hold_rate,mean_payload_margin,mean_translation_mm,held,feasible,objects,invalid\n");
     for set in &r.settings {
         for v in &set.values {
             s.push_str(&format!("{v},"));
+        }
+        if let Some(why) = &set.invalid {
+            // Not run: no scores, only the reason (quoted, doubled quotes inside).
+            s.push_str(&format!(
+                ",,,,,{},\"{}\"\n",
+                set.objects.len(),
+                why.replace('"', "\"\"")
+            ));
+            continue;
         }
         let held = set.objects.iter().filter(|o| o.verdict == "hold").count();
         let feasible = set
@@ -512,7 +565,7 @@ pub fn to_csv(r: &TuneResult) -> String {
             .filter(|o| o.status == "feasible")
             .count();
         s.push_str(&format!(
-            "{:.6},{:.6},{},{held},{feasible},{}\n",
+            "{:.6},{:.6},{},{held},{feasible},{},\n",
             set.hold_rate,
             set.mean_payload_margin,
             set.mean_translation_mm
@@ -533,6 +586,10 @@ pub fn to_table(r: &TuneResult) -> String {
     for (k, set) in r.settings.iter().enumerate() {
         for v in &set.values {
             s.push_str(&format!("{v:>24} "));
+        }
+        if let Some(why) = &set.invalid {
+            s.push_str(&format!(" invalid, not ranked: {why}\n"));
+            continue;
         }
         s.push_str(&format!(
             " {:>9.3}  {:>14.2}  {:>16}{}\n",
@@ -562,7 +619,7 @@ pub fn plot(r: &TuneResult, dir: &std::path::Path) -> Result<Vec<std::path::Path
             .filter_map(|v| {
                 r.settings
                     .iter()
-                    .filter(|s| s.values[i] == *v)
+                    .filter(|s| s.values[i] == *v && s.invalid.is_none())
                     .min_by(|a, b| rank(a, b))
                     .map(|s| (*v, s.hold_rate, s.mean_payload_margin))
             })
