@@ -454,6 +454,7 @@ fn run_object(
                     .to_string(),
                 translation_mm: outcome.as_ref().map(|o| o.1),
                 payload_margin: outcome.as_ref().and_then(|o| o.2),
+                reason: None,
             });
             continue;
         }
