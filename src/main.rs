@@ -132,6 +132,12 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         for w in &report.warnings {
             eprintln!("grasp-sim: warning: {w}");
         }
+        if let Some(dir) = &options.report {
+            eprintln!(
+                "grasp-sim: report written to {}",
+                dir.join(&report.scenario).join("report.html").display()
+            );
+        }
         if cli.json {
             writeln!(out, "{}", grasp_sim::report::to_rounded_json(&report)?)?;
         } else {

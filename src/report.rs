@@ -157,9 +157,8 @@ impl GraspReport {
                 .all(|(a, b)| a.theta1_deg == b.theta1_deg && a.theta2_deg == b.theta2_deg)
     }
 
-    /// The grasp in one line: axis and rules (with relaxations), approach, elevation, pitch,
-    /// joint angles, and the physics check's verdict when it ran on this grasp.
-    pub fn one_line(&self) -> String {
+    /// The rules in words: `thesis`, or `extended: ` and the relaxations used.
+    pub fn one_line_rules(&self) -> String {
         let rules = match serde_json::to_value(self.rules) {
             Ok(serde_json::Value::String(r)) => r,
             _ => String::new(),
@@ -172,11 +171,17 @@ impl GraspReport {
                 _ => None,
             })
             .collect();
-        let rules = if relaxed.is_empty() {
+        if relaxed.is_empty() {
             rules
         } else {
             format!("{rules}: {}", relaxed.join(", "))
-        };
+        }
+    }
+
+    /// The grasp in one line: axis and rules (with relaxations), approach, elevation, pitch,
+    /// joint angles, and the physics check's verdict when it ran on this grasp.
+    pub fn one_line(&self) -> String {
+        let rules = self.one_line_rules();
         let thetas: Vec<String> = self
             .fingers
             .iter()
@@ -483,7 +488,7 @@ impl RunReport {
             );
         }
         let sim_line = match (&self.sim.reason, self.sim.translation_mm) {
-            (Some(r), _) => format!("{} ({r})", self.sim.verdict),
+            (Some(r), _) => format!("{} ({r})", self.sim.verdict.replace('_', " ")),
             (None, Some(t)) => format!(
                 "{}: moved {:.2} mm and {:.2} deg relative to the palm while held; {} steps, {:.0} ms{}",
                 self.sim.verdict,
