@@ -547,14 +547,22 @@ fn has_overlapping_outers(contours: &[Contour]) -> bool {
 fn union_closed(contours: Vec<Contour>) -> Vec<Contour> {
     use i_overlay::core::fill_rule::FillRule;
     use i_overlay::float::simplify::SimplifyShape;
+    map_closed(contours, |rings| rings.simplify_shape(FillRule::NonZero))
+}
+
+/// Applies a polygon operation of i_overlay to the closed contours (as float rings) and turns
+/// its output back into contours with geometric normals; open contours are kept as they are.
+fn map_closed(
+    contours: Vec<Contour>,
+    op: impl FnOnce(Vec<Vec<[f64; 2]>>) -> Vec<Vec<Vec<[f64; 2]>>>,
+) -> Vec<Contour> {
     let (closed, open): (Vec<Contour>, Vec<Contour>) =
         contours.into_iter().partition(|c| c.is_closed);
     let rings: Vec<Vec<[f64; 2]>> = closed
         .iter()
         .map(|c| c.points.iter().map(|p| [p.x, p.y]).collect())
         .collect();
-    let shapes = rings.simplify_shape(FillRule::NonZero);
-    let mut out: Vec<Contour> = shapes
+    let mut out: Vec<Contour> = op(rings)
         .into_iter()
         .flatten()
         .filter(|ring| ring.len() >= 3)
@@ -605,34 +613,17 @@ impl Slice {
     }
 }
 
-/// Morphological closing of the closed contours by a disc of radius `r` (i_overlay's outline
-/// offset, round joins); open contours are kept as they are.
+/// Morphological closing of the closed contours by a polygon of inradius `r` (i_overlay's outline
+/// offset, grown then shrunk); open contours are kept as they are.
 fn close_gaps(contours: Vec<Contour>, r: f64) -> Vec<Contour> {
     use i_overlay::mesh::float::outline::offset::OutlineOffset;
     use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
-    let (closed, open): (Vec<Contour>, Vec<Contour>) =
-        contours.into_iter().partition(|c| c.is_closed);
-    let rings: Vec<Vec<[f64; 2]>> = closed
-        .iter()
-        .map(|c| c.points.iter().map(|p| [p.x, p.y]).collect())
-        .collect();
     // Bevel joins: the structuring element is then a polygon rather than a disc (convex corners
     // come back exactly, a bridged gap's edge is straight to within r (1 - cos(turn / 2))), and
     // the offset makes no arc points, which on a slice of many pieces costs several times more
     // than the rest of the planner.
-    let grown = rings.outline(&OutlineStyle::new(r).line_join(LineJoin::Bevel));
-    let shrunk = grown.outline(&OutlineStyle::new(-r).line_join(LineJoin::Bevel));
-    let mut out: Vec<Contour> = shrunk
-        .into_iter()
-        .flatten()
-        .filter(|ring| ring.len() >= 3)
-        .map(|ring| {
-            Contour::from_polyline(
-                ring.into_iter().map(|[x, y]| Point2::new(x, y)).collect(),
-                true,
-            )
-        })
-        .collect();
-    out.extend(open);
-    out
+    map_closed(contours, |rings| {
+        let grown = rings.outline(&OutlineStyle::new(r).line_join(LineJoin::Bevel));
+        grown.outline(&OutlineStyle::new(-r).line_join(LineJoin::Bevel))
+    })
 }
