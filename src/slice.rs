@@ -586,7 +586,7 @@ impl Slice {
     /// The slice as a finger of width `gap_mm` meets it: open ends within `gap_mm` of each other
     /// joined, and, where the slice is in several pieces, every gap narrower than `gap_mm`
     /// between pieces filled (a morphological closing: the region grown by `gap_mm / 2` and
-    /// shrunk back, so concave corners get a fillet of that radius and convex ones stay). A
+    /// shrunk back, so concave corners get a bevel of that size and convex ones stay). A
     /// finger cannot enter a perforation or a slot narrower than itself, so for the planner it
     /// is solid. A slice in one closed piece is returned unchanged.
     pub fn bridged(self, gap_mm: f64) -> Slice {
