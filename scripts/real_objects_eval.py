@@ -32,17 +32,19 @@ END = "<!-- END GENERATED -->"
 TIMEOUT_S = 300
 
 
-def scenario_text(path, gravity):
-    """The scenario with absolute paths, and the gravity mode set."""
+def scenario_text(path, gravity, sim=()):
+    """The scenario with absolute paths, the gravity mode set, and `sim` (KEY=VALUE strings)
+    added to its [sim] table."""
     text = path.read_text()
     text = text.replace('"../meshes/', f'"{REAL / "meshes"}/')
     text = text.replace('"../../hands/', f'"{ROOT / "assets" / "hands"}/')
-    return text + f'\n[sim]\ngravity = "{gravity}"\n'
+    extra = "".join(f"{kv.split('=', 1)[0].strip()} = {kv.split('=', 1)[1].strip()}\n" for kv in sim)
+    return text + f'\n[sim]\ngravity = "{gravity}"\n' + extra
 
 
-def run_one(binary, scenario, gravity, tmp, mjcf_dir):
+def run_one(binary, scenario, gravity, tmp, mjcf_dir, sim=()):
     s = pathlib.Path(tmp) / f"{scenario.stem}_{gravity}.toml"
-    s.write_text(scenario_text(scenario, gravity))
+    s.write_text(scenario_text(scenario, gravity, sim))
     cmd = [binary, "--json", s.as_posix()]
     if mjcf_dir is not None:
         cmd[1:1] = ["--export-mjcf", str(mjcf_dir)]
@@ -92,6 +94,8 @@ def main():
     ap.add_argument("--no-mujoco", action="store_true")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--write-doc", action="store_true")
+    ap.add_argument("--sim", action="append", default=[], metavar="KEY=VALUE",
+                    help="add KEY = VALUE to every scenario's [sim] table (e.g. squeeze_deg=5)")
     ap.add_argument("names", nargs="*", help="only these objects")
     a = ap.parse_args()
 
@@ -110,7 +114,7 @@ def main():
     results = {}
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(a.jobs) as pool:
         jobs = {
-            (s.stem, g): pool.submit(run_one, a.binary, s, g, tmp, mjcf if g == "down" else None)
+            (s.stem, g): pool.submit(run_one, a.binary, s, g, tmp, mjcf if g == "down" else None, a.sim)
             for s in scenarios
             for g in ("down", "six")
         }
