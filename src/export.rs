@@ -48,6 +48,16 @@ const MM: f64 = 1e-3;
 /// MuJoCo's timestep in the exported scene `[s]` (see [`write_mjcf`]).
 pub const MUJOCO_TIMESTEP_S: f64 = 2e-4;
 
+/// Iterations of MuJoCo's noslip solver in the exported scene. MuJoCo's friction is a soft
+/// constraint: under a steady tangential load a held object creeps (MuJoCo's documentation of
+/// `noslip_iterations`: a post-processing PGS pass "to suppress slip/drift in friction
+/// dimensions resulting from the soft-constraint model"). rapier's Coulomb friction does not
+/// creep, so without it the replay judged `slip` grasps that both engines hold in position: a
+/// milk carton crept 6.1 mm in 2 s, a thermos 8.2 mm (docs/MUJOCO.md). With 10 iterations they
+/// move 0.3 and 0.1 mm, and every bundled scenario keeps its verdict (the weak-motor cup still
+/// drops, the weak-motor chapter 4 object still slips).
+pub const MUJOCO_NOSLIP_ITERATIONS: usize = 10;
+
 fn v3(v: &Vector3<f64>) -> String {
     format!("{:.9} {:.9} {:.9}", v.x, v.y, v.z)
 }
@@ -140,7 +150,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     // step, so the scene uses MuJoCo's `implicitfast` integrator and a 0.2 ms step (ω·dt < 1).
     let _ = writeln!(
         s,
-        "  <option timestep=\"{MUJOCO_TIMESTEP_S}\" integrator=\"implicitfast\" gravity=\"{g}\" cone=\"elliptic\" impratio=\"10\"/>"
+        "  <option timestep=\"{MUJOCO_TIMESTEP_S}\" integrator=\"implicitfast\" gravity=\"{g}\" cone=\"elliptic\" impratio=\"10\" noslip_iterations=\"{MUJOCO_NOSLIP_ITERATIONS}\"/>"
     );
     let _ = writeln!(s, "  <default>");
     let _ = writeln!(
@@ -155,7 +165,10 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     }
     let _ = writeln!(s, "  </asset>");
     let _ = writeln!(s, "  <worldbody>");
-    let palm_pos = case.pose.origin_mm.coords * MM;
+    // Where the rapier check starts: the palm backed off and the fingers opened clear of the
+    // object's collider (`sim::scene::start`).
+    let start = crate::sim::scene::start(case);
+    let palm_pos = start.origin_mm.coords * MM;
     let _ = writeln!(
         s,
         "    <body name=\"palm\" pos=\"{}\" quat=\"{}\">",
@@ -283,14 +296,13 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     let _ = writeln!(s, "  </actuator>");
 
     // Keyframes: joint values are bends; the object's free joint is at rest at the origin.
-    let margin = sim.open_margin_deg.to_radians();
     let mut open = Vec::new();
     let mut planned = Vec::new();
     let mut ctrl = Vec::new();
-    for [t1, t2] in &case.pose.theta_deg {
+    for ([t1, t2], [o1, o2]) in case.pose.theta_deg.iter().zip(&start.open_bend_rad) {
         let (b1, b2) = (bend(*t1), bend(*t2));
-        open.push((b1 - margin).max(lo1));
-        open.push((b2 - margin).max(lo2));
+        open.push(*o1);
+        open.push(*o2);
         planned.push(b1);
         planned.push(b2);
         ctrl.push((b1 + sim.squeeze_deg.to_radians()).clamp(lo1, hi1));

@@ -369,6 +369,7 @@ fn run_sim(
         simulated_s: Some(out.simulated_s),
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
+        start: Some(sim::scene::start(&case)),
         collider: Some(format!("{} ({} parts)", shape.kind, shape.parts)),
         mass_kg: Some(mass_kg),
         grasp_source: Some(source.to_string()),

@@ -310,6 +310,10 @@ pub struct SimReport {
     /// Wall time of the check `[ms]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub wall_ms: Option<f64>,
+    /// Where the check started: how far the palm was backed off the object's collider, how far
+    /// each finger started open, and any penetration left (`sim::scene::Start`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub start: Option<crate::sim::scene::Start>,
     /// The object's collider: `convex_hull` or `convex_decomposition`, and its part count.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub collider: Option<String>,

@@ -210,6 +210,11 @@ pub struct SimParams {
     /// A run checks the planner's candidates in search order until one holds or this many have
     /// been checked (1: only the first grasp, as the thesis would give it).
     pub max_checked: usize,
+    /// Deepest a finger or the palm may be inside the object at the end of closing for the
+    /// grasp to count as a hold `[mm]`: a grasp that holds only because a finger passed into
+    /// the object is not a hold (issue 14). Beyond it the verdict is `slip` (the object stays
+    /// in the hand, but not by a grasp a real hand could make).
+    pub max_penetration_mm: f64,
 }
 
 impl Default for SimParams {
@@ -234,11 +239,12 @@ impl Default for SimParams {
             motor_stiffness_nm_per_rad: 20.0,
             motor_damping_nms_per_rad: 0.2,
             finger_density_kg_m3: 1000.0,
-            contact_stiffness_hz: 1000.0,
+            contact_stiffness_hz: 10000.0,
             open_margin_deg: 20.0,
             override_angles: None,
             override_index: None,
             max_checked: crate::DEFAULT_MAX_CHECKED,
+            max_penetration_mm: 2.0,
         }
     }
 }
@@ -471,6 +477,7 @@ impl Scenario {
             ("sim.open_margin_deg", s.open_margin_deg),
             ("sim.rest_window_s", s.rest_window_s),
             ("sim.rest_safety", s.rest_safety),
+            ("sim.max_penetration_mm", s.max_penetration_mm),
         ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(invalid(key, format!("must be positive, got {v}")));

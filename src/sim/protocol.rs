@@ -19,9 +19,11 @@ use std::time::Instant;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Verdict {
-    /// The object stayed within the thresholds.
+    /// The object stayed within the thresholds, and no hand collider ended the closing
+    /// deeper inside it than `max_penetration_mm`.
     Hold,
-    /// It moved beyond them but still touches the hand.
+    /// It moved beyond them but still touches the hand, or it stayed but a finger ended the
+    /// closing deeper inside it than `max_penetration_mm` (not a grasp a real hand makes).
     Slip,
     /// It left the hand.
     Drop,
@@ -517,6 +519,7 @@ fn hold(
         Verdict::Drop
     } else if translation_mm <= params.hold_translation_mm
         && judged_rotation <= params.hold_rotation_deg
+        && closing.penetration_mm <= params.max_penetration_mm
     {
         Verdict::Hold
     } else if in_contact {

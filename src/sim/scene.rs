@@ -218,6 +218,240 @@ impl Case<'_> {
     }
 }
 
+/// A box of the hand, in its body's frame `[mm]`: half extents and centre.
+#[derive(Debug, Clone, Copy)]
+struct HandBox {
+    half: Vector3<f64>,
+    centre: Vector3<f64>,
+}
+
+impl HandBox {
+    fn shape(&self) -> SharedShape {
+        let h = convert::vector_m(&self.half);
+        SharedShape::cuboid(h.x, h.y, h.z)
+    }
+}
+
+/// The palm box in the palm's frame: `offset_mm` deep behind the contact surface (palm x points
+/// away from the object), as wide as the palm, and as tall as the fingers' span plus the margin.
+fn palm_box(hand: &Hand) -> HandBox {
+    let (h_lo, h_hi) = hand.finger_height_span();
+    let m = hand.palm.margin_mm;
+    let (z_lo, z_hi) = (h_lo - m, h_hi + m);
+    HandBox {
+        half: Vector3::new(
+            hand.palm.offset_mm / 2.0,
+            hand.palm.half_width_mm,
+            (z_hi - z_lo) / 2.0,
+        ),
+        centre: Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (z_hi + z_lo) / 2.0),
+    }
+}
+
+/// The boxes of phalanx 1 and of phalanx 2 (its contact part, then its thinned tip if it has
+/// one), each in its phalanx's frame, for a finger on side `s` (±1).
+fn phalanx_boxes(hand: &Hand, s: f64) -> (HandBox, Vec<HandBox>) {
+    let o = hand.fingers.offset_mm;
+    let (l1, l2) = (hand.phalanx_1.length_mm, hand.phalanx_2.length_mm);
+    let l2_contact = l2 - hand.phalanx_2.unusable_distal_mm;
+    let p1 = HandBox {
+        half: Vector3::new(o, l1 / 2.0, o),
+        centre: Vector3::new(0.0, s * l1 / 2.0, 0.0),
+    };
+    let mut p2 = vec![HandBox {
+        half: Vector3::new(o, l2_contact / 2.0, o),
+        centre: Vector3::new(0.0, s * l2_contact / 2.0, 0.0),
+    }];
+    if l2 > l2_contact + 1e-9 {
+        // The thinned tip (thesis Fig. 3.8): its contact side recedes to the tip thickness.
+        let t = hand.fingers.tip_thickness_mm;
+        p2.push(HandBox {
+            half: Vector3::new(t / 2.0, (l2 - l2_contact) / 2.0, o),
+            centre: Vector3::new(o - t / 2.0, s * (l2 + l2_contact) / 2.0, 0.0),
+        });
+    }
+    (p1, p2)
+}
+
+/// The side of a finger as a sign: +1 on the left, −1 on the right.
+fn side_sign(side: Side) -> f64 {
+    match side {
+        Side::Left => 1.0,
+        Side::Right => -1.0,
+    }
+}
+
+/// The palm's rotation from its axes (aligned frame).
+fn palm_rotation(pose: &SimHand) -> UnitQuaternion<f64> {
+    let [x, y, z] = pose.axes;
+    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
+        nalgebra::Matrix3::from_columns(&[x, y, z]),
+    ))
+}
+
+/// Frames of a finger's phalanx 1 and 2 (joint position `[mm]` and rotation, aligned frame)
+/// with the palm at `origin`, turned `r_palm`, and the joints bent `b1`, `b2` `[rad]`. A
+/// phalanx's frame is its parent's turned by side × bend about the palm's z: the revolute
+/// joint's angle about (0, 0, side) is then the bend itself.
+fn finger_frames(
+    hand: &Hand,
+    finger: &crate::hand::Finger,
+    origin: &Point3<f64>,
+    r_palm: &UnitQuaternion<f64>,
+    b1: f64,
+    b2: f64,
+) -> [(Point3<f64>, UnitQuaternion<f64>); 2] {
+    let s = side_sign(finger.side);
+    let turn = |b: f64| UnitQuaternion::from_axis_angle(&Vector3::z_axis(), s * b);
+    let anchor1 = Vector3::new(
+        hand.joints.setback_mm,
+        s * hand.joints.lateral_mm,
+        finger.height_mm,
+    );
+    let r1 = r_palm * turn(b1);
+    let j1 = origin + r_palm * anchor1;
+    let r2 = r1 * turn(b2);
+    let j2 = j1 + r1 * Vector3::new(0.0, s * hand.phalanx_1.length_mm, 0.0);
+    [(j1, r1), (j2, r2)]
+}
+
+/// Where the check starts (docs/SIM.md, "Starting clear"): the palm at the planned pose, backed
+/// off along its normal if it starts inside the object's collider, and each finger opened
+/// `open_margin_deg` short of its plan at both joints, or, if a phalanx would start inside the
+/// collider there, the nearest margin in 5° steps (wider first, up to the joint limits, then
+/// narrower down to 0) at which the whole finger is clear. The planner works on the mesh, the
+/// check on its convex hull or decomposition, whose parts bulge past the mesh by millimetres: a
+/// hand collider starting inside one is thrown out by the solver (MuJoCo's stiff contacts threw
+/// a golf club 3 m), which is a different test from closing on the object.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Start {
+    /// The palm's origin `[mm]` (the planned one moved by `palm_backoff_mm` along palm x).
+    #[serde(skip)]
+    pub origin_mm: Point3<f64>,
+    /// How far the palm was backed off the collider `[mm]` (0 when it starts clear).
+    pub palm_backoff_mm: f64,
+    /// Per finger, the bends the joints start at `[rad]`.
+    #[serde(skip)]
+    pub open_bend_rad: Vec<[f64; 2]>,
+    /// Per finger, the margin it starts open by `[deg]`.
+    pub open_margin_deg: Vec<f64>,
+    /// The deepest penetration of a hand collider into the object's left at the start `[mm]`
+    /// (0 when everything starts clear).
+    pub penetration_mm: f64,
+}
+
+/// A hand collider penetrates the object's collider deeper than this at the start `[mm]`: twice
+/// rapier's allowed linear error at the scene's length unit (0.05 mm), so flush contact counts
+/// as clear.
+const START_TOLERANCE_MM: f64 = 0.1;
+
+/// Depth of the deepest overlap of `boxes` (posed by `frame`) with the object `[mm]`, 0 if none.
+fn overlap_mm(
+    object: &SharedShape,
+    frame: &(Point3<f64>, UnitQuaternion<f64>),
+    boxes: &[HandBox],
+) -> f64 {
+    let at_origin = Pose::IDENTITY;
+    boxes
+        .iter()
+        .map(|b| {
+            let c = frame.0 + frame.1 * b.centre;
+            let pose = convert::pose(&c, &frame.1);
+            match rapier3d::parry::query::contact(&pose, &*b.shape().0, &at_origin, &*object.0, 0.0)
+            {
+                Ok(Some(contact)) => (-f64::from(contact.dist) / convert::M_PER_MM).max(0.0),
+                _ => 0.0,
+            }
+        })
+        .fold(0.0, f64::max)
+}
+
+/// The start of the check for `case` (see [`Start`]).
+pub fn start(case: &Case) -> Start {
+    let Case {
+        hand,
+        pose,
+        object,
+        params,
+        ..
+    } = *case;
+    let r_palm = palm_rotation(pose);
+    let palm = [palm_box(hand)];
+    let limits1 = [
+        bend(hand.joints.theta1_range_deg[1]),
+        bend(hand.joints.theta1_range_deg[0]),
+    ];
+    let limits2 = [
+        bend(hand.joints.theta2_range_deg[1]),
+        bend(hand.joints.theta2_range_deg[0]),
+    ];
+    // The palm: backed off by the depth found, plus the tolerance, until clear (a few rounds:
+    // moving off one part can meet another only in a concave object).
+    let mut origin = pose.origin_mm;
+    let mut backoff = 0.0;
+    for _ in 0..10 {
+        let d = overlap_mm(&object.shape, &(origin, r_palm), &palm);
+        if d <= START_TOLERANCE_MM {
+            break;
+        }
+        backoff += d + START_TOLERANCE_MM;
+        origin = pose.origin_mm + pose.axes[0] * backoff;
+    }
+    let mut penetration = overlap_mm(&object.shape, &(origin, r_palm), &palm);
+    let margin0 = params.open_margin_deg;
+    let mut margins = vec![margin0];
+    margins.extend(
+        (1..)
+            .map(|k| margin0 + 5.0 * f64::from(k))
+            .take_while(|m| *m <= 90.0),
+    );
+    margins.extend(
+        (1..)
+            .map(|k| margin0 - 5.0 * f64::from(k))
+            .take_while(|m| *m >= 0.0),
+    );
+    let mut open_bend = Vec::new();
+    let mut open_margin = Vec::new();
+    for (f, [t1, t2]) in hand.finger_list.iter().zip(&pose.theta_deg) {
+        let (p1, p2) = phalanx_boxes(hand, side_sign(f.side));
+        let at = |m: f64| {
+            let b1 = (bend(*t1) - m.to_radians()).max(limits1[0]);
+            let b2 = (bend(*t2) - m.to_radians()).max(limits2[0]);
+            let [f1, f2] = finger_frames(hand, f, &origin, &r_palm, b1, b2);
+            let d = overlap_mm(&object.shape, &f1, &[p1]).max(overlap_mm(&object.shape, &f2, &p2));
+            ([b1, b2], d)
+        };
+        let (first, d0) = at(margin0);
+        let found = if d0 <= START_TOLERANCE_MM {
+            Some((margin0, first))
+        } else {
+            margins[1..].iter().find_map(|&m| {
+                let (b, d) = at(m);
+                (d <= START_TOLERANCE_MM).then_some((m, b))
+            })
+        };
+        match found {
+            Some((m, b)) => {
+                open_margin.push(m);
+                open_bend.push(b);
+            }
+            None => {
+                // No margin clears it: start as the scenario says, and report the overlap.
+                penetration = penetration.max(d0);
+                open_margin.push(margin0);
+                open_bend.push(first);
+            }
+        }
+    }
+    Start {
+        origin_mm: origin,
+        palm_backoff_mm: backoff,
+        open_bend_rad: open_bend,
+        open_margin_deg: open_margin,
+        penetration_mm: penetration,
+    }
+}
+
 /// Builds the scene with the fingers open and gravity off.
 pub fn build(case: &Case) -> Scene {
     let Case {
@@ -245,7 +479,13 @@ pub fn build(case: &Case) -> Scene {
     // Contact softness is a natural frequency relative to the bodies' effective mass. rapier's
     // default (30 Hz; 60 Hz against fixed bodies) is a spring of about 430 N/m against a 12 g
     // phalanx: a 1 N·m finger squeezing at 30 mm (33 N) would sink centimetres into the object.
-    // 1 kHz is about 5e5 N/m, under 0.1 mm at that force.
+    // 1 kHz is about 5e5 N/m against a phalanx's own mass, but not stiff enough against the
+    // motors: with the 10° squeeze overshoot, phalanx 2 was driven 5.2 mm into the D40 cylinder
+    // (2.2 mm at 5°), and at 3 kHz still 6.5 mm into a box of cream cheese, its tip pushed past
+    // the far face instead of stopping on it. At 10 kHz the fingers stop on the surface
+    // (0.01 mm on both) and every real object's penetration after closing is within
+    // `max_penetration_mm` (issue 14, docs/SIM.md "Penetration"); the bundled scenarios keep
+    // their verdicts and MuJoCo still agrees on all of them.
     // Grasps live on friction: one Coulomb friction constraint per contact point, not rapier's
     // default simplification (one per four contacts plus a twist constraint), and no recycling
     // of stale contacts between steps.
@@ -255,45 +495,29 @@ pub fn build(case: &Case) -> Scene {
     ip.contact_softness = SpringCoefficients::new(hz, 10.0);
     ip.static_contact_softness = SpringCoefficients::new(hz, 10.0);
 
-    let [x, y, z] = pose.axes;
-    let r_palm = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
-        nalgebra::Matrix3::from_columns(&[x, y, z]),
-    ));
+    let r_palm = palm_rotation(pose);
+    let start = start(case);
     // The palm never moves during the check: a fixed body. (A kinematic body here made rapier
     // refresh the palm's contacts irregularly: the object, pressed against the palm, sank into it
     // for about five steps and was thrown back in one, a 0.16 mm sawtooth that ratcheted it along
     // the fingers by 0.03 mm per period, docs/SIM.md.)
     let palm = world
         .bodies
-        .insert(RigidBodyBuilder::fixed().pose(convert::pose(&pose.origin_mm, &r_palm)));
+        .insert(RigidBodyBuilder::fixed().pose(convert::pose(&start.origin_mm, &r_palm)));
     let mm = |v: f64| (v * convert::M_PER_MM) as f32;
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
-    let (z_lo, z_hi) = (h_lo - m, h_hi + m);
-    let mut hand_colliders = Vec::new();
-    hand_colliders.push(
-        world.colliders.insert_with_parent(
-            ColliderBuilder::cuboid(
-                mm(hand.palm.offset_mm / 2.0),
-                mm(hand.palm.half_width_mm),
-                mm((z_hi - z_lo) / 2.0),
-            )
-            .translation(Vector::new(
-                mm(hand.palm.offset_mm / 2.0),
-                0.0,
-                mm((z_hi + z_lo) / 2.0),
-            ))
-            .friction(friction as f32),
-            palm,
-            &mut world.bodies,
-        ),
-    );
+    let collider = |b: &HandBox| {
+        ColliderBuilder::new(b.shape())
+            .translation(convert::vector_m(&b.centre))
+            .friction(friction as f32)
+    };
+    let mut hand_colliders = vec![world.colliders.insert_with_parent(
+        collider(&palm_box(hand)),
+        palm,
+        &mut world.bodies,
+    )];
 
-    let o = hand.fingers.offset_mm;
-    let (l1, l2) = (hand.phalanx_1.length_mm, hand.phalanx_2.length_mm);
-    let l2_contact = l2 - hand.phalanx_2.unusable_distal_mm;
+    let l1 = hand.phalanx_1.length_mm;
     let density = params.finger_density_kg_m3 as f32;
-    let open_margin = params.open_margin_deg.to_radians();
     let limits1 = [
         bend(hand.joints.theta1_range_deg[1]) as f32,
         bend(hand.joints.theta1_range_deg[0]) as f32,
@@ -309,41 +533,33 @@ pub fn build(case: &Case) -> Scene {
     let mut opening = Vec::new();
     let mut joint2_handles = Vec::new();
     let mut joint1_handles = Vec::new();
-    for (f, [t1, t2]) in hand.finger_list.iter().zip(&pose.theta_deg) {
-        let s: f32 = match f.side {
-            Side::Left => 1.0,
-            Side::Right => -1.0,
-        };
-        // A phalanx's frame is its parent's turned by side × bend about the palm's z: the
-        // revolute joint's angle about (0, 0, side) is then the bend itself.
-        let turn = |b: f64| UnitQuaternion::from_axis_angle(&Vector3::z_axis(), f64::from(s) * b);
-        let anchor1_mm = Vector3::new(
-            hand.joints.setback_mm,
-            f64::from(s) * hand.joints.lateral_mm,
-            f.height_mm,
-        );
-        // Start open: each joint `open_margin_deg` short of its plan (within its limits), so
-        // contact is made by closing along the planned path.
-        let open1 = (bend(*t1) - open_margin).max(f64::from(limits1[0]));
-        let open2 = (bend(*t2) - open_margin).max(f64::from(limits2[0]));
-        let r1 = r_palm * turn(open1);
-        let j1 = pose.origin_mm + r_palm * anchor1_mm;
+    for ((f, [t1, t2]), [open1, open2]) in hand
+        .finger_list
+        .iter()
+        .zip(&pose.theta_deg)
+        .zip(&start.open_bend_rad)
+    {
+        let s = side_sign(f.side);
+        let (p1, p2) = phalanx_boxes(hand, s);
+        // Start open (see [`Start`]), so contact is made by closing along the planned path.
+        let [(j1, r1), (j2, r2)] =
+            finger_frames(hand, f, &start.origin_mm, &r_palm, *open1, *open2);
         let b1 = world.bodies.insert(
             RigidBodyBuilder::dynamic()
                 .pose(convert::pose(&j1, &r1))
                 .can_sleep(false),
         );
-        hand_colliders.push(
-            world.colliders.insert_with_parent(
-                ColliderBuilder::cuboid(mm(o), mm(l1 / 2.0), mm(o))
-                    .translation(Vector::new(0.0, s * mm(l1 / 2.0), 0.0))
-                    .density(density)
-                    .friction(friction as f32),
-                b1,
-                &mut world.bodies,
-            ),
+        hand_colliders.push(world.colliders.insert_with_parent(
+            collider(&p1).density(density),
+            b1,
+            &mut world.bodies,
+        ));
+        let axis = Vector::new(0.0, 0.0, s as f32);
+        let anchor1_mm = Vector3::new(
+            hand.joints.setback_mm,
+            s * hand.joints.lateral_mm,
+            f.height_mm,
         );
-        let axis = Vector::new(0.0, 0.0, s);
         let joint1 = RevoluteJointBuilder::new(axis)
             .local_anchor1(convert::vector_m(&anchor1_mm))
             .local_anchor2(Vector::ZERO)
@@ -360,49 +576,26 @@ pub fn build(case: &Case) -> Scene {
             joint1_handles.push(h);
         }
 
-        let r2 = r1 * turn(open2);
-        let j2 = j1 + r1 * Vector3::new(0.0, f64::from(s) * l1, 0.0);
         let b2 = world.bodies.insert(
             RigidBodyBuilder::dynamic()
                 .pose(convert::pose(&j2, &r2))
                 .can_sleep(false),
         );
-        hand_colliders.push(
-            world.colliders.insert_with_parent(
-                ColliderBuilder::cuboid(mm(o), mm(l2_contact / 2.0), mm(o))
-                    .translation(Vector::new(0.0, s * mm(l2_contact / 2.0), 0.0))
-                    .density(density)
-                    .friction(friction as f32),
+        for b in &p2 {
+            hand_colliders.push(world.colliders.insert_with_parent(
+                collider(b).density(density),
                 b2,
                 &mut world.bodies,
-            ),
-        );
-        if l2 > l2_contact + 1e-9 {
-            // The thinned tip (thesis Fig. 3.8): its contact side recedes to the tip thickness.
-            let t = hand.fingers.tip_thickness_mm;
-            hand_colliders.push(
-                world.colliders.insert_with_parent(
-                    ColliderBuilder::cuboid(mm(t / 2.0), mm((l2 - l2_contact) / 2.0), mm(o))
-                        .translation(Vector::new(
-                            mm(o - t / 2.0),
-                            s * mm((l2 + l2_contact) / 2.0),
-                            0.0,
-                        ))
-                        .density(density)
-                        .friction(friction as f32),
-                    b2,
-                    &mut world.bodies,
-                ),
-            );
+            ));
         }
         // Joint 2 is held at its open angle until released (see `Scene::release_joint2`).
         let joint2 = RevoluteJointBuilder::new(axis)
-            .local_anchor1(Vector::new(0.0, s * mm(l1), 0.0))
+            .local_anchor1(Vector::new(0.0, s as f32 * mm(l1), 0.0))
             .local_anchor2(Vector::ZERO)
             .limits(limits2)
             .motor_model(MotorModel::ForceBased)
             .motor_position(
-                open2 as f32,
+                *open2 as f32,
                 params.motor_stiffness_nm_per_rad as f32,
                 params.motor_damping_nms_per_rad as f32,
             )
@@ -412,7 +605,7 @@ pub fn build(case: &Case) -> Scene {
             joint2_handles.push((h, motor(bend(*t2) + squeeze2, limits2)));
         }
         fingers.push((b1, b2, bend(*t1), bend(*t2)));
-        opening.push((b1, open1, b2, open2));
+        opening.push((b1, *open1, b2, *open2));
     }
     // A multibody places its links from its joint coordinates, which start at zero (every
     // phalanx straight): set them to the open pose and move the bodies there.
@@ -452,12 +645,9 @@ pub fn build(case: &Case) -> Scene {
     // Reach: the palm box's farthest corner, or a finger's joint 1 plus phalanx 1 plus the
     // farthest point of phalanx 2 (or its tip) from joint 2, whichever is larger; the finger
     // boxes are 2 × offset thick and wide.
-    let mut reach_mm = Vector3::new(
-        hand.palm.offset_mm,
-        hand.palm.half_width_mm,
-        z_lo.abs().max(z_hi.abs()),
-    )
-    .norm();
+    let pb = palm_box(hand);
+    let mut reach_mm = (pb.centre.abs() + pb.half).norm();
+    let (o, l2) = (hand.fingers.offset_mm, hand.phalanx_2.length_mm);
     for f in &hand.finger_list {
         let anchor = Vector3::new(hand.joints.setback_mm, hand.joints.lateral_mm, f.height_mm);
         let finger = anchor.norm() + l1 + (l2 * l2 + 2.0 * o * o).sqrt();
@@ -503,4 +693,87 @@ pub fn collider_inertia(
         nalgebra::Vector3::new(f64::from(c.x), f64::from(c.y), f64::from(c.z)),
         nalgebra::Matrix3::from_column_slice(&cols.map(f64::from)),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn thesis_hand() -> Hand {
+        let (_, text) = crate::hand::bundled("thesis").unwrap();
+        Hand::parse(text, Path::new("thesis.toml"), &[]).unwrap()
+    }
+
+    /// A 40 x 100 x 80 mm box about the z axis, its faces at x = ±20 and y = ±50.
+    fn box_shape() -> ObjectShape {
+        let mesh = crate::objects::prism(40.0, 100.0, 80.0);
+        let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
+        ObjectShape::from_mesh(&mesh, volume)
+    }
+
+    /// The palm facing the box's −x face, its contact surface at `x`, fingers at `theta`.
+    fn hand_at(x: f64, theta: [f64; 2]) -> SimHand {
+        SimHand {
+            origin_mm: Point3::new(x, 0.0, 40.0),
+            axes: [-Vector3::x(), -Vector3::y(), Vector3::z()],
+            theta_deg: vec![theta; 3],
+        }
+    }
+
+    #[test]
+    fn a_palm_inside_the_collider_starts_backed_off() {
+        let hand = thesis_hand();
+        let object = box_shape();
+        let params = SimParams::default();
+        // Flush on the face: nothing to do.
+        let pose = hand_at(-20.0, [120.0, 120.0]);
+        let case = Case {
+            hand: &hand,
+            pose: &pose,
+            object: &object,
+            mass_kg: 0.1,
+            friction: 0.5,
+            params: &params,
+        };
+        let s = start(&case);
+        assert_eq!(s.palm_backoff_mm, 0.0);
+        assert_eq!(s.origin_mm, pose.origin_mm);
+        // 3 mm inside: backed off by the depth plus the tolerance, along palm x.
+        let pose = hand_at(-17.0, [120.0, 120.0]);
+        let s = start(&Case {
+            pose: &pose,
+            ..case
+        });
+        assert!((s.palm_backoff_mm - 3.1).abs() < 1e-3, "{s:?}");
+        assert!((s.origin_mm.x + 20.1).abs() < 1e-3, "{s:?}");
+        assert_eq!((s.origin_mm.y, s.origin_mm.z), (0.0, 40.0));
+        assert!(
+            overlap_mm(
+                &object.shape,
+                &(s.origin_mm, palm_rotation(&pose)),
+                &[palm_box(&hand)]
+            ) <= START_TOLERANCE_MM
+        );
+    }
+
+    #[test]
+    fn a_finger_that_cannot_start_clear_is_reported() {
+        // A 100 mm wide face: the fingers' planes (36.7 mm either side of the palm's centre) cut
+        // the box, and even fully open (45° bend) phalanx 1 starts inside it.
+        let hand = thesis_hand();
+        let object = box_shape();
+        let params = SimParams::default();
+        let pose = hand_at(-20.0, [120.0, 120.0]);
+        let s = start(&Case {
+            hand: &hand,
+            pose: &pose,
+            object: &object,
+            mass_kg: 0.1,
+            friction: 0.5,
+            params: &params,
+        });
+        assert!(s.penetration_mm > 10.0, "{s:?}");
+        assert_eq!(s.open_margin_deg, vec![20.0; 3]);
+    }
 }

@@ -359,3 +359,61 @@ fn fast_and_full_protocols_agree_on_the_bundled_scenarios() {
     }
     assert!(compared >= 10, "only {compared} scenarios checked");
 }
+
+#[test]
+fn penetration_after_closing_is_reported_and_bounded() {
+    // At the default contact stiffness (3 kHz) the squeeze overshoot leaves phalanx 2 a
+    // fraction of a millimetre inside the D40 cylinder, and it holds.
+    let (_d, s) = scenario_with("cylinder_d40.stl", "max_checked = 1");
+    let r = run(&s, &with_sim()).unwrap();
+    let depth = r.sim.directions[0].closing_penetration_mm;
+    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim);
+    assert!(depth < 0.5, "{depth} mm");
+    // Soft contacts (300 Hz) let the motors drive the fingers about 6 mm into it. The object
+    // does not move, but a grasp made by fingers inside the object is not a hold ...
+    let (_d, s) = scenario_with(
+        "cylinder_d40.stl",
+        "max_checked = 1\ncontact_stiffness_hz = 300.0",
+    );
+    let r = run(&s, &with_sim()).unwrap();
+    let dir = &r.sim.directions[0];
+    assert!(dir.closing_penetration_mm > 4.0, "{dir:?}");
+    assert!(dir.translation_mm < 1.0, "{dir:?}");
+    assert_eq!(r.sim.verdict, "slip", "{:?}", r.sim);
+    assert_eq!(r.expect.met, Some(false));
+    // ... unless the bound is raised past the depth.
+    let (_d, s) = scenario_with(
+        "cylinder_d40.stl",
+        "max_checked = 1\ncontact_stiffness_hz = 300.0\nmax_penetration_mm = 10.0",
+    );
+    let r = run(&s, &with_sim()).unwrap();
+    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim);
+}
+
+#[test]
+fn the_hand_starts_clear_of_the_collider() {
+    // The golf club's convex decomposition bulges past the mesh the planner used: at the
+    // planned palm pose the palm starts inside one part, and with every joint 20° open finger 1
+    // starts 11 mm inside the club's head (MuJoCo then threw the club 3 m). The check backs the
+    // palm off and opens fingers 1 and 3 further, so everything starts clear.
+    let out = crate::succeed(crate::grasp_sim().args([
+        "--json",
+        "--max-checked",
+        "1",
+        "assets/real/scenarios/mw_golf_club.toml",
+    ]));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let start = &v["sim"]["start"];
+    assert_eq!(start["penetration_mm"], 0.0, "{start}");
+    let backoff = start["palm_backoff_mm"].as_f64().unwrap();
+    assert!(backoff > 0.3 && backoff < 2.0, "{start}");
+    let margins: Vec<f64> = start["open_margin_deg"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|m| m.as_f64().unwrap())
+        .collect();
+    assert_eq!(margins.len(), 3);
+    assert!(margins[0] > 20.0 && margins[2] > 20.0, "{start}");
+    assert_eq!(margins[1], 20.0, "{start}");
+}
