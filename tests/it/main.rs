@@ -2,6 +2,7 @@
 
 mod batch;
 mod cli;
+mod engines;
 mod export;
 mod formats;
 mod geometry;
