@@ -63,11 +63,12 @@ def run_shard(binary, k, n, inputs, flags, work_dir, jobs, cwd):
     p = subprocess.run(cmd, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                        stderr=subprocess.PIPE, preexec_fn=die_with_parent())
     err = p.stderr.decode("utf-8", "replace").strip().splitlines()
-    tail = [l for l in err if not l.startswith("[")][-3:]
+    summary = [l for l in err if l.startswith("batch: ")]
+    tail = summary[-1:] or [l for l in err if not l.startswith("[")][-3:]
     # 0, 1 and 2 are the batch's answers (2: an object has an error line) when it got to its
     # summary; anything else (a signal, a batch that stopped before running) is a failure
     # that Ray retries.
-    finished = any(l.startswith("batch: ") for l in err)
+    finished = bool(summary)
     if p.returncode not in (0, 1, 2) or not finished:
         raise RuntimeError(f"shard {k}/{n}: {' '.join(cmd)} exited {p.returncode}: "
                            + " | ".join(tail))
@@ -112,6 +113,7 @@ def main():
 
     import ray  # imported late: --help works without Ray installed
 
+
     binary = os.path.abspath(args.binary)
     if not os.access(binary, os.X_OK):
         print(f"ray_batch: error: {args.binary}: no such program (build it: cargo build --release)",
@@ -130,6 +132,14 @@ def main():
         # "local": always a new instance here, never one that happens to run on this machine.
         ray.init(address="local", num_cpus=args.num_cpus, include_dashboard=False,
                  log_to_driver=False)
+    # SIGTERM (a scheduler, `kill`) stops the local instance before the driver exits (set
+    # after ray.init, which installs its own handler). After a SIGKILL nothing can: a local
+    # instance may leave agent processes behind.
+    def on_term(*_):
+        print("ray_batch: stopped (SIGTERM); the same command continues the run", file=sys.stderr)
+        ray.shutdown()
+        os._exit(143)
+    signal.signal(signal.SIGTERM, on_term)
     cpus = int(ray.cluster_resources().get("CPU", 1))
     slots = max(1, cpus // max(1, args.cpus_per_task))
     n = args.shards or 4 * slots
