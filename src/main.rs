@@ -406,13 +406,13 @@ fn batch(args: &cli::BatchArgs) -> anyhow::Result<u8> {
     }
     let run_items: Vec<batch::Item> = todo.iter().map(|&i| items[i].clone()).collect();
     let run_keys: Vec<batch::Key> = todo.iter().map(|&i| keys[i].clone()).collect();
+    let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
+    let total = run_items.len();
     let isolation = if args.in_process {
         Isolation::InProcess
     } else {
-        Isolation::Process(batch_worker_command(args)?)
+        Isolation::Process(batch_worker_command(args, (jobs / total.max(1)).max(1))?)
     };
-    let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
-    let total = run_items.len();
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(total as u64);
         b.set_style(
@@ -531,8 +531,11 @@ fn exit_status(counts: &grasp_sim::batch::Counts, interrupted: usize) -> u8 {
 }
 
 /// The worker command for each object: this binary's hidden `batch-worker`, with the flags
-/// that decide an object's result.
-fn batch_worker_command(args: &cli::BatchArgs) -> anyhow::Result<grasp_sim::batch::Worker> {
+/// that decide an object's result; each worker may use `threads` threads.
+fn batch_worker_command(
+    args: &cli::BatchArgs,
+    threads: usize,
+) -> anyhow::Result<grasp_sim::batch::Worker> {
     let program = std::env::current_exe()
         .context("cannot find this program to start a worker per object (try --in-process)")?;
     let mut wargs: Vec<std::ffi::OsString> = vec!["batch-worker".into()];
@@ -555,6 +558,7 @@ fn batch_worker_command(args: &cli::BatchArgs) -> anyhow::Result<grasp_sim::batc
         args: wargs,
         timeout: args.object_timeout.map(std::time::Duration::from_secs_f64),
         memory_limit_mib: args.object_memory,
+        threads,
     })
 }
 

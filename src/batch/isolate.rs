@@ -29,6 +29,10 @@ pub struct Worker {
     pub timeout: Option<Duration>,
     /// Limit each worker's memory (address space) to this many MiB.
     pub memory_limit_mib: Option<u64>,
+    /// Threads each worker may use for the gravity directions of its physics check
+    /// (`RAYON_NUM_THREADS`, unless set already): 1 when the batch's jobs are all busy with
+    /// objects, more when there are fewer objects than jobs.
+    pub threads: usize,
 }
 
 /// An object whose worker was interrupted from outside: no line, run it again on resume.
@@ -61,10 +65,10 @@ pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, I
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
         .stderr(Stdio::piped());
-    // One worker per job: its physics directions run one after another, as they did on the
-    // batch's own threads.
+    // The batch's jobs are shared out: a worker's physics directions run on its share, as
+    // they did on the batch's own threads.
     if std::env::var_os("RAYON_NUM_THREADS").is_none() {
-        cmd.env("RAYON_NUM_THREADS", "1");
+        cmd.env("RAYON_NUM_THREADS", worker.threads.max(1).to_string());
     }
     limit_child(&mut cmd, worker.memory_limit_mib);
     let mut child = match cmd.spawn() {
