@@ -70,31 +70,46 @@ pub enum Command {
     /// Run many objects: every scenario and mesh in the given folders, or the files given; one
     /// JSON line per object, in input order, and a summary on stderr.
     ///
+    /// Each object runs in a worker process of its own, so a panic, a crash, a run past
+    /// --object-timeout or memory exhaustion is an error line for that object and the others
+    /// go on. Each line carries `batch.input`, `batch.input_hash` and `batch.wall_ms`.
+    ///
     /// Exit status: 0 every stated expectation met (bare meshes state none), 1 an expectation not
     /// met, 2 an input could not be run (its JSON line has an `error`; the others still run).
-    Batch {
-        /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
-        #[arg(required = true, value_name = "DIR | SCENARIO")]
-        inputs: Vec<PathBuf>,
-        /// Scenario used for bare meshes (default: the thesis hand and defaults).
-        #[arg(long, value_name = "SCENARIO")]
-        template: Option<PathBuf>,
-        /// Length unit of bare meshes (overrides the template's).
-        #[arg(long, value_name = "UNIT", value_parser = ["mm", "m", "inch"])]
-        units: Option<String>,
-        /// Write the JSON lines to this file instead of stdout (written whole, or not at all).
+    Batch(BatchArgs),
+    /// Summarize a batch's results (a JSON Lines file from `batch`, or from `--json`): counts
+    /// (planned, ungraspable, hold / slip / drop, held per gravity direction, expectations,
+    /// errors) and the slowest objects; `--csv` writes one row per object.
+    Summarize {
+        /// The results file.
+        #[arg(value_name = "RESULTS.jsonl")]
+        file: PathBuf,
+        /// Also write one row per object to this CSV file.
         #[arg(long, value_name = "FILE")]
-        out: Option<PathBuf>,
-        /// Worker threads (default: all cores).
-        #[arg(long, value_name = "N")]
-        jobs: Option<usize>,
-        /// Run only the K-th of N contiguous blocks of the inputs (e.g. a Slurm array task).
-        #[arg(long, value_name = "K/N")]
-        shard: Option<String>,
-        /// Plan only.
+        csv: Option<PathBuf>,
+        /// How many of the slowest objects to list.
+        #[arg(long, value_name = "N", default_value_t = 10)]
+        slowest: usize,
+    },
+    /// Internal: run one object of a batch in a process of its own and print its line (the
+    /// batch starts it for each object; see `batch --in-process`).
+    #[command(hide = true)]
+    BatchWorker {
+        /// The scenario or mesh.
+        path: PathBuf,
+        /// The input hash the batch computed for it.
+        #[arg(long)]
+        input_hash: String,
+        /// As `batch --template`.
+        #[arg(long)]
+        template: Option<PathBuf>,
+        /// As `batch --units`.
+        #[arg(long)]
+        units: Option<String>,
+        /// As `batch --no-sim`.
         #[arg(long)]
         no_sim: bool,
-        /// Also find each grasp's payload margin.
+        /// As `batch --payload`.
         #[arg(long)]
         payload: bool,
     },
@@ -129,4 +144,67 @@ pub enum Command {
         #[arg(long, default_value = "assets/objects")]
         out: PathBuf,
     },
+}
+
+/// `grasp-sim batch` flags.
+#[derive(Debug, clap::Args)]
+pub struct BatchArgs {
+    /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
+    #[arg(required = true, value_name = "DIR | SCENARIO")]
+    pub inputs: Vec<PathBuf>,
+    /// Scenario used for bare meshes (default: the thesis hand and defaults).
+    #[arg(long, value_name = "SCENARIO")]
+    pub template: Option<PathBuf>,
+    /// Length unit of bare meshes (overrides the template's).
+    #[arg(long, value_name = "UNIT", value_parser = ["mm", "m", "inch"])]
+    pub units: Option<String>,
+    /// Write the JSON lines to this file instead of stdout (written whole, or not at all;
+    /// with --resume, appended as objects finish).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Continue the run in --out FILE: keep the objects it already holds (same input path,
+    /// same contents, flags and template; an edited input runs again), run the others,
+    /// appending each line as it finishes (a killed run leaves a file this continues), and
+    /// end with the file in input order, as one uninterrupted run writes it.
+    #[arg(long, requires = "out")]
+    pub resume: bool,
+    /// With --resume: run again the objects whose line in FILE is an error.
+    #[arg(long, requires = "resume")]
+    pub retry_errors: bool,
+    /// Stop an object still running after this many seconds; its line is an error.
+    #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
+    pub object_timeout: Option<f64>,
+    /// Limit each object's worker process to this much memory (address space, MiB); an
+    /// object that runs out gets an error line.
+    #[arg(long, value_name = "MIB", value_parser = clap::value_parser!(u64).range(16..))]
+    pub object_memory: Option<u64>,
+    /// Run the objects on threads of this process instead of a worker process each (a little
+    /// faster for objects that take milliseconds): a panic is still an error line, but a
+    /// crash or memory exhaustion ends the whole batch, and there is no --object-timeout.
+    #[arg(long, conflicts_with_all = ["object_timeout", "object_memory"])]
+    pub in_process: bool,
+    /// Run nothing: put together the lines of these shard files (or folders of *.jsonl) in
+    /// input order, checking that every input is there exactly once (give the inputs and the
+    /// flags the shards ran with). Repeatable.
+    #[arg(long, value_name = "FILE | DIR", conflicts_with_all = ["resume", "in_process"])]
+    pub merge: Vec<PathBuf>,
+    /// Objects run at once (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// Run only the K-th of N contiguous blocks of the inputs (e.g. a Slurm array task).
+    #[arg(long, value_name = "K/N")]
+    pub shard: Option<String>,
+    /// Plan only.
+    #[arg(long)]
+    pub no_sim: bool,
+    /// Also find each grasp's payload margin.
+    #[arg(long)]
+    pub payload: bool,
+}
+
+fn positive_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(t) if t > 0.0 && t.is_finite() => Ok(t),
+        _ => Err(format!("`{s}` is not a positive number of seconds")),
+    }
 }

@@ -29,6 +29,7 @@ pub mod scenario;
 pub mod select;
 pub mod sim;
 pub mod slice;
+pub mod summarize;
 pub mod tune;
 pub mod visual;
 

@@ -29,35 +29,29 @@ fn main() -> ExitCode {
 fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
     match cli.command {
         Some(cli::Command::GenAssets { out }) => return gen_assets(&out).map(|()| 0),
-        Some(cli::Command::Batch {
-            inputs,
+        Some(cli::Command::Batch(args)) => return batch(&args),
+        Some(cli::Command::BatchWorker {
+            path,
+            input_hash,
             template,
             units,
-            out,
-            jobs,
-            shard,
             no_sim,
             payload,
         }) => {
-            if no_sim && payload {
-                eprintln!(
-                    "grasp-sim: warning: --payload is ignored with --no-sim (the payload search is part of the physics check)"
-                );
-            }
-            let options = RunOptions {
-                no_sim,
-                payload,
-                ..RunOptions::default()
-            };
-            return batch(
-                &inputs,
+            return batch_worker(
+                &path,
+                &input_hash,
                 template.as_deref(),
                 units.as_deref(),
-                out.as_deref(),
-                jobs,
-                shard.as_deref(),
-                &options,
-            );
+                &RunOptions {
+                    no_sim,
+                    payload,
+                    ..RunOptions::default()
+                },
+            )
+        }
+        Some(cli::Command::Summarize { file, csv, slowest }) => {
+            return summarize(&file, csv.as_deref(), slowest)
         }
         Some(cli::Command::Tune {
             inputs,
@@ -333,35 +327,92 @@ fn default_jobs() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
-#[allow(clippy::too_many_arguments)]
-fn batch(
-    inputs: &[std::path::PathBuf],
+/// The template for bare meshes: `--template` or the built-in one, with `--units` applied.
+fn batch_template(
     template: Option<&std::path::Path>,
     units: Option<&str>,
-    out: Option<&std::path::Path>,
-    jobs: Option<usize>,
-    shard: Option<&str>,
-    options: &RunOptions,
-) -> anyhow::Result<u8> {
-    use grasp_sim::batch;
-    use std::io::IsTerminal;
+) -> anyhow::Result<Scenario> {
     let mut template = match template {
         Some(p) => Scenario::load(p)?,
-        None => batch::default_template(),
+        None => grasp_sim::batch::default_template(),
     };
     if let Some(u) = units {
         template.object.units = parse_units(u);
     }
-    if let Some(path) = out {
+    Ok(template)
+}
+
+fn batch(args: &cli::BatchArgs) -> anyhow::Result<u8> {
+    use grasp_sim::batch::{self, journal, Isolation, Record};
+    use std::io::IsTerminal;
+    if args.no_sim && args.payload {
+        eprintln!(
+            "grasp-sim: warning: --payload is ignored with --no-sim (the payload search is part of the physics check)"
+        );
+    }
+    let options = RunOptions {
+        no_sim: args.no_sim,
+        payload: args.payload,
+        ..RunOptions::default()
+    };
+    let template = batch_template(args.template.as_deref(), args.units.as_deref())?;
+    if let Some(path) = &args.out {
         check_writable_file(path).context("--out")?;
     }
-    let mut items = batch::expand(inputs)?;
-    if let Some(s) = shard {
+    let mut items = batch::expand(&args.inputs)?;
+    if let Some(s) = &args.shard {
         let (k, n) = batch::parse_shard(s).map_err(|m| anyhow::anyhow!("--shard: {m}"))?;
         items = batch::shard(&items, k, n);
     }
-    let jobs = jobs.unwrap_or_else(default_jobs).max(1);
-    let total = items.len();
+    let keys = batch::keys(&items, &template, &options);
+    if !args.merge.is_empty() {
+        return batch_merge(args, &keys);
+    }
+    // Resuming: the lines the file already holds for these inputs, as they are now.
+    let (journal, mut kept) = match (&args.out, args.resume) {
+        (Some(path), true) => {
+            let (j, read) = journal::Journal::open(path)?;
+            if read.partial_bytes > 0 {
+                eprintln!(
+                    "grasp-sim: warning: {}: cut off a partial last line ({} bytes) an interrupted run left",
+                    path.display(),
+                    read.partial_bytes
+                );
+            }
+            let mut kept: std::collections::HashMap<batch::Key, Record> = read
+                .records
+                .into_iter()
+                .map(|(_, r)| (r.key.clone(), r))
+                .collect();
+            if args.retry_errors {
+                kept.retain(|_, r| r.error().is_none());
+            }
+            (Some(j), kept)
+        }
+        _ => Default::default(),
+    };
+    let in_file: Vec<batch::Key> = kept.keys().cloned().collect();
+    let todo: Vec<usize> = (0..items.len())
+        .filter(|&i| !kept.contains_key(&keys[i]))
+        .collect();
+    if let Some(path) = args.out.as_ref().filter(|_| args.resume) {
+        eprintln!(
+            "resume: {} of {} already in {}; running {}",
+            items.len() - todo.len(),
+            batch::plural(items.len(), "object"),
+            path.display(),
+            todo.len()
+        );
+    }
+    let run_items: Vec<batch::Item> = todo.iter().map(|&i| items[i].clone()).collect();
+    let run_keys: Vec<batch::Key> = todo.iter().map(|&i| keys[i].clone()).collect();
+    let jobs = args.jobs.unwrap_or_else(default_jobs).max(1);
+    let total = run_items.len();
+    let isolation = if args.in_process {
+        Isolation::InProcess
+    } else {
+        Isolation::Process(batch_worker_command(args, (jobs / total.max(1)).max(1))?)
+    };
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(total as u64);
         b.set_style(
@@ -371,11 +422,27 @@ fn batch(
         b
     });
     let done = std::sync::atomic::AtomicUsize::new(0);
+    let append_error = std::sync::Mutex::new(None);
     let progress = |item: &batch::Item, r: &batch::ItemResult| {
+        if let (Some(j), Ok(rec)) = (&journal, r) {
+            if let Err(e) = j.append(rec) {
+                append_error
+                    .lock()
+                    .unwrap_or_else(|p| p.into_inner())
+                    .get_or_insert(e);
+            }
+        }
         let k = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         let what = match r {
-            Ok(rep) => format!("{} {}", rep.plan.status, rep.sim.verdict),
-            Err(_) => "error".to_string(),
+            Ok(rec) => match rec.error() {
+                Some(_) => "error".to_string(),
+                None => format!(
+                    "{} {}",
+                    rec.value["plan"]["status"].as_str().unwrap_or("?"),
+                    rec.value["sim"]["verdict"].as_str().unwrap_or("?")
+                ),
+            },
+            Err(_) => "interrupted".to_string(),
         };
         match &bar {
             Some(b) => {
@@ -386,61 +453,228 @@ fn batch(
         }
     };
     let t0 = std::time::Instant::now();
-    let results = batch::run_all(&items, &template, options, jobs, &progress);
+    let results = batch::run_all(
+        &run_items, &run_keys, &template, &options, jobs, &isolation, &progress,
+    );
     if let Some(b) = bar {
         b.finish_and_clear();
     }
+    if let Some(e) = append_error.into_inner().unwrap_or_else(|p| p.into_inner()) {
+        return Err(e.into());
+    }
+    let mut interrupted = 0;
+    for (key, r) in run_keys.iter().zip(results) {
+        match r {
+            Ok(rec) => {
+                if let Some(e) = rec.error() {
+                    eprintln!("grasp-sim: error: {e}");
+                }
+                kept.insert(key.clone(), rec);
+            }
+            Err(batch::Interrupted(why)) => {
+                interrupted += 1;
+                eprintln!("grasp-sim: error: {why}");
+            }
+        }
+    }
+    // Everything in input order; a line for an input no longer given (or since edited) goes.
     let mut text = String::new();
-    let mut errors = 0;
-    let mut not_met = 0;
-    for (item, r) in items.iter().zip(&results) {
-        let line = match r {
-            Ok(rep) => {
-                not_met += usize::from(rep.expect.met == Some(false));
-                grasp_sim::report::to_rounded_json(rep)?
-            }
-            Err(e) => {
-                errors += 1;
-                eprintln!("grasp-sim: error: {e}");
-                serde_json::json!({"scenario": item.path().display().to_string(), "error": e})
-                    .to_string()
-            }
-        };
-        text.push_str(&line);
-        text.push('\n');
+    let mut lines = Vec::with_capacity(items.len());
+    for key in &keys {
+        if let Some(rec) = kept.get(key) {
+            text.push_str(&rec.line);
+            text.push('\n');
+            lines.push(&rec.value);
+        }
     }
-    match out {
-        Some(path) => write_atomically(path, text.as_bytes())?,
-        None => std::io::stdout().lock().write_all(text.as_bytes())?,
+    let current: std::collections::HashSet<&batch::Key> = keys.iter().collect();
+    let dropped = in_file.iter().filter(|k| !current.contains(k)).count();
+    match (&args.out, journal) {
+        (Some(path), Some(j)) => {
+            if dropped > 0 {
+                eprintln!(
+                    "grasp-sim: warning: {}: dropped {} for no current input (an input edited or removed, or other flags or template)",
+                    path.display(),
+                    batch::plural(dropped, "line")
+                );
+            }
+            j.finish(text.as_bytes())?;
+        }
+        (Some(path), None) => journal::write_atomically(path, text.as_bytes())?,
+        _ => std::io::stdout().lock().write_all(text.as_bytes())?,
     }
+    let counts = batch::Counts::of(lines);
     eprintln!(
-        "{}",
-        batch::summary(&results, t0.elapsed().as_secs_f64(), jobs)
+        "{}{}",
+        batch::summary(&counts, total, t0.elapsed().as_secs_f64(), jobs),
+        if interrupted > 0 {
+            format!(
+                "; {} interrupted (no line; --resume runs them again)",
+                interrupted
+            )
+        } else {
+            String::new()
+        }
     );
-    Ok(if errors > 0 {
+    Ok(exit_status(&counts, interrupted))
+}
+
+/// 2 if an input could not be run, else 1 if an expectation was not met, else 0.
+fn exit_status(counts: &grasp_sim::batch::Counts, interrupted: usize) -> u8 {
+    if counts.errors > 0 || interrupted > 0 {
         2
-    } else if not_met > 0 {
+    } else if counts.not_met > 0 {
         1
     } else {
         0
+    }
+}
+
+/// The worker command for each object: this binary's hidden `batch-worker`, with the flags
+/// that decide an object's result; each worker may use `threads` threads.
+fn batch_worker_command(
+    args: &cli::BatchArgs,
+    threads: usize,
+) -> anyhow::Result<grasp_sim::batch::Worker> {
+    let program = std::env::current_exe()
+        .context("cannot find this program to start a worker per object (try --in-process)")?;
+    let mut wargs: Vec<std::ffi::OsString> = vec!["batch-worker".into()];
+    if let Some(t) = &args.template {
+        wargs.push("--template".into());
+        wargs.push(t.into());
+    }
+    if let Some(u) = &args.units {
+        wargs.push("--units".into());
+        wargs.push(u.into());
+    }
+    if args.no_sim {
+        wargs.push("--no-sim".into());
+    }
+    if args.payload {
+        wargs.push("--payload".into());
+    }
+    Ok(grasp_sim::batch::Worker {
+        program,
+        args: wargs,
+        timeout: args.object_timeout.map(std::time::Duration::from_secs_f64),
+        memory_limit_mib: args.object_memory,
+        threads,
     })
+}
+
+/// `batch --merge`: the shard files' lines for these inputs, in input order, checked.
+fn batch_merge(args: &cli::BatchArgs, keys: &[grasp_sim::batch::Key]) -> anyhow::Result<u8> {
+    use grasp_sim::batch::{self, journal};
+    let mut files = Vec::new();
+    for m in &args.merge {
+        if m.is_dir() {
+            let mut found: Vec<std::path::PathBuf> = std::fs::read_dir(m)
+                .with_context(|| format!("{}: cannot read folder", m.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "jsonl"))
+                .collect();
+            found.sort();
+            files.extend(found);
+        } else {
+            files.push(m.clone());
+        }
+    }
+    let mut records = Vec::new();
+    for f in &files {
+        let read = journal::read_records(f)?;
+        if read.partial_bytes > 0 {
+            eprintln!(
+                "grasp-sim: warning: {}: ignoring a partial last line (its shard was interrupted)",
+                f.display()
+            );
+        }
+        records.extend(
+            read.records
+                .into_iter()
+                .map(|(line, r)| (format!("{}:{line}", f.display()), r)),
+        );
+    }
+    let merged = batch::merge(keys, records)?;
+    let mut text = String::new();
+    for r in &merged {
+        text.push_str(&r.line);
+        text.push('\n');
+    }
+    match &args.out {
+        Some(path) => journal::write_atomically(path, text.as_bytes())?,
+        None => std::io::stdout().lock().write_all(text.as_bytes())?,
+    }
+    let counts = batch::Counts::of(merged.iter().map(|r| &r.value));
+    eprintln!(
+        "merge: {} from {}, every input exactly once: {} planned, {} ungraspable; physics: {} hold, {} slip, {} drop; expectations: {} met, {} not met, {} not judged; {}",
+        batch::plural(merged.len(), "object"),
+        batch::plural(files.len(), "file"),
+        counts.feasible,
+        counts.ungraspable,
+        counts.hold,
+        counts.slip,
+        counts.drop,
+        counts.met,
+        counts.not_met,
+        counts.unjudged,
+        batch::plural(counts.errors, "error")
+    );
+    Ok(exit_status(&counts, 0))
+}
+
+/// `batch-worker`: one object, its line on stdout.
+fn batch_worker(
+    path: &std::path::Path,
+    input_hash: &str,
+    template: Option<&std::path::Path>,
+    units: Option<&str>,
+    options: &RunOptions,
+) -> anyhow::Result<u8> {
+    use grasp_sim::batch;
+    let template = batch_template(template, units)?;
+    let item = batch::classify(path.to_path_buf()).ok_or_else(|| {
+        anyhow::anyhow!(
+            "{}: neither a scenario (.toml) nor a mesh (.stl, .obj, .ply)",
+            path.display()
+        )
+    })?;
+    let key = batch::Key {
+        input: path.display().to_string(),
+        input_hash: input_hash.to_string(),
+    };
+    let record = batch::run_one(&item, &key, &template, options);
+    let mut out = std::io::stdout().lock();
+    writeln!(out, "{}", record.line)?;
+    out.flush()?;
+    Ok(0)
+}
+
+/// `summarize`: the dataset report on stdout, and the CSV.
+fn summarize(
+    file: &std::path::Path,
+    csv: Option<&std::path::Path>,
+    slowest: usize,
+) -> anyhow::Result<u8> {
+    use grasp_sim::summarize::Summary;
+    if let Some(c) = csv {
+        check_writable_file(c).context("--csv")?;
+    }
+    let summary = Summary::read(file)?;
+    for w in &summary.warnings {
+        eprintln!("grasp-sim: warning: {}: {w}", file.display());
+    }
+    print!("{}", summary.to_text(&file.display().to_string(), slowest));
+    if let Some(c) = csv {
+        grasp_sim::batch::journal::write_atomically(c, summary.to_csv().as_bytes())?;
+        eprintln!("summarize: wrote {}", c.display());
+    }
+    Ok(0)
 }
 
 /// Writes `bytes` to `path` through a temporary file beside it, so a reader never sees half a
 /// file.
 fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(std::path::Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp"));
-    std::fs::write(&tmp, bytes)
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .with_context(|| format!("{}: cannot write", path.display()))
+    Ok(grasp_sim::batch::journal::write_atomically(path, bytes)?)
 }
 
 fn gen_assets(out: &std::path::Path) -> anyhow::Result<()> {

@@ -17,6 +17,7 @@ fn stable(text: &str) -> Vec<serde_json::Value> {
             let mut v: serde_json::Value = serde_json::from_str(l).unwrap();
             v["plan"]["timings_ms"] = serde_json::Value::Null;
             v["sim"]["wall_ms"] = serde_json::Value::Null;
+            v["batch"]["wall_ms"] = serde_json::Value::Null;
             v
         })
         .collect()

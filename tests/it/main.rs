@@ -2,13 +2,17 @@
 
 mod batch;
 mod cli;
+mod engines;
 mod export;
 mod formats;
 mod geometry;
+mod isolation;
 mod issue16;
 mod planner;
 mod real_meshes;
+mod resume;
 mod sim;
+mod summarize;
 mod thesis_table;
 mod tune;
 mod visual;

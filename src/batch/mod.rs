@@ -1,0 +1,503 @@
+//! Running many objects: input expansion, templates, sharding, parallel runs in a stable order.
+//!
+//! An input is a scenario file, a mesh file (STL, OBJ or PLY), or a folder (its `*.toml`
+//! scenarios and meshes, not recursing, sorted by path). A mesh is run with a template scenario: by default the
+//! thesis hand (built into the binary), millimetres, 500 kg/m³, μ = 0.3, the thesis's planner and
+//! physics defaults. Results come back in input order whatever the number of threads; a shard
+//! `K/N` is the K-th of N contiguous blocks, so the shards' outputs concatenate to the whole.
+//!
+//! Each object's result is a [`Record`]: one JSON line that also names its input and the hash
+//! of what decides it ([`record`]). That is what makes a long run restartable and checkable:
+//! [`journal`] appends records crash-safely and reads them back for `--resume`, [`merge`] puts
+//! shard files together and checks that every input is there exactly once, and [`isolate`]
+//! runs each object in its own process so a crash, a timeout or memory exhaustion costs one
+//! error line.
+
+pub mod isolate;
+pub mod journal;
+pub mod record;
+
+pub use isolate::{Interrupted, Worker};
+pub use record::{input_hash, Key, Record};
+
+use crate::hand::Hand;
+use crate::scenario::{MassSpec, ObjectSpec, PlannerParams, Scenario, ScenarioError, SimParams};
+use crate::{run, Error, RunOptions};
+use rayon::prelude::*;
+use record::BatchInfo;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Why a batch file could not be used: bad input, named by its file.
+#[derive(Debug, thiserror::Error)]
+pub enum BatchError {
+    /// The file cannot be read or written.
+    #[error("{}: {message}", path.display())]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// What went wrong.
+        message: String,
+    },
+    /// A complete line that is not a batch record.
+    #[error("{}: line {line} is not a batch record: {why}", path.display())]
+    NotARecord {
+        /// The file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// What is wrong with it.
+        why: String,
+    },
+    /// Another run is appending to the file.
+    #[error("{}: in use by another `grasp-sim batch --resume` (locked); one run per file", path.display())]
+    Locked {
+        /// The file.
+        path: PathBuf,
+    },
+    /// Shard files that do not hold every input exactly once.
+    #[error("merge check failed: {0}")]
+    Merge(String),
+}
+
+impl BatchError {
+    fn io(path: &Path, e: &std::io::Error) -> BatchError {
+        BatchError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        }
+    }
+}
+
+/// The thesis hand file, built in for templates.
+pub const THESIS_HAND_TOML: &str = crate::hand::BUNDLED[0].1;
+
+/// One thing to run.
+#[derive(Debug, Clone, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Item {
+    /// A scenario file.
+    Scenario(PathBuf),
+    /// A mesh, run with the template.
+    Mesh(PathBuf),
+}
+
+impl Item {
+    /// The file.
+    pub fn path(&self) -> &Path {
+        match self {
+            Item::Scenario(p) | Item::Mesh(p) => p,
+        }
+    }
+}
+
+/// Expands inputs into items, in a deterministic order. A folder gives its scenarios (`*.toml`)
+/// when it has any (they name their own meshes), its meshes (`*.stl`, `*.obj`, `*.ply`) otherwise.
+///
+/// # Errors
+/// [`ScenarioError::Io`] for an input that does not exist or is neither a folder, a `.toml` nor
+/// a mesh file.
+pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
+    let mut items = Vec::new();
+    for input in inputs {
+        if input.is_dir() {
+            let entries = std::fs::read_dir(input).map_err(|e| ScenarioError::Io {
+                path: input.clone(),
+                message: e.to_string(),
+            })?;
+            let mut found: Vec<Item> = entries
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file())
+                .filter_map(classify)
+                .filter(|i| !is_hand_file(i.path()))
+                .collect();
+            if found.iter().any(|i| matches!(i, Item::Scenario(_))) {
+                found.retain(|i| matches!(i, Item::Scenario(_)));
+            }
+            found.sort_by(|a, b| a.path().cmp(b.path()));
+            items.extend(found);
+        } else if input.is_file() {
+            items.push(classify(input.clone()).ok_or_else(|| ScenarioError::Io {
+                path: input.clone(),
+                message: "neither a scenario (.toml) nor a mesh (.stl, .obj, .ply)".to_string(),
+            })?);
+        } else {
+            return Err(ScenarioError::Io {
+                path: input.clone(),
+                message: "no such file or folder".to_string(),
+            });
+        }
+    }
+    Ok(items)
+}
+
+/// Returns true if and only if `path` is a TOML file that reads as a hand file (it has a
+/// `[palm]` table and `[[finger]]` entries): a folder holding its hand beside its scenarios is
+/// not a folder of one more scenario.
+fn is_hand_file(path: &Path) -> bool {
+    path.extension().is_some_and(|e| e == "toml")
+        && std::fs::read_to_string(path)
+            .ok()
+            .and_then(|t| t.parse::<toml::Table>().ok())
+            .is_some_and(|t| t.contains_key("palm") && t.contains_key("finger"))
+}
+
+/// The item a file is by its extension: `.toml` a scenario, `.stl`, `.obj`, `.ply` a mesh.
+pub fn classify(p: PathBuf) -> Option<Item> {
+    match p.extension()?.to_str()?.to_ascii_lowercase().as_str() {
+        "toml" => Some(Item::Scenario(p)),
+        "stl" | "obj" | "ply" => Some(Item::Mesh(p)),
+        _ => None,
+    }
+}
+
+/// The default template: the thesis hand and the thesis's defaults.
+pub fn default_template() -> Scenario {
+    let hand = Hand::parse(THESIS_HAND_TOML, Path::new("<built-in thesis hand>"), &[])
+        .expect("the built-in thesis hand is valid");
+    Scenario {
+        path: PathBuf::from("<built-in template>"),
+        name: String::new(),
+        object: ObjectSpec {
+            mesh: PathBuf::new(),
+            units: Default::default(),
+            mass: MassSpec::Density(crate::scenario::DEFAULT_DENSITY_KG_M3),
+            friction: 0.3,
+        },
+        hand,
+        hand_file: PathBuf::from("<built-in thesis hand>"),
+        planner: PlannerParams::default(),
+        sim: SimParams::default(),
+        // A bare mesh comes with no expectation: nothing to judge (issue 16, item 2).
+        expect: None,
+    }
+}
+
+/// The scenario for an item: the file itself, or the template with the mesh swapped in.
+///
+/// # Errors
+/// A bad scenario file.
+pub fn scenario_for(item: &Item, template: &Scenario) -> Result<Scenario, Error> {
+    match item {
+        Item::Scenario(p) => Ok(Scenario::load(p)?),
+        Item::Mesh(p) => {
+            let mut s = template.clone();
+            s.object.mesh = p.clone();
+            s.name = p
+                .file_stem()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            Ok(s)
+        }
+    }
+}
+
+/// Parses `K/N` (1 ≤ K ≤ N).
+///
+/// # Errors
+/// A message saying what is wrong.
+pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let (k, n) = s
+        .split_once('/')
+        .ok_or_else(|| format!("shard `{s}` is not K/N"))?;
+    let k: usize = k
+        .trim()
+        .parse()
+        .map_err(|_| format!("shard `{s}`: K is not a number"))?;
+    let n: usize = n
+        .trim()
+        .parse()
+        .map_err(|_| format!("shard `{s}`: N is not a number"))?;
+    if n == 0 || k == 0 || k > n {
+        return Err(format!("shard `{s}`: need 1 <= K <= N"));
+    }
+    Ok((k, n))
+}
+
+/// The K-th (1-based) of N contiguous blocks of `items`.
+pub fn shard<T: Clone>(items: &[T], k: usize, n: usize) -> Vec<T> {
+    let len = items.len();
+    items[(k - 1) * len / n..k * len / n].to_vec()
+}
+
+/// How each object runs.
+#[derive(Debug, Clone)]
+pub enum Isolation {
+    /// On a thread of this process; a panic is caught and becomes the object's error line.
+    InProcess,
+    /// In a worker process of its own ([`isolate`]): a crash, a timeout or memory exhaustion
+    /// too becomes the object's error line.
+    Process(Worker),
+}
+
+/// The items of a batch with their keys, hashed in parallel.
+pub fn keys(items: &[Item], template: &Scenario, options: &RunOptions) -> Vec<Key> {
+    items
+        .par_iter()
+        .map(|item| Key {
+            input: item.path().display().to_string(),
+            input_hash: input_hash(item, template, options),
+        })
+        .collect()
+}
+
+/// Runs one item on this thread and returns its record; a panic is caught and becomes the
+/// record's error (`panicked: <message>`).
+pub fn run_one(item: &Item, key: &Key, template: &Scenario, options: &RunOptions) -> Record {
+    let t0 = Instant::now();
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        test_fault(item);
+        scenario_for(item, template).and_then(|s| run(&s, options))
+    }));
+    let info = BatchInfo {
+        input: key.input.clone(),
+        input_hash: key.input_hash.clone(),
+        wall_ms: t0.elapsed().as_secs_f64() * 1000.0,
+    };
+    let scenario = item.path().display().to_string();
+    match result {
+        Ok(Ok(report)) => Record::from_report(&report, info),
+        Ok(Err(e)) => Record::from_error(&scenario, &format!("{e:#}"), info),
+        Err(payload) => {
+            let message = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "(no message)".to_string());
+            Record::from_error(&scenario, &format!("{scenario}: panicked: {message}"), info)
+        }
+    }
+}
+
+/// Test hook, debug builds only: `GRASP_SIM_TEST_FAULT=panic:NAME` panics and
+/// `GRASP_SIM_TEST_FAULT=abort:NAME` aborts the process while running an input whose path
+/// contains `NAME`, so the tests can show that a fault inside a dependency costs one error
+/// line. Release builds never read the variable.
+fn test_fault(item: &Item) {
+    #[cfg(debug_assertions)]
+    if let Ok(fault) = std::env::var("GRASP_SIM_TEST_FAULT") {
+        if let Some((kind, name)) = fault.split_once(':') {
+            if item.path().to_string_lossy().contains(name) {
+                match kind {
+                    "panic" => panic!("test fault (GRASP_SIM_TEST_FAULT) in {name}"),
+                    "abort" => std::process::abort(),
+                    _ => {}
+                }
+            }
+        }
+    }
+    #[cfg(not(debug_assertions))]
+    let _ = item;
+}
+
+/// The result of one item: its record, or why it has none (its worker was interrupted).
+pub type ItemResult = Result<Record, Interrupted>;
+
+/// Runs `items` (with their `keys`) on `jobs` threads (at least 1), each in the way
+/// `isolation` says; calls `done` as each finishes (from the worker threads, in completion
+/// order); returns the results in item order.
+pub fn run_all(
+    items: &[Item],
+    keys: &[Key],
+    template: &Scenario,
+    options: &RunOptions,
+    jobs: usize,
+    isolation: &Isolation,
+    done: &(dyn Fn(&Item, &ItemResult) + Sync),
+) -> Vec<ItemResult> {
+    let work = || {
+        items
+            .par_iter()
+            .zip(keys)
+            .map(|(item, key)| {
+                let r = match isolation {
+                    Isolation::InProcess => Ok(run_one(item, key, template, options)),
+                    Isolation::Process(w) => isolate::run_isolated(item, key, w),
+                };
+                done(item, &r);
+                r
+            })
+            .collect()
+    };
+    match rayon::ThreadPoolBuilder::new()
+        .num_threads(jobs.max(1))
+        .build()
+    {
+        Ok(pool) => pool.install(work),
+        Err(_) => work(),
+    }
+}
+
+/// Puts together the records of shard files for `keys` (the whole batch, in input order) and
+/// checks them: every key exactly once, no record left over.
+///
+/// `records` are the records read, each with where it came from (`file:line`).
+///
+/// # Errors
+/// [`BatchError::Merge`] saying how many inputs are missing, duplicated, stale (a record for
+/// the input made from different contents, flags or template) or unknown, with the first of
+/// each.
+pub fn merge(keys: &[Key], records: Vec<(String, Record)>) -> Result<Vec<Record>, BatchError> {
+    let mut found: BTreeMap<Key, Vec<(String, Record)>> = BTreeMap::new();
+    for (place, r) in records {
+        found.entry(r.key.clone()).or_default().push((place, r));
+    }
+    let inputs: BTreeMap<&str, &Key> = keys.iter().map(|k| (k.input.as_str(), k)).collect();
+    let mut problems = Vec::new();
+    let mut missing = Vec::new();
+    let mut duplicated = Vec::new();
+    let mut merged = Vec::with_capacity(keys.len());
+    for k in keys {
+        match found.get(k).map(Vec::as_slice) {
+            Some([(_, r)]) => merged.push(r.clone()),
+            Some(many @ [(_, r), ..]) => {
+                duplicated.push(format!(
+                    "{} ({} times: {})",
+                    k.input,
+                    many.len(),
+                    many.iter()
+                        .map(|(p, _)| p.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+                merged.push(r.clone());
+            }
+            _ => missing.push(k.input.clone()),
+        }
+    }
+    let mut stale = Vec::new();
+    let mut unknown = Vec::new();
+    for (k, rs) in &found {
+        match inputs.get(k.input.as_str()) {
+            Some(expected) if *expected == k => {}
+            Some(_) => stale.push(format!("{} ({})", k.input, rs[0].0)),
+            None => unknown.push(format!("{} ({})", k.input, rs[0].0)),
+        }
+    }
+    for (what, list, hint) in [
+        ("missing", &missing, "did every shard finish?"),
+        ("duplicated", &duplicated, "do the shards overlap?"),
+        (
+            "stale",
+            &stale,
+            "made from other contents, flags or template; run its shard again",
+        ),
+        ("unknown", &unknown, "not among the inputs"),
+    ] {
+        if let Some(first) = list.first() {
+            problems.push(format!("{} {what} (first: {first}; {hint})", list.len()));
+        }
+    }
+    if problems.is_empty() {
+        Ok(merged)
+    } else {
+        Err(BatchError::Merge(format!(
+            "{} inputs: {}",
+            keys.len(),
+            problems.join("; ")
+        )))
+    }
+}
+
+/// The counts a batch summary reports, from records (any JSON Lines of run reports).
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Counts {
+    /// Records.
+    pub objects: usize,
+    /// `plan.status` feasible.
+    pub feasible: usize,
+    /// `plan.status` ungraspable.
+    pub ungraspable: usize,
+    /// `sim.verdict` hold, slip, drop.
+    pub hold: usize,
+    /// See `hold`.
+    pub slip: usize,
+    /// See `hold`.
+    pub drop: usize,
+    /// `expect.met` true.
+    pub met: usize,
+    /// `expect.met` false.
+    pub not_met: usize,
+    /// `expect.met` null.
+    pub unjudged: usize,
+    /// Lines with an `error`.
+    pub errors: usize,
+}
+
+impl Counts {
+    /// Counts the outcomes of `lines`.
+    pub fn of<'a>(lines: impl IntoIterator<Item = &'a serde_json::Value>) -> Counts {
+        let mut c = Counts::default();
+        for v in lines {
+            c.objects += 1;
+            if v.get("error").is_some() {
+                c.errors += 1;
+                continue;
+            }
+            match v["plan"]["status"].as_str() {
+                Some("feasible") => c.feasible += 1,
+                _ => c.ungraspable += 1,
+            }
+            match v["sim"]["verdict"].as_str() {
+                Some("hold") => c.hold += 1,
+                Some("slip") => c.slip += 1,
+                Some("drop") => c.drop += 1,
+                _ => {}
+            }
+            match v["expect"]["met"].as_bool() {
+                Some(true) => c.met += 1,
+                Some(false) => c.not_met += 1,
+                None => c.unjudged += 1,
+            }
+        }
+        c
+    }
+}
+
+/// The summary line of a batch: `ran` objects run in `seconds` on `jobs` threads, of
+/// `counts.objects` in all (the rest were already in the file being resumed).
+pub fn summary(counts: &Counts, ran: usize, seconds: f64, jobs: usize) -> String {
+    let Counts {
+        feasible,
+        ungraspable,
+        hold,
+        slip,
+        drop,
+        met,
+        not_met,
+        unjudged,
+        errors,
+        ..
+    } = *counts;
+    let n = ran.max(1);
+    // Threads beyond the number of objects sit idle: per-object time counts the busy ones.
+    let busy = jobs.clamp(1, n);
+    let resumed = if ran == counts.objects {
+        String::new()
+    } else {
+        format!(
+            " ({} run, {} already done)",
+            ran,
+            counts.objects.saturating_sub(ran)
+        )
+    };
+    format!(
+        "batch: {}{resumed} in {:.2} s ({:.3} s per object, {}): {feasible} planned, \
+         {ungraspable} ungraspable; physics: {hold} hold, {slip} slip, {drop} drop; \
+         expectations: {met} met, {not_met} not met, {unjudged} not judged; {}",
+        plural(counts.objects, "object"),
+        seconds,
+        seconds * busy as f64 / n as f64,
+        plural(jobs.max(1), "job"),
+        plural(errors, "error")
+    )
+}
+
+/// `n thing` or `n things`.
+pub fn plural(n: usize, thing: &str) -> String {
+    if n == 1 {
+        format!("1 {thing}")
+    } else {
+        format!("{n} {thing}s")
+    }
+}

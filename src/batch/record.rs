@@ -1,0 +1,237 @@
+//! One object's line in a batch's JSON Lines output, and what identifies it for `--resume` and
+//! `--merge`: the input's path as the batch saw it and a hash of everything that decides its
+//! result.
+//!
+//! A line is the run report (DESIGN.md §6) or `{"scenario", "error"}` for an object that could
+//! not be run, plus `"batch": {"input", "input_hash", "wall_ms"}`. The hash covers the scenario
+//! file's text, the scenario as parsed (so the hand file and, for a bare mesh, the template and
+//! units are in it), the mesh file's bytes, the run options and the grasp-sim version: an input
+//! edited since its line was written does not match it and is run again.
+
+use super::Item;
+use crate::report::{to_rounded_json, RunReport};
+use crate::scenario::Scenario;
+use crate::RunOptions;
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+
+/// What identifies an object's line: its input and the hash of what decides its result.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Key {
+    /// The input path as the batch saw it (a folder's entries as `folder/name`).
+    pub input: String,
+    /// `sha256:` and the hex digest (see the module docs for what it covers).
+    pub input_hash: String,
+}
+
+/// What a batch adds to each line, under `"batch"`.
+#[derive(Debug, Clone, Serialize)]
+pub struct BatchInfo {
+    /// The input path as the batch saw it.
+    pub input: String,
+    /// See [`Key::input_hash`].
+    pub input_hash: String,
+    /// Wall time of this object's run `[ms]`: a timing, different run to run (as
+    /// `plan.timings_ms` and `sim.wall_ms`).
+    pub wall_ms: f64,
+}
+
+/// One object's line, kept as the text written (so a line read back from a file is written
+/// again byte for byte) and as parsed JSON (to count outcomes).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Record {
+    /// What the line belongs to.
+    pub key: Key,
+    /// The JSON object, one line, no newline.
+    pub line: String,
+    /// The same, parsed.
+    pub value: serde_json::Value,
+}
+
+#[derive(Serialize)]
+struct ReportLine<'a> {
+    #[serde(flatten)]
+    report: &'a RunReport,
+    batch: &'a BatchInfo,
+}
+
+#[derive(Serialize)]
+struct ErrorLine<'a> {
+    scenario: &'a str,
+    error: &'a str,
+    batch: &'a BatchInfo,
+}
+
+impl Record {
+    /// The line of a run that finished (numbers rounded as `--json` rounds them).
+    pub fn from_report(report: &RunReport, batch: BatchInfo) -> Record {
+        match to_rounded_json(&ReportLine {
+            report,
+            batch: &batch,
+        }) {
+            Ok(line) => Record::from_line(line, &batch),
+            Err(e) => Record::from_error(
+                &report.scenario,
+                &format!("cannot write the report as JSON: {e}"),
+                batch,
+            ),
+        }
+    }
+
+    /// The line of an object that could not be run: `scenario` names it (its path), `error`
+    /// says why in one line.
+    pub fn from_error(scenario: &str, error: &str, batch: BatchInfo) -> Record {
+        let error = error.replace('\n', " ");
+        let line = to_rounded_json(&ErrorLine {
+            scenario,
+            error: &error,
+            batch: &batch,
+        })
+        .unwrap_or_else(|_| {
+            // Serializing strings and a number cannot fail; keep a valid line regardless.
+            serde_json::json!({"scenario": scenario, "error": error}).to_string()
+        });
+        Record::from_line(line, &batch)
+    }
+
+    fn from_line(line: String, batch: &BatchInfo) -> Record {
+        let value = serde_json::from_str(&line).unwrap_or(serde_json::Value::Null);
+        Record {
+            key: Key {
+                input: batch.input.clone(),
+                input_hash: batch.input_hash.clone(),
+            },
+            line,
+            value,
+        }
+    }
+
+    /// Reads a line written by a batch: a JSON object with `batch.input` and
+    /// `batch.input_hash`.
+    ///
+    /// # Errors
+    /// What is wrong with the line, in a few words.
+    pub fn parse(line: &str) -> Result<Record, String> {
+        let value: serde_json::Value =
+            serde_json::from_str(line).map_err(|e| format!("not JSON ({e})"))?;
+        let field = |name: &str| {
+            value["batch"][name]
+                .as_str()
+                .map(str::to_string)
+                .ok_or_else(|| format!("no `batch.{name}` (not a line written by `batch`)"))
+        };
+        let key = Key {
+            input: field("input")?,
+            input_hash: field("input_hash")?,
+        };
+        Ok(Record {
+            key,
+            line: line.to_string(),
+            value,
+        })
+    }
+
+    /// The error, when the object could not be run.
+    pub fn error(&self) -> Option<&str> {
+        self.value["error"].as_str()
+    }
+}
+
+/// The hash of everything that decides an item's result (see the module docs), as
+/// `sha256:<hex>`.
+pub fn input_hash(item: &Item, template: &Scenario, options: &RunOptions) -> String {
+    let mut h = Sha256::new();
+    let mut part = |label: &str, bytes: &[u8]| {
+        h.update(label.as_bytes());
+        h.update((bytes.len() as u64).to_le_bytes());
+        h.update(bytes);
+    };
+    part("grasp-sim", env!("CARGO_PKG_VERSION").as_bytes());
+    part("options", format!("{options:?}").as_bytes());
+    if let Item::Scenario(p) = item {
+        match std::fs::read(p) {
+            Ok(text) => part("scenario file", &text),
+            Err(e) => part("scenario file unreadable", e.to_string().as_bytes()),
+        }
+    }
+    match super::scenario_for(item, template) {
+        Ok(s) => {
+            // The parsed scenario: its hand (file contents parsed), and for a mesh the template.
+            part("scenario", format!("{s:?}").as_bytes());
+            match std::fs::read(&s.object.mesh) {
+                Ok(bytes) => part("mesh", &bytes),
+                Err(e) => part("mesh unreadable", e.to_string().as_bytes()),
+            }
+        }
+        Err(e) => part("scenario error", format!("{e:#}").as_bytes()),
+    }
+    let digest = h.finalize();
+    let mut hex = String::with_capacity(7 + 64);
+    hex.push_str("sha256:");
+    for b in digest {
+        hex.push_str(&format!("{b:02x}"));
+    }
+    hex
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn info(input: &str) -> BatchInfo {
+        BatchInfo {
+            input: input.to_string(),
+            input_hash: "sha256:00".to_string(),
+            wall_ms: 1.25,
+        }
+    }
+
+    #[test]
+    fn error_lines_read_back() {
+        let r = Record::from_error("a/b.stl", "bad\nmesh", info("a/b.stl"));
+        assert_eq!(
+            r.line,
+            r#"{"scenario":"a/b.stl","error":"bad mesh","batch":{"input":"a/b.stl","input_hash":"sha256:00","wall_ms":1.25}}"#
+        );
+        let back = Record::parse(&r.line).unwrap();
+        assert_eq!(back, r);
+        assert_eq!(back.error(), Some("bad mesh"));
+    }
+
+    #[test]
+    fn lines_without_batch_fields_are_refused() {
+        for (line, why) in [
+            ("{\"scenario\":\"x\"}", "no `batch.input`"),
+            ("{\"batch\":{\"input\":\"x\"}}", "no `batch.input_hash`"),
+            ("{\"batch\":", "not JSON"),
+            ("[1,2]", "no `batch.input`"),
+        ] {
+            let e = Record::parse(line).unwrap_err();
+            assert!(e.contains(why), "{line}: {e}");
+        }
+    }
+
+    #[test]
+    fn the_hash_follows_the_mesh_bytes_and_the_options() {
+        let dir = tempfile::tempdir().unwrap();
+        let mesh = dir.path().join("m.stl");
+        std::fs::write(&mesh, b"solid a\nendsolid a\n").unwrap();
+        let item = Item::Mesh(mesh.clone());
+        let template = super::super::default_template();
+        let opts = RunOptions::default();
+        let h1 = input_hash(&item, &template, &opts);
+        assert!(h1.starts_with("sha256:") && h1.len() == 71, "{h1}");
+        assert_eq!(h1, input_hash(&item, &template, &opts));
+        std::fs::write(&mesh, b"solid b\nendsolid b\n").unwrap();
+        let h2 = input_hash(&item, &template, &opts);
+        assert_ne!(h1, h2);
+        let no_sim = RunOptions {
+            no_sim: true,
+            ..RunOptions::default()
+        };
+        assert_ne!(h2, input_hash(&item, &template, &no_sim));
+        let mut inch = template.clone();
+        inch.object.units = crate::mesh::LengthUnit::Inch;
+        assert_ne!(h2, input_hash(&item, &inch, &opts));
+    }
+}

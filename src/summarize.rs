@@ -1,0 +1,425 @@
+//! `grasp-sim summarize`: a dataset report from a batch's JSON Lines, so nobody needs jq to
+//! read a run.
+//!
+//! Input: lines written by `batch` (or by `grasp-sim --json`): run reports (DESIGN.md §6) and
+//! `{"scenario", "error"}` lines. Output: the counts (planned, ungraspable, errors; hold, slip,
+//! drop; held per gravity direction; expectations), the slowest objects, and a CSV with one row
+//! per object in file order. A last line without its newline (a run interrupted while writing)
+//! is not taken as data: it is skipped with a warning.
+
+use crate::batch::{BatchError, Counts};
+use std::collections::BTreeMap;
+use std::fmt::Write;
+use std::path::Path;
+
+/// One object's row.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// `batch.input`, or the scenario name for a line without one.
+    pub input: String,
+    /// `scenario`.
+    pub scenario: String,
+    /// `plan.status`, or `error`.
+    pub status: String,
+    /// `sim.verdict` (empty for an error).
+    pub verdict: String,
+    /// `sim.translation_mm`, when the check ran.
+    pub translation_mm: Option<f64>,
+    /// `sim.rotation_deg`, when the check ran.
+    pub rotation_deg: Option<f64>,
+    /// `sim.payload_margin`, when searched.
+    pub payload_margin: Option<f64>,
+    /// Each gravity direction and its verdict, `-Z hold +X slip`.
+    pub directions: String,
+    /// `expect.outcome`.
+    pub expected: String,
+    /// `expect.met`.
+    pub met: Option<bool>,
+    /// The object's wall time `[ms]`: `batch.wall_ms`, or (a line from `--json`) the plan's
+    /// stage timings plus the check's wall time.
+    pub wall_ms: f64,
+    /// The error, for an object that could not be run.
+    pub error: String,
+}
+
+/// Per gravity direction: how many grasps were checked under it and their verdicts.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct DirectionCount {
+    /// Checked under this direction.
+    pub checked: usize,
+    /// Held.
+    pub hold: usize,
+    /// Slipped.
+    pub slip: usize,
+    /// Dropped.
+    pub drop: usize,
+}
+
+/// The report on one results file.
+#[derive(Debug, Clone, Default)]
+pub struct Summary {
+    /// The counts, as the batch summary line gives them.
+    pub counts: Counts,
+    /// Per gravity direction (a label such as `-Z (down)`), in label order.
+    pub directions: BTreeMap<String, DirectionCount>,
+    /// One row per line, in file order.
+    pub rows: Vec<Row>,
+    /// Things a reader should know (a partial last line, an input given twice).
+    pub warnings: Vec<String>,
+}
+
+impl Summary {
+    /// Reads a results file.
+    ///
+    /// # Errors
+    /// [`BatchError::Io`] when it cannot be read; [`BatchError::NotARecord`] for a complete
+    /// line that is not a run report or an error line (naming its line number).
+    pub fn read(path: &Path) -> Result<Summary, BatchError> {
+        let bytes = std::fs::read(path).map_err(|e| BatchError::Io {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        Summary::parse(path, &bytes)
+    }
+
+    /// [`Summary::read`] on the file's bytes (`path` names it in errors).
+    ///
+    /// # Errors
+    /// As [`Summary::read`].
+    pub fn parse(path: &Path, bytes: &[u8]) -> Result<Summary, BatchError> {
+        let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let mut s = Summary::default();
+        if complete < bytes.len() {
+            s.warnings.push(format!(
+                "skipped a partial last line ({} bytes, no newline: a run interrupted while writing; `batch --resume` continues it)",
+                bytes.len() - complete
+            ));
+        }
+        let mut values = Vec::new();
+        let mut seen: BTreeMap<String, usize> = BTreeMap::new();
+        for (i, line) in bytes[..complete].split(|&b| b == b'\n').enumerate() {
+            if line.iter().all(u8::is_ascii_whitespace) {
+                continue;
+            }
+            let bad = |why: String| BatchError::NotARecord {
+                path: path.to_path_buf(),
+                line: i + 1,
+                why,
+            };
+            let text = std::str::from_utf8(line).map_err(|_| bad("not UTF-8".to_string()))?;
+            let v: serde_json::Value =
+                serde_json::from_str(text).map_err(|e| bad(format!("not JSON ({e})")))?;
+            let row = row_of(&v).map_err(bad)?;
+            *seen.entry(row.input.clone()).or_insert(0) += 1;
+            for d in v["sim"]["directions"].as_array().into_iter().flatten() {
+                let c = s
+                    .directions
+                    .entry(direction_label(&d["gravity"]))
+                    .or_default();
+                c.checked += 1;
+                match d["verdict"].as_str() {
+                    Some("hold") => c.hold += 1,
+                    Some("slip") => c.slip += 1,
+                    Some("drop") => c.drop += 1,
+                    _ => {}
+                }
+            }
+            s.rows.push(row);
+            values.push(v);
+        }
+        s.counts = Counts::of(&values);
+        let twice: Vec<String> = seen
+            .iter()
+            .filter(|(_, &n)| n > 1)
+            .map(|(k, n)| format!("{k} ({n} times)"))
+            .collect();
+        if let Some(first) = twice.first() {
+            s.warnings.push(format!(
+                "{} given more than once (first: {first}); counted each time",
+                crate::batch::plural(twice.len(), "input")
+            ));
+        }
+        Ok(s)
+    }
+
+    /// The report as text: `name` heads it; the `slowest` slowest objects are listed.
+    pub fn to_text(&self, name: &str, slowest: usize) -> String {
+        let c = &self.counts;
+        let mut t = String::new();
+        let pct = |n: usize| {
+            if c.objects == 0 {
+                0.0
+            } else {
+                100.0 * n as f64 / c.objects as f64
+            }
+        };
+        let _ = writeln!(t, "{name}: {}", crate::batch::plural(c.objects, "object"));
+        let _ = writeln!(
+            t,
+            "  planned       {} ({:.1} %), ungraspable {} ({:.1} %), errors {} ({:.1} %)",
+            c.feasible,
+            pct(c.feasible),
+            c.ungraspable,
+            pct(c.ungraspable),
+            c.errors,
+            pct(c.errors)
+        );
+        let checked = c.hold + c.slip + c.drop;
+        let _ = writeln!(
+            t,
+            "  physics       {} checked: {} hold, {} slip, {} drop; {} not run",
+            checked,
+            c.hold,
+            c.slip,
+            c.drop,
+            c.objects - c.errors - checked
+        );
+        if !self.directions.is_empty() {
+            let _ = writeln!(t, "  held per gravity direction (aligned object frame):");
+            for (label, d) in &self.directions {
+                let _ = writeln!(
+                    t,
+                    "    {label:<10} {} of {} held ({} slip, {} drop)",
+                    d.hold, d.checked, d.slip, d.drop
+                );
+            }
+        }
+        let _ = writeln!(
+            t,
+            "  expectations  {} met, {} not met, {} not judged",
+            c.met, c.not_met, c.unjudged
+        );
+        let total_s: f64 = self.rows.iter().map(|r| r.wall_ms).sum::<f64>() / 1000.0;
+        let _ = writeln!(
+            t,
+            "  time          {total_s:.1} s summed over objects ({:.3} s per object)",
+            total_s / c.objects.max(1) as f64
+        );
+        let mut order: Vec<&Row> = self.rows.iter().collect();
+        // Slowest first; equal times in file order (the sort is stable).
+        order.sort_by(|a, b| b.wall_ms.total_cmp(&a.wall_ms));
+        if slowest > 0 && !order.is_empty() {
+            let _ = writeln!(t, "  slowest:");
+            for r in order.iter().take(slowest) {
+                let what = if r.error.is_empty() {
+                    format!("{} {}", r.status, r.verdict)
+                } else {
+                    "error".to_string()
+                };
+                let _ = writeln!(
+                    t,
+                    "    {:>8.2} s  {}  ({what})",
+                    r.wall_ms / 1000.0,
+                    r.input
+                );
+            }
+        }
+        let errors: Vec<&Row> = self.rows.iter().filter(|r| !r.error.is_empty()).collect();
+        if !errors.is_empty() {
+            let _ = writeln!(t, "  errors:");
+            for r in errors.iter().take(10) {
+                let _ = writeln!(t, "    {}: {}", r.input, r.error);
+            }
+            if errors.len() > 10 {
+                let _ = writeln!(t, "    ... and {} more (see the CSV)", errors.len() - 10);
+            }
+        }
+        t
+    }
+
+    /// One row per object, in file order, with a header.
+    pub fn to_csv(&self) -> String {
+        let mut t = String::from(
+            "input,scenario,status,verdict,translation_mm,rotation_deg,payload_margin,directions,expected,met,wall_ms,error\n",
+        );
+        let num = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v}"));
+        for r in &self.rows {
+            let fields = [
+                csv_field(&r.input),
+                csv_field(&r.scenario),
+                csv_field(&r.status),
+                csv_field(&r.verdict),
+                num(r.translation_mm),
+                num(r.rotation_deg),
+                num(r.payload_margin),
+                csv_field(&r.directions),
+                csv_field(&r.expected),
+                r.met.map_or(String::new(), |m| m.to_string()),
+                format!("{:.3}", r.wall_ms),
+                csv_field(&r.error),
+            ];
+            t.push_str(&fields.join(","));
+            t.push('\n');
+        }
+        t
+    }
+}
+
+/// A field quoted when it holds a comma, a quote or a line break (RFC 4180).
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// `-Z (down)` for gravity along an axis (the aligned object frame, the thesis's weight
+/// direction −Z), the rounded vector otherwise.
+fn direction_label(g: &serde_json::Value) -> String {
+    let v: Vec<f64> = g
+        .as_array()
+        .map(|a| a.iter().filter_map(serde_json::Value::as_f64).collect())
+        .unwrap_or_default();
+    if v.len() != 3 {
+        return "?".to_string();
+    }
+    for (i, axis) in ["X", "Y", "Z"].iter().enumerate() {
+        if (v[i].abs() - 1.0).abs() < 1e-6 {
+            let sign = if v[i] < 0.0 { "-" } else { "+" };
+            let down = if i == 2 && v[i] < 0.0 { " (down)" } else { "" };
+            return format!("{sign}{axis}{down}");
+        }
+    }
+    format!("({:.3}, {:.3}, {:.3})", v[0], v[1], v[2])
+}
+
+/// The row of one line.
+fn row_of(v: &serde_json::Value) -> Result<Row, String> {
+    if !v.is_object() {
+        return Err("not a JSON object".to_string());
+    }
+    let scenario = v["scenario"]
+        .as_str()
+        .ok_or("no `scenario` (not a run report from `batch` or `--json`)")?
+        .to_string();
+    let input = v["batch"]["input"]
+        .as_str()
+        .unwrap_or(&scenario)
+        .to_string();
+    if let Some(e) = v.get("error") {
+        return Ok(Row {
+            input,
+            scenario,
+            status: "error".to_string(),
+            verdict: String::new(),
+            translation_mm: None,
+            rotation_deg: None,
+            payload_margin: None,
+            directions: String::new(),
+            expected: String::new(),
+            met: None,
+            wall_ms: v["batch"]["wall_ms"].as_f64().unwrap_or(0.0),
+            error: e.as_str().map_or_else(|| e.to_string(), str::to_string),
+        });
+    }
+    let status = v["plan"]["status"]
+        .as_str()
+        .ok_or("no `plan.status` (not a run report)")?
+        .to_string();
+    let sim = &v["sim"];
+    let directions: Vec<String> = sim["directions"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .map(|d| {
+            let label = direction_label(&d["gravity"]);
+            let label = label.trim_end_matches(" (down)");
+            format!("{label} {}", d["verdict"].as_str().unwrap_or("?"))
+        })
+        .collect();
+    let wall_ms = v["batch"]["wall_ms"].as_f64().unwrap_or_else(|| {
+        let plan: f64 = v["plan"]["timings_ms"]
+            .as_object()
+            .map(|m| m.values().filter_map(serde_json::Value::as_f64).sum())
+            .unwrap_or(0.0);
+        plan + sim["wall_ms"].as_f64().unwrap_or(0.0)
+    });
+    Ok(Row {
+        input,
+        scenario,
+        status,
+        verdict: sim["verdict"].as_str().unwrap_or("").to_string(),
+        translation_mm: sim["translation_mm"].as_f64(),
+        rotation_deg: sim["rotation_deg"].as_f64(),
+        payload_margin: sim["payload_margin"].as_f64(),
+        directions: directions.join(" "),
+        expected: v["expect"]["outcome"].as_str().unwrap_or("").to_string(),
+        met: v["expect"]["met"].as_bool(),
+        wall_ms,
+        error: String::new(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HOLD: &str = r#"{"scenario":"a","plan":{"status":"feasible"},"sim":{"verdict":"hold","translation_mm":0.5,"rotation_deg":0.25,"directions":[{"gravity":[0.0,0.0,-1.0],"verdict":"hold"},{"gravity":[1.0,0.0,0.0],"verdict":"slip"}]},"expect":{"outcome":"hold","met":true},"batch":{"input":"d/a.toml","input_hash":"sha256:0","wall_ms":1500.0}}"#;
+    const UNGRASPABLE: &str = r#"{"scenario":"b","plan":{"status":"ungraspable","timings_ms":{"load":1.0,"search":2.5}},"sim":{"verdict":"not_run"},"expect":{"outcome":"none","met":null}}"#;
+    const ERROR: &str = r#"{"scenario":"d/c, \"odd\".stl","error":"timed out","batch":{"input":"d/c, \"odd\".stl","input_hash":"sha256:1","wall_ms":2000.0}}"#;
+
+    #[test]
+    fn counts_directions_slowest_and_csv() {
+        let text = format!("{HOLD}\n{UNGRASPABLE}\n\n{ERROR}\n{{\"scen");
+        let s = Summary::parse(Path::new("r.jsonl"), text.as_bytes()).unwrap();
+        assert_eq!(s.counts.objects, 3);
+        assert_eq!(
+            (
+                s.counts.feasible,
+                s.counts.ungraspable,
+                s.counts.errors,
+                s.counts.hold
+            ),
+            (1, 1, 1, 1)
+        );
+        assert_eq!(s.directions["-Z (down)"].hold, 1);
+        assert_eq!(s.directions["+X"].slip, 1);
+        assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+        assert!(s.warnings[0].contains("partial last line"));
+        assert_eq!(s.rows[1].wall_ms, 3.5);
+        let t = s.to_text("r.jsonl", 2);
+        assert!(t.contains("r.jsonl: 3 objects"), "{t}");
+        assert!(t.contains("-Z (down)  1 of 1 held"), "{t}");
+        let slow: Vec<&str> = t
+            .lines()
+            .skip_while(|l| !l.contains("slowest"))
+            .skip(1)
+            .take(2)
+            .collect();
+        assert!(
+            slow[0].contains("2.00 s") && slow[1].contains("1.50 s  d/a.toml"),
+            "{t}"
+        );
+        let csv = s.to_csv();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(lines.len(), 4);
+        assert_eq!(
+            lines[1],
+            "d/a.toml,a,feasible,hold,0.5,0.25,,-Z hold +X slip,hold,true,1500.000,"
+        );
+        assert!(
+            lines[3].starts_with("\"d/c, \"\"odd\"\".stl\","),
+            "{}",
+            lines[3]
+        );
+    }
+
+    #[test]
+    fn bad_lines_name_the_file_and_line() {
+        for (text, why) in [
+            (
+                "{\"scenario\":\"a\",\"plan\":{\"status\":\"feasible\"}}\nnot json\n",
+                "line 2 is not a batch record: not JSON",
+            ),
+            ("[1]\n", "line 1 is not a batch record: not a JSON object"),
+            ("{\"x\":1}\n", "no `scenario`"),
+            ("{\"scenario\":\"a\"}\n", "no `plan.status`"),
+        ] {
+            let e = Summary::parse(Path::new("r.jsonl"), text.as_bytes())
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("r.jsonl: ") && e.contains(why), "{e}");
+        }
+    }
+}
