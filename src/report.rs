@@ -19,6 +19,10 @@ pub struct RunReport {
     pub sim: SimReport,
     /// Whether the scenario's expectations were met.
     pub expect: ExpectReport,
+    /// The chosen grasp's analytic quality (Ferrari–Canny epsilon and volume, with its
+    /// contacts); `null` without a grasp. From the physics check's contacts when it ran on
+    /// the grasp (`quality.source` = `sim`), else from the planned contacts (`planned`).
+    pub quality: Option<crate::quality::Quality>,
     /// One-line warnings about the input (repairs made, an open surface, ...).
     pub warnings: Vec<String>,
 }
@@ -136,6 +140,41 @@ pub struct GraspReport {
     /// The physics check on this grasp, when it ran on it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub check: Option<CandidateCheck>,
+    /// This grasp's analytic quality, without its contacts (the chosen grasp's are in the
+    /// report's `quality`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quality: Option<GraspQuality>,
+}
+
+/// A candidate grasp's analytic quality in brief.
+#[derive(Debug, Clone, Serialize)]
+pub struct GraspQuality {
+    /// `sim` or `planned` contacts.
+    pub source: &'static str,
+    /// L1 Ferrari–Canny epsilon (0: not force closure).
+    pub epsilon: f64,
+    /// L1 wrench-space volume.
+    pub volume: f64,
+    /// L∞ epsilon, when computed.
+    pub epsilon_linf: Option<f64>,
+    /// True if and only if the origin lies strictly inside the wrench space.
+    pub force_closure: bool,
+    /// Number of contacts.
+    pub contacts: usize,
+}
+
+impl GraspQuality {
+    /// The brief of `q`.
+    pub fn of(q: &crate::quality::Quality) -> GraspQuality {
+        GraspQuality {
+            source: q.source,
+            epsilon: q.epsilon,
+            volume: q.volume,
+            epsilon_linf: q.linf.map(|m| m.epsilon),
+            force_closure: q.force_closure,
+            contacts: q.contacts.len(),
+        }
+    }
 }
 
 /// The physics check's verdict on one candidate grasp.
