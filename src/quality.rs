@@ -240,10 +240,20 @@ fn hull(points: &[Wrench]) -> Option<Hull> {
         c
     };
     std::panic::catch_unwind(move || {
+        // Qt first; where qhull meets a precision error on nearly degenerate input (duplicate
+        // contacts, a contact's coplanar edges), joggled input (QJ) as qhull's docs advise.
         let qh = qhull::Qh::builder()
             .compute(true)
             .triangulate(true)
-            .build_managed(6, coords)
+            .build_managed(6, coords.clone())
+            .or_else(|_| {
+                qhull::Qh::builder()
+                    .compute(true)
+                    .qhull_args(["QJ"])
+                    .map(|b| b.build_managed(6, coords))
+                    .map_err(|_| ())?
+                    .map_err(|_| ())
+            })
             .ok()?;
         let mut facets = Vec::new();
         let mut volume = 0.0;
