@@ -59,6 +59,49 @@ fn bench_plan(c: &mut Criterion) {
     }
     g.finish();
 
+    // The whole selection as a run does it without the physics check: the thesis's axis first,
+    // then the other axes and senses, then the extended rules (issue 13: what three axes cost).
+    let mut g = c.benchmark_group("select");
+    let d10 = objects::cylinder(10.0, 124.0);
+    let sphere = objects::uv_sphere(30.0, 72);
+    let cases = [
+        ("cup", objects::frustum(56.0, 80.0, 110.0)),
+        (
+            "chapter4",
+            objects::thesis_objects().pop().expect("chapter 4").1,
+        ),
+        ("d10_ungraspable_every_axis", d10),
+        ("sphere_extended_rules", sphere),
+    ];
+    for (name, mesh) in cases {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let props = grasp_sim::mesh::mass_properties(black_box(&mesh));
+                let never = |_: &grasp_sim::mesh::AlignedObject,
+                             _: &grasp_sim::plan::search::Grasp|
+                 -> grasp_sim::sim::SimOutcome {
+                    unreachable!("no physics check")
+                };
+                let mut t = BTreeMap::new();
+                grasp_sim::select::select(
+                    &mesh,
+                    &props,
+                    &grasp_sim::select::SelectParams {
+                        hand: &hand,
+                        planner: &params,
+                        friction: 0.3,
+                        collect: 1,
+                        max_checked: None,
+                        check: &never,
+                        domains: None,
+                    },
+                    &mut t,
+                )
+            })
+        });
+    }
+    g.finish();
+
     let cup = align(&objects::frustum(56.0, 80.0, 110.0)).mesh;
     let mut g = c.benchmark_group("plan_scaling");
     for step in [5.0, 10.0, 20.0] {

@@ -57,6 +57,7 @@ fn study(path: &Path) -> Result<Vec<Row>, String> {
             collect: 4,
             max_checked: None,
             check: &no_check,
+            domains: None,
         },
         &mut BTreeMap::new(),
     );

@@ -223,11 +223,10 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
         let _ = writeln!(s, "      </body>");
     }
     let _ = writeln!(s, "    </body>");
-    // The object: free, at the origin of the aligned frame, with grasp-sim's inertia.
-    let props = crate::mesh::mass_properties(&input.object.mesh);
-    let density_kg_mm3 = case.mass_kg / props.volume_mm3;
-    let inertia = props.inertia * density_kg_mm3 * MM * MM;
-    let c = props.centroid.coords * MM;
+    // The object: free, at the origin of the aligned frame, with the mass distribution the rapier
+    // check gives it: its collider's (convex hull or decomposition) at the scenario's mass. (The
+    // mesh's own surface integral is no inertia at all for an open mesh.)
+    let (c, inertia) = crate::sim::collider_inertia(case.object, case.mass_kg);
     let _ = writeln!(s, "    <body name=\"object\" pos=\"0 0 0\">");
     let _ = writeln!(s, "      <freejoint name=\"object\"/>");
     let _ = writeln!(

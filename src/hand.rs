@@ -188,10 +188,19 @@ impl Hand {
         let mut doc: toml::Table = toml::from_str(text)
             .map_err(|e: toml::de::Error| parse_err(crate::scenario::toml_message(&e, text)))?;
         for (key, value) in overrides {
-            set_number(&mut doc, key, *value).map_err(|problem| HandError::BadOverride {
-                path: path.to_path_buf(),
-                key: key.clone(),
-                problem,
+            set_number(&mut doc, key, *value).map_err(|problem| {
+                let mut keys = Vec::new();
+                number_keys(&doc, "", &mut keys);
+                let problem =
+                    match crate::scenario::did_you_mean(key, keys.iter().map(|k| k.as_str())) {
+                        Some(k) => format!("{problem}; did you mean `{k}`?"),
+                        None => problem,
+                    };
+                HandError::BadOverride {
+                    path: path.to_path_buf(),
+                    key: key.clone(),
+                    problem,
+                }
             })?;
         }
         // Without overrides, parse the text itself so an error carries its line; with them, the
@@ -202,7 +211,11 @@ impl Hand {
         } else {
             toml::Value::Table(doc)
                 .try_into()
-                .map_err(|e: toml::de::Error| parse_err(e.message().replace('\n', " ")))?
+                .map_err(|e: toml::de::Error| {
+                    parse_err(crate::scenario::with_suggestion(
+                        &e.message().replace('\n', " "),
+                    ))
+                })?
         };
         hand.validate(path)?;
         Ok(hand)
@@ -334,6 +347,17 @@ impl Hand {
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), f| {
                 (lo.min(f.height_mm), hi.max(f.height_mm))
             })
+    }
+}
+
+/// Every dotted key of `doc` that holds a number, in the table's order.
+fn number_keys(doc: &toml::Table, prefix: &str, out: &mut Vec<String>) {
+    for (k, v) in doc {
+        match v {
+            toml::Value::Float(_) | toml::Value::Integer(_) => out.push(format!("{prefix}{k}")),
+            toml::Value::Table(t) => number_keys(t, &format!("{prefix}{k}."), out),
+            _ => {}
+        }
     }
 }
 

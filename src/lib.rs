@@ -168,11 +168,18 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
                     .max(1),
             ),
             check: &check,
+            domains: None,
         },
         &mut timings,
     );
     let shown = selection.reported_axis();
     let graded = &shown.graded;
+    let open_slices = graded
+        .domain
+        .slices
+        .iter()
+        .filter(|s| s.open_count() > 0)
+        .count();
     let qualities: Vec<quality::Quality> = selection
         .candidates
         .iter()
@@ -248,6 +255,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             Vec::new()
         },
         candidates_checked: selection.checked(),
+        open_slices,
         axes: selection.axes.iter().map(axis_report).collect(),
         timings_ms: timings,
     };
@@ -278,6 +286,13 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         warnings: loaded
             .warnings()
             .into_iter()
+            .chain((open_slices > 0).then(|| {
+                format!(
+                    "{open_slices} of {} vertical slices stay open after joining their ends: \
+                     the planner uses their pieces as they are",
+                    graded.domain.slices.len()
+                )
+            }))
             .map(|w| format!("{}: {w}", scenario.object.mesh.display()))
             .collect(),
     };

@@ -39,6 +39,11 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
             no_sim,
             payload,
         }) => {
+            if no_sim && payload {
+                eprintln!(
+                    "grasp-sim: warning: --payload is ignored with --no-sim (the payload search is part of the physics check)"
+                );
+            }
             let options = RunOptions {
                 no_sim,
                 payload,
@@ -92,6 +97,11 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
             check_writable_dir(d).context(flag)?;
         }
     }
+    if cli.no_sim && cli.payload {
+        eprintln!(
+            "grasp-sim: warning: --payload is ignored with --no-sim (the payload search is part of the physics check)"
+        );
+    }
     let mut template = grasp_sim::batch::default_template();
     template.object.units = parse_units(&cli.units);
     // Each input runs on its own: a bad one is reported on stderr and the others still run and
@@ -104,9 +114,14 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         } else {
             grasp_sim::batch::Item::Scenario(path.clone())
         };
-        let report = match grasp_sim::batch::scenario_for(&item, &template)
-            .and_then(|s| run(&s, &options))
-        {
+        let report = match grasp_sim::batch::scenario_for(&item, &template).and_then(|s| {
+            let spinner = progress_spinner(&s, &options);
+            let r = run(&s, &options);
+            if let Some(b) = spinner {
+                b.finish_and_clear();
+            }
+            r
+        }) {
             Ok(r) => r,
             Err(e) => {
                 eprintln!("grasp-sim: error: {}", format!("{e:#}").replace('\n', " "));
@@ -117,8 +132,14 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         for w in &report.warnings {
             eprintln!("grasp-sim: warning: {w}");
         }
+        if let Some(dir) = &options.report {
+            eprintln!(
+                "grasp-sim: report written to {}",
+                dir.join(&report.scenario).join("report.html").display()
+            );
+        }
         if cli.json {
-            writeln!(out, "{}", serde_json::to_string(&report)?)?;
+            writeln!(out, "{}", grasp_sim::report::to_rounded_json(&report)?)?;
         } else {
             write!(out, "{}", report.summary())?;
         }
@@ -128,6 +149,32 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         }
     }
     Ok(status)
+}
+
+/// A spinner with the elapsed time on stderr while one scenario runs, only when stderr is a
+/// terminal (piped or redirected output stays clean) and the run does the physics check (the
+/// plan alone takes milliseconds; `six` and `--payload` take seconds to tens of seconds).
+fn progress_spinner(s: &Scenario, options: &RunOptions) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if options.no_sim || !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let mut what = vec!["planning".to_string(), "physics check".to_string()];
+    if s.sim.gravity == grasp_sim::scenario::GravityMode::Six {
+        what[1] = "physics check (gravity six)".to_string();
+    }
+    if options.payload {
+        what.push("payload search".to_string());
+    }
+    let b = indicatif::ProgressBar::new_spinner();
+    b.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {elapsed} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    b.set_message(format!("{}: {}", s.name, what.join(", ")));
+    b.enable_steady_tick(std::time::Duration::from_millis(120));
+    b.tick();
+    Some(b)
 }
 
 /// Creates `dir` if needed and checks a file can be written in it.
@@ -168,6 +215,7 @@ fn tune(
     jobs: Option<usize>,
 ) -> anyhow::Result<u8> {
     use grasp_sim::{batch, tune};
+    use std::io::IsTerminal;
     let sweeps = params
         .iter()
         .map(|p| tune::parse_sweep(p).map_err(|m| anyhow::anyhow!("--param {m}")))
@@ -180,16 +228,62 @@ fn tune(
     check_writable_dir(out).context("--out")?;
     let jobs = jobs.unwrap_or_else(default_jobs).max(1);
     let t0 = std::time::Instant::now();
-    let result = tune::tune(&items, &template, &sweeps, candidates.max(1), jobs)?;
+    // A progress bar over objects x settings, on a terminal only (as batch's).
+    let total = items.len() * tune::grid(&sweeps).len();
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new(total as u64);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} {elapsed} tune: {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b.set_message("loading objects");
+        b.tick();
+        b
+    });
+    let progress = |name: &str| {
+        if let Some(b) = &bar {
+            b.set_message(format!("{name} done at one setting"));
+            b.inc(1);
+        }
+    };
+    let result = tune::tune_with_progress(
+        &items,
+        &template,
+        &sweeps,
+        candidates.max(1),
+        jobs,
+        &progress,
+    );
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let result = result?;
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot create folder", out.display()))?;
     write_atomically(&out.join("tune.csv"), tune::to_csv(&result).as_bytes())?;
     write_atomically(
         &out.join("tune.json"),
-        serde_json::to_string_pretty(&result)?.as_bytes(),
+        grasp_sim::report::to_rounded_json_pretty(&result)?.as_bytes(),
     )?;
     let plots = tune::plot(&result, out).map_err(|m| anyhow::anyhow!(m))?;
     print!("{}", tune::to_table(&result));
+    let invalid = result
+        .settings
+        .iter()
+        .filter(|s| s.invalid.is_some())
+        .count();
+    if invalid == result.settings.len() {
+        anyhow::bail!(
+            "--param: every setting is invalid, nothing to rank ({})",
+            result.settings[0].invalid.as_deref().unwrap_or("")
+        );
+    }
+    if invalid > 0 {
+        eprintln!(
+            "tune: {} invalid (not run, not ranked; the table says why)",
+            grasp_sim::batch::plural(invalid, "setting")
+        );
+    }
     let best = &result.settings[result.best];
     let setting: Vec<String> = sweeps
         .iter()
@@ -197,25 +291,31 @@ fn tune(
         .map(|(s, v)| format!("{}={v}", s.name))
         .collect();
     println!(
-        "best: {} (hold rate {:.3}, mean payload margin {:.2}, mean translation {} mm) over {} objects",
+        "best: {} (hold rate {:.3}, mean payload margin {:.2}, mean translation {} mm) over {}",
         setting.join(" "),
         best.hold_rate,
         best.mean_payload_margin,
-        best.mean_translation_mm.map_or("-".to_string(), |t| format!("{t:.2}")),
-        items.len()
+        best.mean_translation_mm
+            .map_or("-".to_string(), |t| format!("{t:.2}")),
+        batch::plural(items.len(), "object")
     );
     let c = &result.counters;
     eprintln!(
-        "tune: {} settings x {} objects in {:.1} s ({jobs} jobs); loaded {} objects, built {} domains, ran {} plans and {} physics checks ({} reused); wrote {}",
-        result.settings.len(),
-        items.len(),
+        "tune: {} x {} in {:.1} s ({}); loaded {}, built {}, ran {} and {} ({} reused); wrote {}",
+        batch::plural(result.settings.len(), "setting"),
+        batch::plural(items.len(), "object"),
         t0.elapsed().as_secs_f64(),
-        c.objects_loaded,
-        c.domains_built,
-        c.plans,
-        c.sim_runs,
+        batch::plural(jobs, "job"),
+        batch::plural(c.objects_loaded, "object"),
+        batch::plural(c.domains_built, "domain"),
+        batch::plural(c.plans, "plan"),
+        batch::plural(c.sim_runs, "physics check"),
         c.sim_reused,
-        plots.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+        plots
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
     );
     Ok(0)
 }
@@ -297,7 +397,7 @@ fn batch(
         let line = match r {
             Ok(rep) => {
                 not_met += usize::from(rep.expect.met == Some(false));
-                serde_json::to_string(rep)?
+                grasp_sim::report::to_rounded_json(rep)?
             }
             Err(e) => {
                 errors += 1;

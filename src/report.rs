@@ -103,6 +103,9 @@ pub struct PlanReport {
     pub grasps: Vec<GraspReport>,
     /// Candidates the physics check ran on, in search order until one held.
     pub candidates_checked: usize,
+    /// Vertical slices (of the axis reported) with a contour that stays open after its ends
+    /// were joined: an open mesh's gaps wider than the joining tolerance.
+    pub open_slices: usize,
     /// Each principal axis and rule set the planner tried, in order.
     pub axes: Vec<AxisReport>,
     /// Per-stage wall times `[ms]`.
@@ -174,6 +177,71 @@ impl GraspQuality {
             force_closure: q.force_closure,
             contacts: q.contacts.len(),
         }
+    }
+}
+
+impl GraspReport {
+    /// Returns true if and only if `other` is the same grasp: the same axis, rules, approach,
+    /// elevation, pitch and joint angles.
+    pub fn is_same_grasp(&self, other: &GraspReport) -> bool {
+        self.axis_name == other.axis_name
+            && self.rules == other.rules
+            && self.approach_angle_deg == other.approach_angle_deg
+            && self.elevation_index == other.elevation_index
+            && self.palm_pitch_deg == other.palm_pitch_deg
+            && self
+                .fingers
+                .iter()
+                .zip(&other.fingers)
+                .all(|(a, b)| a.theta1_deg == b.theta1_deg && a.theta2_deg == b.theta2_deg)
+    }
+
+    /// The rules in words: `thesis`, or `extended: ` and the relaxations used.
+    pub fn one_line_rules(&self) -> String {
+        let rules = match serde_json::to_value(self.rules) {
+            Ok(serde_json::Value::String(r)) => r,
+            _ => String::new(),
+        };
+        let relaxed: Vec<String> = self
+            .relaxations
+            .iter()
+            .filter_map(|r| match serde_json::to_value(r) {
+                Ok(serde_json::Value::String(r)) => Some(r),
+                _ => None,
+            })
+            .collect();
+        if relaxed.is_empty() {
+            rules
+        } else {
+            format!("{rules}: {}", relaxed.join(", "))
+        }
+    }
+
+    /// The grasp in one line: axis and rules (with relaxations), approach, elevation, pitch,
+    /// joint angles, and the physics check's verdict when it ran on this grasp.
+    pub fn one_line(&self) -> String {
+        let rules = self.one_line_rules();
+        let thetas: Vec<String> = self
+            .fingers
+            .iter()
+            .map(|f| format!("{:.1}/{:.1}", f.theta1_deg, f.theta2_deg))
+            .collect();
+        let check = match &self.check {
+            Some(c) => format!(
+                "; check: {} ({:.2} mm, {:.2} deg)",
+                c.verdict, c.translation_mm, c.rotation_deg
+            ),
+            None => "; not checked".to_string(),
+        };
+        format!(
+            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{check}",
+            self.axis_name,
+            self.approach_angle_deg,
+            self.elevation_index,
+            self.elevation_mm,
+            fmt_signed(self.palm_pitch_deg, 1),
+            thetas.join(", ")
+        )
     }
 }
 
@@ -399,11 +467,33 @@ impl RunReport {
             Some(r) => format!("{} ({r})", p.status),
             None => p.status.clone(),
         };
+        let checked = if p.candidates_checked > 0 {
+            format!(", {} checked", p.candidates_checked)
+        } else {
+            String::new()
+        };
         let _ = writeln!(
             s,
-            "  Plan        {plan_line}; {} tried",
+            "  Plan        {plan_line}; {} tried{checked}",
             crate::batch::plural(p.candidates_tried, "candidate")
         );
+        if p.grasps.len() > 1 {
+            let _ = writeln!(
+                s,
+                "  Candidates  {} collected, in search order (* the one reported below):",
+                p.grasps.len()
+            );
+            for (k, g) in p.grasps.iter().enumerate() {
+                let chosen = p.grasp.as_ref().is_some_and(|c| c.is_same_grasp(g));
+                let _ = writeln!(
+                    s,
+                    "   {}{:>2}. {}",
+                    if chosen { "*" } else { " " },
+                    k + 1,
+                    g.one_line()
+                );
+            }
+        }
         if let Some(g) = &p.grasp {
             let _ = writeln!(s, "  Grasp Parameter Set:");
             let _ = writeln!(s, "    GraspCondition -> Passed");
@@ -437,7 +527,7 @@ impl RunReport {
             );
         }
         let sim_line = match (&self.sim.reason, self.sim.translation_mm) {
-            (Some(r), _) => format!("{} ({r})", self.sim.verdict),
+            (Some(r), _) => format!("{} ({r})", self.sim.verdict.replace('_', " ")),
             (None, Some(t)) => format!(
                 "{}: moved {:.2} mm and {:.2} deg relative to the palm while held; {} steps, {:.0} ms{}",
                 self.sim.verdict,
@@ -510,6 +600,97 @@ impl RunReport {
     }
 }
 
+/// Significant digits kept in reported JSON figures: float noise from the arithmetic
+/// (7.000000000000007) goes, every measured or planned figure keeps more digits than it is
+/// accurate to (micrometres on a metre-sized object, 1e-10 on a unit quaternion).
+pub const JSON_SIGNIFICANT_DIGITS: usize = 12;
+
+/// Magnitudes below this are float noise around zero in the report's units (mm, deg, kg, s,
+/// a unit quaternion's components): reported as 0.
+pub const JSON_ZERO_BELOW: f64 = 1e-10;
+
+/// `value` as JSON text with every fractional number rounded to [`JSON_SIGNIFICANT_DIGITS`]
+/// significant digits, magnitudes below [`JSON_ZERO_BELOW`] and -0 written as 0, and integers
+/// and field order left as they are. Deterministic: the same value gives the same text.
+///
+/// # Errors
+/// When `value` cannot be serialized (never for the report types).
+pub fn to_rounded_json<T: Serialize>(value: &T) -> serde_json::Result<String> {
+    Ok(round_json_numbers(&serde_json::to_string(value)?))
+}
+
+/// [`to_rounded_json`] on JSON text, pretty-printed with indentation.
+///
+/// # Errors
+/// As [`to_rounded_json`].
+pub fn to_rounded_json_pretty<T: Serialize>(value: &T) -> serde_json::Result<String> {
+    Ok(round_json_numbers(&serde_json::to_string_pretty(value)?))
+}
+
+/// Rewrites every number with a fraction or an exponent in JSON text, outside strings.
+fn round_json_numbers(json: &str) -> String {
+    let mut out = String::with_capacity(json.len());
+    let mut chars = json.char_indices().peekable();
+    let mut in_string = false;
+    let mut escaped = false;
+    while let Some((i, c)) = chars.next() {
+        if in_string {
+            out.push(c);
+            match (escaped, c) {
+                (true, _) => escaped = false,
+                (false, '\\') => escaped = true,
+                (false, '"') => in_string = false,
+                _ => {}
+            }
+            continue;
+        }
+        if c == '"' {
+            in_string = true;
+            out.push(c);
+            continue;
+        }
+        if c == '-' || c.is_ascii_digit() {
+            let mut end = i + c.len_utf8();
+            while let Some(&(j, d)) = chars.peek() {
+                if d.is_ascii_digit() || matches!(d, '.' | 'e' | 'E' | '+' | '-') {
+                    end = j + d.len_utf8();
+                    chars.next();
+                } else {
+                    break;
+                }
+            }
+            let token = &json[i..end];
+            let is_float = token.contains(['.', 'e', 'E']);
+            match token.parse::<f64>() {
+                Ok(x) if is_float => {
+                    let r = round_significant(x, JSON_SIGNIFICANT_DIGITS);
+                    let r = if r.abs() < JSON_ZERO_BELOW { 0.0 } else { r };
+                    match serde_json::Number::from_f64(r) {
+                        Some(n) => out.push_str(&n.to_string()),
+                        None => out.push_str(token),
+                    }
+                }
+                _ => out.push_str(token),
+            }
+            continue;
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// `x` rounded to `digits` significant digits (through its decimal text, so 7.000000000000007
+/// becomes exactly 7.0), with -0 as 0; non-finite values unchanged.
+pub fn round_significant(x: f64, digits: usize) -> f64 {
+    if !x.is_finite() || x == 0.0 {
+        return if x == 0.0 { 0.0 } else { x };
+    }
+    let r: f64 = format!("{:.*e}", digits.saturating_sub(1), x)
+        .parse()
+        .unwrap_or(x);
+    r + 0.0
+}
+
 /// `v` with `digits` decimals, without the sign of a value that rounds to zero ("-0.0").
 pub fn fmt_signed(v: f64, digits: usize) -> String {
     let s = format!("{v:.digits$}");
@@ -534,6 +715,36 @@ fn capitalise(name: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::fmt_signed;
+
+    #[test]
+    fn reported_figures_lose_float_noise_only() {
+        use super::{round_significant, to_rounded_json};
+        assert_eq!(round_significant(7.000000000000007, 12), 7.0);
+        assert_eq!(round_significant(0.30000000000000004, 12), 0.3);
+        assert_eq!(round_significant(-6.225829064425771, 12), -6.22582906443);
+        assert_eq!(round_significant(6842.683214567891, 12), 6842.68321457);
+        assert_eq!(round_significant(-0.0, 12), 0.0);
+        assert!(round_significant(-0.0, 12).is_sign_positive());
+        assert_eq!(round_significant(1.5e-18, 12), 1.5e-18);
+        #[derive(serde::Serialize)]
+        struct T {
+            z: Vec<f64>,
+            a: f64,
+            s: &'static str,
+            n: i64,
+        }
+        let v = to_rounded_json(&T {
+            z: vec![7.000000000000007, 3.0, 3.6063889953e-16, -0.0],
+            a: -1.25e-3,
+            s: "x 7.000000000000007 \" 1.0000000000001",
+            n: -12,
+        })
+        .unwrap();
+        assert_eq!(
+            v,
+            r#"{"z":[7.0,3.0,0.0,0.0],"a":-0.00125,"s":"x 7.000000000000007 \" 1.0000000000001","n":-12}"#
+        );
+    }
 
     #[test]
     fn a_value_that_rounds_to_zero_has_no_sign() {

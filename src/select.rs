@@ -98,7 +98,14 @@ pub struct SelectParams<'a> {
     /// Runs the physics check on a grasp about an axis.
     #[allow(clippy::type_complexity)]
     pub check: &'a dyn Fn(&AlignedObject, &Grasp) -> SimOutcome,
+    /// Stage-1 domains kept across calls (a parameter sweep): they depend only on the axis, the
+    /// rule set, the AngularStep and the HeightStep. `None`: built afresh.
+    pub domains: Option<&'a DomainCache>,
 }
+
+/// Stage-1 domains by (axis, rule set, AngularStep bits, HeightStep bits).
+pub type DomainCache =
+    std::cell::RefCell<std::collections::HashMap<(GraspAxis, RuleSet, u64, u64), plan::Domain>>;
 
 /// Plans across axes and rule sets, checking candidates when asked (see the module docs).
 ///
@@ -128,14 +135,32 @@ pub fn select(
                 .get_or_insert_with(|| align_with(mesh, props, *axis))
                 .clone();
             let mut t = BTreeMap::new();
-            let graded = plan::grade_domain_with(
-                &aligned.mesh,
-                p.hand,
-                p.planner,
-                p.friction,
-                rules,
-                &mut t,
-            );
+            let graded = match p.domains {
+                None => plan::grade_domain_with(
+                    &aligned.mesh,
+                    p.hand,
+                    p.planner,
+                    p.friction,
+                    rules,
+                    &mut t,
+                ),
+                Some(cache) => {
+                    let key = (
+                        *axis,
+                        rules,
+                        p.planner.angular_step_deg.to_bits(),
+                        p.planner.height_step_mm.to_bits(),
+                    );
+                    let domain = cache
+                        .borrow_mut()
+                        .entry(key)
+                        .or_insert_with(|| {
+                            plan::stage1_with(&aligned.mesh, p.hand, p.planner, rules)
+                        })
+                        .clone();
+                    plan::grade_built_with(domain, p.hand, p.planner, p.friction, rules, &mut t)
+                }
+            };
             let slot = sel.axes.len();
             let t0 = std::time::Instant::now();
             let mut found = 0;

@@ -11,7 +11,7 @@
 //! produce is simulated once (its physics does not depend on how it was found).
 
 use crate::batch::{scenario_for, Item};
-use crate::mesh::{align, load_mesh, AlignedObject};
+use crate::mesh::{load_mesh, AlignedObject};
 use crate::plan::{self, Domain};
 use crate::scenario::{validate_planner, MassSpec, PlannerParams, Scenario};
 use crate::sim::{self, ObjectShape, SimHand, Verdict};
@@ -129,6 +129,9 @@ pub struct ObjectResult {
     pub translation_mm: Option<f64>,
     /// Payload margin (held objects only).
     pub payload_margin: Option<f64>,
+    /// Why the setting is `invalid` for this object's hand.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
 }
 
 /// One setting's results and score.
@@ -144,6 +147,11 @@ pub struct SettingResult {
     pub mean_translation_mm: Option<f64>,
     /// Per object.
     pub objects: Vec<ObjectResult>,
+    /// Why the setting is invalid (it breaks a rule for an object's hand, e.g. a HeightStep
+    /// that does not divide the finger gap): such a setting is not run and not ranked, and its
+    /// scores are 0. Absent for a valid setting.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub invalid: Option<String>,
 }
 
 /// Counters that show which work was shared.
@@ -168,7 +176,7 @@ pub struct TuneResult {
     pub sweeps: Vec<Sweep>,
     /// Every setting, in grid order.
     pub settings: Vec<SettingResult>,
-    /// Index into `settings` of the best one.
+    /// Index into `settings` of the best valid one (0 when every setting is invalid).
     pub best: usize,
     /// Work counters.
     pub counters: TuneCounters,
@@ -176,9 +184,62 @@ pub struct TuneResult {
 
 struct Prepared {
     scenario: Scenario,
+    /// The mesh as loaded (original frame), for planning on every axis.
+    mesh: crate::mesh::Mesh,
+    props: crate::mesh::MassProperties,
     aligned: AlignedObject,
     shape: ObjectShape,
     mass_kg: f64,
+}
+
+/// Simulated grasps by (axis, fingerprint): verdict, translation, payload margin of a hold, and
+/// the outcome.
+type SimCache =
+    HashMap<(crate::mesh::GraspAxis, Vec<u64>), (Verdict, f64, Option<f64>, sim::SimOutcome)>;
+
+/// The object's collider about `a`'s axis (the thesis axis's is prepared; others made once).
+fn shape_for(
+    p: &Prepared,
+    a: &AlignedObject,
+    shapes: &std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>>,
+) -> ObjectShape {
+    if a.axis == p.aligned.axis {
+        return p.shape.clone();
+    }
+    shapes
+        .borrow_mut()
+        .entry(a.axis)
+        .or_insert_with(|| ObjectShape::from_mesh(&a.mesh, p.props.volume_mm3))
+        .clone()
+}
+
+/// The physics check of a pose (and its payload margin when it holds), cached by `key`.
+fn simulate(
+    p: &Prepared,
+    pose: &SimHand,
+    shape: &ObjectShape,
+    key: (crate::mesh::GraspAxis, Vec<u64>),
+    sims: &mut SimCache,
+    counters: &mut TuneCounters,
+) -> (Verdict, f64, Option<f64>, sim::SimOutcome) {
+    if let Some(o) = sims.get(&key) {
+        counters.sim_reused += 1;
+        return o.clone();
+    }
+    let case = sim::Case {
+        hand: &p.scenario.hand,
+        pose,
+        object: shape,
+        mass_kg: p.mass_kg,
+        friction: p.scenario.object.friction,
+        params: &p.scenario.sim,
+    };
+    let out = sim::check(&case);
+    counters.sim_runs += 1;
+    let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
+    let o = (out.verdict, out.translation_mm, margin, out);
+    sims.insert(key, o.clone());
+    o
 }
 
 /// What identifies a grasp for the physics check: its palm pose and joint angles, bit for bit.
@@ -209,12 +270,29 @@ pub fn tune(
     candidates: usize,
     jobs: usize,
 ) -> Result<TuneResult, Error> {
+    tune_with_progress(items, template, sweeps, candidates, jobs, &|_| {})
+}
+
+/// [`tune`], calling `progress` with the object's scenario name each time one object is done at
+/// one setting (objects × settings calls in all, from the worker threads).
+///
+/// # Errors
+/// A bad scenario or mesh among the items.
+pub fn tune_with_progress(
+    items: &[Item],
+    template: &Scenario,
+    sweeps: &[Sweep],
+    candidates: usize,
+    jobs: usize,
+    progress: &(dyn Fn(&str) + Sync),
+) -> Result<TuneResult, Error> {
     let settings = grid(sweeps);
     let mut prepared = Vec::new();
     for item in items {
         let scenario = scenario_for(item, template)?;
         let loaded = load_mesh(&scenario.object.mesh, scenario.object.units)?;
-        let aligned = align(&loaded.mesh);
+        let props = crate::mesh::mass_properties(&loaded.mesh);
+        let aligned = crate::mesh::align_with(&loaded.mesh, &props, crate::mesh::GraspAxis::THESIS);
         let volume = aligned.original.volume_mm3;
         let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
         let mass_kg = match scenario.object.mass {
@@ -223,6 +301,8 @@ pub fn tune(
         };
         prepared.push(Prepared {
             scenario,
+            mesh: loaded.mesh,
+            props,
             aligned,
             shape,
             mass_kg,
@@ -231,7 +311,7 @@ pub fn tune(
     let work = || -> Vec<PerObject> {
         prepared
             .par_iter()
-            .map(|p| run_object(p, sweeps, &settings, candidates))
+            .map(|p| run_object(p, sweeps, &settings, candidates, progress))
             .collect()
     };
     let per_object = match rayon::ThreadPoolBuilder::new()
@@ -261,6 +341,7 @@ pub fn tune(
         })
         .collect();
     let best = (0..results.len())
+        .filter(|&k| results[k].invalid.is_none())
         .min_by(|&a, &b| rank(&results[a], &results[b]).then(a.cmp(&b)))
         .unwrap_or(0);
     Ok(TuneResult {
@@ -284,6 +365,9 @@ pub fn rank(a: &SettingResult, b: &SettingResult) -> std::cmp::Ordering {
 }
 
 fn score(values: Vec<f64>, objects: Vec<ObjectResult>) -> SettingResult {
+    let invalid = objects
+        .iter()
+        .find_map(|o| o.reason.as_ref().map(|r| format!("{}: {r}", o.scenario)));
     let n = objects.len().max(1) as f64;
     let held: Vec<&ObjectResult> = objects.iter().filter(|o| o.verdict == "hold").collect();
     let mean_translation_mm = (!held.is_empty())
@@ -291,9 +375,15 @@ fn score(values: Vec<f64>, objects: Vec<ObjectResult>) -> SettingResult {
     SettingResult {
         values,
         hold_rate: held.len() as f64 / n,
-        mean_payload_margin: objects.iter().filter_map(|o| o.payload_margin).sum::<f64>() / n,
+        // Folded from +0.0: an empty f64 sum is -0.0, printed "-0.00".
+        mean_payload_margin: objects
+            .iter()
+            .filter_map(|o| o.payload_margin)
+            .fold(0.0, |a, m| a + m)
+            / n,
         mean_translation_mm,
         objects,
+        invalid,
     }
 }
 
@@ -302,116 +392,148 @@ fn run_object(
     sweeps: &[Sweep],
     settings: &[Vec<f64>],
     candidates: usize,
+    progress: &(dyn Fn(&str) + Sync),
 ) -> PerObject {
     let mut counters = TuneCounters::default();
     let mut domains: HashMap<(u64, u64), Domain> = HashMap::new();
-    let mut sims: HashMap<Vec<u64>, (Verdict, f64, Option<f64>)> = HashMap::new();
+    let mut sims: SimCache = HashMap::new();
+    let select_domains: crate::select::DomainCache = Default::default();
+    let shapes: std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>> =
+        Default::default();
     let hand = &p.scenario.hand;
     let friction = p.scenario.object.friction;
     let mut results = Vec::with_capacity(settings.len());
     for values in settings {
+        if !results.is_empty() {
+            progress(&p.scenario.name);
+        }
         let mut params = p.scenario.planner.clone();
         for (s, v) in sweeps.iter().zip(values) {
             apply(&mut params, &s.name, *v);
         }
         let name = p.scenario.name.clone();
-        if validate_planner(&params, hand, friction).is_err() {
+        if let Err((key, why)) = validate_planner(&params, hand, friction) {
             results.push(ObjectResult {
                 scenario: name,
                 status: "invalid".to_string(),
                 verdict: "not_run".to_string(),
                 translation_mm: None,
                 payload_margin: None,
+                reason: Some(format!("{key} {why}")),
             });
             continue;
         }
-        let key = (
-            params.angular_step_deg.to_bits(),
-            params.height_step_mm.to_bits(),
-        );
-        let domain = domains
-            .entry(key)
-            .or_insert_with(|| {
-                counters.domains_built += 1;
-                Domain::build(&p.aligned.mesh, &params, hand)
-            })
-            .clone();
-        let mut t = BTreeMap::new();
-        let graded = plan::grade_built(domain, hand, &params, friction, &mut t);
         let s = &p.scenario.sim;
         // A scenario that fixes the joint angles (`[sim] override_angles`) is checked with them,
         // as `grasp-sim scenario.toml` does: its outcome does not depend on the planner.
-        let (status, poses) = if let Some(angles) = &s.override_angles {
-            match crate::override_pose(&p.aligned.mesh, hand, &graded, s, angles) {
-                Ok(pose) => ("override_angles", vec![pose]),
-                Err(_) => ("override_angles", Vec::new()),
-            }
-        } else {
-            let found = plan::search::search(&p.aligned.mesh, hand, &graded, &params, candidates);
-            counters.plans += 1;
-            let poses: Vec<SimHand> = found.grasps.iter().map(SimHand::from_grasp).collect();
-            (
-                if poses.is_empty() {
-                    "ungraspable"
-                } else {
-                    "feasible"
-                },
-                poses,
-            )
-        };
-        if poses.is_empty() {
+        if let Some(angles) = &s.override_angles {
+            let key = (
+                params.angular_step_deg.to_bits(),
+                params.height_step_mm.to_bits(),
+            );
+            let domain = domains
+                .entry(key)
+                .or_insert_with(|| {
+                    counters.domains_built += 1;
+                    Domain::build(&p.aligned.mesh, &params, hand)
+                })
+                .clone();
+            let mut t = BTreeMap::new();
+            let graded = plan::grade_built(domain, hand, &params, friction, &mut t);
+            let pose = crate::override_pose(&p.aligned.mesh, hand, &graded, s, angles);
+            let outcome = pose.ok().map(|pose| {
+                let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
+                simulate(p, &pose, &p.shape, key, &mut sims, &mut counters)
+            });
             results.push(ObjectResult {
                 scenario: name,
-                status: status.to_string(),
-                verdict: "not_run".to_string(),
-                translation_mm: None,
-                payload_margin: None,
+                status: "override_angles".to_string(),
+                verdict: outcome
+                    .as_ref()
+                    .map_or("not_run", |o| o.0.as_str())
+                    .to_string(),
+                translation_mm: outcome.as_ref().map(|o| o.1),
+                payload_margin: outcome.as_ref().and_then(|o| o.2),
+                reason: None,
             });
             continue;
         }
-        // The best of the candidates by simulation: hold before slip before drop, then the
-        // smaller translation; the first in search order on a tie.
-        let mut best: Option<(Verdict, f64, Option<f64>)> = None;
-        for pose in &poses {
-            let key = fingerprint(pose);
-            let outcome = match sims.get(&key) {
-                Some(o) => {
-                    counters.sim_reused += 1;
-                    *o
-                }
-                None => {
-                    let case = sim::Case {
-                        hand,
-                        pose,
-                        object: &p.shape,
-                        mass_kg: p.mass_kg,
-                        friction,
-                        params: s,
-                    };
-                    let out = sim::check(&case);
-                    counters.sim_runs += 1;
-                    let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
-                    let o = (out.verdict, out.translation_mm, margin);
-                    sims.insert(key, o);
-                    o
-                }
-            };
-            let better = match best {
-                None => true,
-                Some(b) => (outcome.0, outcome.1) < (b.0, b.1),
-            };
-            if better {
-                best = Some(outcome);
+        // As a run plans and chooses (every axis, the extended rules when the thesis's find
+        // nothing, candidates checked until one holds): the grasp a setting leads to. A grasp
+        // two settings share is simulated once.
+        let sims_cell = std::cell::RefCell::new(std::mem::take(&mut sims));
+        let counters_cell = std::cell::RefCell::new(std::mem::take(&mut counters));
+        let check = |a: &AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
+            let pose = SimHand::from_grasp(g);
+            let shape = shape_for(p, a, &shapes);
+            let key = (a.axis, fingerprint(&pose));
+            let o = simulate(
+                p,
+                &pose,
+                &shape,
+                key,
+                &mut sims_cell.borrow_mut(),
+                &mut counters_cell.borrow_mut(),
+            );
+            sim::SimOutcome {
+                verdict: o.0,
+                translation_mm: o.1,
+                ..o.3.clone()
             }
-        }
-        let (verdict, translation, margin) = best.expect("at least one grasp");
+        };
+        let mut t = BTreeMap::new();
+        let selection = crate::select::select(
+            &p.mesh,
+            &p.props,
+            &crate::select::SelectParams {
+                hand,
+                planner: &params,
+                friction,
+                collect: candidates,
+                max_checked: Some(s.max_checked.max(1)),
+                check: &check,
+                domains: Some(&select_domains),
+            },
+            &mut t,
+        );
+        sims = sims_cell.into_inner();
+        counters = counters_cell.into_inner();
+        counters.domains_built = domains.len() + select_domains.borrow().len();
+        counters.plans += 1;
+        let chosen = selection.chosen().and_then(|c| {
+            let a = &selection.axes[c.axis_plan].aligned;
+            let pose = SimHand::from_grasp(&c.grasp);
+            sims.get(&(a.axis, fingerprint(&pose))).cloned()
+        });
+        let Some(best) = chosen else {
+            results.push(ObjectResult {
+                scenario: name,
+                status: if selection.chosen.is_some() {
+                    "feasible"
+                } else {
+                    "ungraspable"
+                }
+                .to_string(),
+                verdict: "not_run".to_string(),
+                translation_mm: None,
+                payload_margin: None,
+                reason: None,
+            });
+            continue;
+        };
+        let status = "feasible";
+        let (verdict, translation, margin) = (best.0, best.1, best.2);
         results.push(ObjectResult {
             scenario: name,
             status: status.to_string(),
             verdict: verdict.as_str().to_string(),
             translation_mm: Some(translation),
             payload_margin: margin,
+            reason: None,
         });
+    }
+    if !results.is_empty() {
+        progress(&p.scenario.name);
     }
     PerObject { results, counters }
 }
@@ -423,10 +545,19 @@ pub fn to_csv(r: &TuneResult) -> String {
         s.push_str(&sw.name);
         s.push(',');
     }
-    s.push_str("hold_rate,mean_payload_margin,mean_translation_mm,held,feasible,objects\n");
+    s.push_str("hold_rate,mean_payload_margin,mean_translation_mm,held,feasible,objects,invalid\n");
     for set in &r.settings {
         for v in &set.values {
             s.push_str(&format!("{v},"));
+        }
+        if let Some(why) = &set.invalid {
+            // Not run: no scores, only the reason (quoted, doubled quotes inside).
+            s.push_str(&format!(
+                ",,,,,{},\"{}\"\n",
+                set.objects.len(),
+                why.replace('"', "\"\"")
+            ));
+            continue;
         }
         let held = set.objects.iter().filter(|o| o.verdict == "hold").count();
         let feasible = set
@@ -435,7 +566,7 @@ pub fn to_csv(r: &TuneResult) -> String {
             .filter(|o| o.status == "feasible")
             .count();
         s.push_str(&format!(
-            "{:.6},{:.6},{},{held},{feasible},{}\n",
+            "{:.6},{:.6},{},{held},{feasible},{},\n",
             set.hold_rate,
             set.mean_payload_margin,
             set.mean_translation_mm
@@ -456,6 +587,10 @@ pub fn to_table(r: &TuneResult) -> String {
     for (k, set) in r.settings.iter().enumerate() {
         for v in &set.values {
             s.push_str(&format!("{v:>24} "));
+        }
+        if let Some(why) = &set.invalid {
+            s.push_str(&format!(" invalid, not ranked: {why}\n"));
+            continue;
         }
         s.push_str(&format!(
             " {:>9.3}  {:>14.2}  {:>16}{}\n",
@@ -485,7 +620,7 @@ pub fn plot(r: &TuneResult, dir: &std::path::Path) -> Result<Vec<std::path::Path
             .filter_map(|v| {
                 r.settings
                     .iter()
-                    .filter(|s| s.values[i] == *v)
+                    .filter(|s| s.values[i] == *v && s.invalid.is_none())
                     .min_by(|a, b| rank(a, b))
                     .map(|s| (*v, s.hold_rate, s.mean_payload_margin))
             })

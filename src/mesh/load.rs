@@ -593,6 +593,7 @@ pub fn parse_stl(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMe
                 len
             ),
         })?;
+        let original_text = text;
         // stl_io wants "solid <name>"; a bare "solid" first line is valid STL too.
         let trimmed = text.trim_start();
         let first_line = trimmed.lines().next().unwrap_or("");
@@ -601,7 +602,17 @@ pub fn parse_stl(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMe
         } else {
             trimmed.to_string()
         };
-        read_triangles(text.as_bytes(), path, false)?
+        read_triangles(text.as_bytes(), path, false).map_err(|e| match e {
+            // stl_io names no line: find the first line that breaks the grammar and name it.
+            MeshError::Ascii { path, detail } => MeshError::Ascii {
+                detail: match first_bad_ascii_line(original_text) {
+                    Some((n, line, want)) => format!("line {n} ({line}): {want} ({detail})"),
+                    None => detail,
+                },
+                path,
+            },
+            e => e,
+        })?
     } else {
         return Err(MeshError::NotStl {
             path: p(),
@@ -610,6 +621,64 @@ pub fn parse_stl(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMe
     };
 
     build(triangles, path, unit, is_binary, MeshFormat::Stl)
+}
+
+/// The first line of an ASCII STL that breaks its grammar (`solid`, then per facet `facet
+/// normal x y z`, `outer loop`, three `vertex x y z`, `endloop`, `endfacet`, then `endsolid`):
+/// its 1-based number, the line quoted (or "end of file"), and what was expected there. `None`
+/// when every line fits (the parser's complaint is then about something else).
+fn first_bad_ascii_line(text: &str) -> Option<(usize, String, String)> {
+    const STEPS: [(&str, usize); 7] = [
+        ("facet normal", 3),
+        ("outer loop", 0),
+        ("vertex", 3),
+        ("vertex", 3),
+        ("vertex", 3),
+        ("endloop", 0),
+        ("endfacet", 0),
+    ];
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .map(|(i, l)| (i + 1, l))
+        .filter(|(_, l)| !l.trim().is_empty());
+    let quote = |l: &str| format!("`{}`", l.trim());
+    let mut last = match lines.next() {
+        Some((n, l)) if l.split_whitespace().next() == Some("solid") => n,
+        Some((n, l)) => return Some((n, quote(l), "expected `solid`".to_string())),
+        None => return None,
+    };
+    let mut step = 0;
+    for (n, l) in lines {
+        last = n;
+        let words: Vec<&str> = l.split_whitespace().collect();
+        if step == 0 && words.first() == Some(&"endsolid") {
+            return None;
+        }
+        let (keyword, numbers) = STEPS[step];
+        let kw: Vec<&str> = keyword.split(' ').collect();
+        let want = || {
+            let nums = [" x y z", ""][usize::from(numbers == 0)];
+            if step == 0 {
+                format!("expected `{keyword}{nums}` or `endsolid`")
+            } else {
+                format!("expected `{keyword}{nums}`")
+            }
+        };
+        let fits = words.len() == kw.len() + numbers
+            && words[..kw.len()] == kw[..]
+            && words[kw.len()..].iter().all(|w| w.parse::<f32>().is_ok());
+        if !fits {
+            return Some((n, quote(l), want()));
+        }
+        step = (step + 1) % STEPS.len();
+    }
+    let want = if step == 0 {
+        "expected `endsolid`".to_string()
+    } else {
+        format!("expected `{}`", STEPS[step].0)
+    };
+    Some((last + 1, "end of file".to_string(), want))
 }
 
 fn read_triangles(
@@ -679,7 +748,7 @@ fn build(
         }
         soup.push(corners);
     }
-    let (mut mesh, mut degenerate) = Mesh::from_triangles(&soup);
+    let (mut mesh, mut degenerate) = Mesh::from_triangles_welded(&soup);
     if mesh.triangles.is_empty() {
         return Err(MeshError::AllDegenerate {
             path: p(),

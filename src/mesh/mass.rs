@@ -88,26 +88,10 @@ pub fn sliced_mass_properties(mesh: &Mesh, n: usize) -> MassProperties {
         m[8] += sy * z * dz;
         m[9] += sx * z * dz;
     }
-    let v = m[0];
-    if v <= 0.0 {
-        return MassProperties {
-            volume_mm3: 0.0,
-            centroid: reference,
-            inertia: Matrix3::zeros(),
-        };
+    if m[0] <= 0.0 {
+        m[0] = 0.0;
     }
-    let c = Vector3::new(m[1], m[2], m[3]) / v;
-    let xx = m[5] + m[6] - v * (c.y * c.y + c.z * c.z);
-    let yy = m[4] + m[6] - v * (c.z * c.z + c.x * c.x);
-    let zz = m[4] + m[5] - v * (c.x * c.x + c.y * c.y);
-    let xy = -(m[7] - v * c.x * c.y);
-    let yz = -(m[8] - v * c.y * c.z);
-    let zx = -(m[9] - v * c.z * c.x);
-    MassProperties {
-        volume_mm3: v,
-        centroid: reference + c,
-        inertia: Matrix3::new(xx, xy, zx, xy, yy, yz, zx, yz, zz),
-    }
+    from_integrals(reference, &m)
 }
 
 /// Mass properties by the divergence theorem over the surface (exact for one closed shell; for
@@ -150,23 +134,30 @@ pub fn surface_mass_properties(mesh: &Mesh) -> MassProperties {
     for (v, m) in intg.iter_mut().zip(MULT) {
         *v *= m;
     }
-    let volume = intg[0];
-    if volume == 0.0 {
+    from_integrals(reference, &intg)
+}
+
+/// Mass properties from the volume integrals about `reference`: ∫1, ∫x, ∫y, ∫z, ∫x², ∫y², ∫z²,
+/// ∫xy, ∫yz, ∫zx (unit density); the inertia is taken about the centroid. A zero volume gives
+/// no centroid offset and no inertia.
+fn from_integrals(reference: Point3<f64>, m: &[f64; 10]) -> MassProperties {
+    let v = m[0];
+    if v == 0.0 {
         return MassProperties {
             volume_mm3: 0.0,
             centroid: reference,
             inertia: Matrix3::zeros(),
         };
     }
-    let c = Vector3::new(intg[1], intg[2], intg[3]) / volume;
-    let xx = intg[5] + intg[6] - volume * (c.y * c.y + c.z * c.z);
-    let yy = intg[4] + intg[6] - volume * (c.z * c.z + c.x * c.x);
-    let zz = intg[4] + intg[5] - volume * (c.x * c.x + c.y * c.y);
-    let xy = -(intg[7] - volume * c.x * c.y);
-    let yz = -(intg[8] - volume * c.y * c.z);
-    let zx = -(intg[9] - volume * c.z * c.x);
+    let c = Vector3::new(m[1], m[2], m[3]) / v;
+    let xx = m[5] + m[6] - v * (c.y * c.y + c.z * c.z);
+    let yy = m[4] + m[6] - v * (c.z * c.z + c.x * c.x);
+    let zz = m[4] + m[5] - v * (c.x * c.x + c.y * c.y);
+    let xy = -(m[7] - v * c.x * c.y);
+    let yz = -(m[8] - v * c.y * c.z);
+    let zx = -(m[9] - v * c.z * c.x);
     MassProperties {
-        volume_mm3: volume,
+        volume_mm3: v,
         centroid: reference + c,
         inertia: Matrix3::new(xx, xy, zx, xy, yy, yz, zx, yz, zz),
     }

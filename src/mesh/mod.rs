@@ -176,6 +176,13 @@ pub enum MeshError {
     },
 }
 
+/// Vertices of a loaded mesh closer than this fraction of its bounding-box diagonal are one
+/// vertex ([`Mesh::from_triangles_welded`]). 1e-9 is far below f32's resolution of a
+/// coordinate of the mesh's own size (about 6e-8 of it), so two vertices a mesh file can tell
+/// apart at its own scale stay apart, while a seam whose coordinates differ by rounding near
+/// zero (1e-18 m against 0) closes.
+pub const WELD_TOLERANCE: f64 = 1e-9;
+
 /// A welded triangle mesh in millimetres.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mesh {
@@ -226,6 +233,82 @@ impl Mesh {
                     vertices.push(Point3::new(p.x + 0.0, p.y + 0.0, p.z + 0.0));
                     (vertices.len() - 1) as u32
                 });
+            }
+            if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
+                dropped += 1;
+            } else {
+                triangles.push(ids);
+            }
+        }
+        (
+            Mesh {
+                vertices,
+                triangles,
+            },
+            dropped,
+        )
+    }
+
+    /// Builds a mesh from triangle soup, welding vertices closer than `WELD_TOLERANCE` × the
+    /// soup's bounding-box diagonal (Euclidean distance): a seam written with coordinates that
+    /// differ in their last bits (1e-18 m against 0) is one edge, not two boundary edges. Each
+    /// vertex joins the first-appearing vertex within the tolerance, so the result is
+    /// deterministic; a soup whose vertices are all further apart than that gives exactly what
+    /// [`Mesh::from_triangles`] gives.
+    pub fn from_triangles_welded(soup: &[[Point3<f64>; 3]]) -> (Mesh, usize) {
+        let mut lo = Vector3::repeat(f64::INFINITY);
+        let mut hi = Vector3::repeat(f64::NEG_INFINITY);
+        for p in soup.iter().flatten() {
+            lo = lo.inf(&p.coords);
+            hi = hi.sup(&p.coords);
+        }
+        let tol = WELD_TOLERANCE * (hi - lo).norm();
+        if !(tol.is_finite() && tol > 0.0) {
+            return Mesh::from_triangles(soup);
+        }
+        // Grid cells of side `tol`: a vertex's weld partner lies in its cell or a neighbour.
+        let cell = |p: &Point3<f64>| -> [i64; 3] {
+            [
+                ((p.x - lo.x) / tol).floor() as i64,
+                ((p.y - lo.y) / tol).floor() as i64,
+                ((p.z - lo.z) / tol).floor() as i64,
+            ]
+        };
+        let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::with_capacity(soup.len());
+        let mut vertices: Vec<Point3<f64>> = Vec::new();
+        let mut triangles = Vec::with_capacity(soup.len());
+        let mut dropped = 0;
+        for tri in soup {
+            let mut ids = [0u32; 3];
+            for (k, p) in tri.iter().enumerate() {
+                let p = Point3::new(p.x + 0.0, p.y + 0.0, p.z + 0.0);
+                let c = cell(&p);
+                let mut found: Option<u32> = None;
+                for dx in -1..=1 {
+                    for dy in -1..=1 {
+                        for dz in -1..=1 {
+                            let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                                continue;
+                            };
+                            for &v in list {
+                                if (vertices[v as usize] - p).norm() <= tol
+                                    && found.is_none_or(|f| v < f)
+                                {
+                                    found = Some(v);
+                                }
+                            }
+                        }
+                    }
+                }
+                ids[k] = match found {
+                    Some(v) => v,
+                    None => {
+                        vertices.push(p);
+                        let v = (vertices.len() - 1) as u32;
+                        grid.entry(c).or_default().push(v);
+                        v
+                    }
+                };
             }
             if ids[0] == ids[1] || ids[1] == ids[2] || ids[0] == ids[2] {
                 dropped += 1;

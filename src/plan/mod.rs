@@ -98,15 +98,21 @@ pub fn grade_domain_with(
     timings: &mut BTreeMap<String, f64>,
 ) -> GradedDomain {
     let t = Instant::now();
+    let domain = stage1_with(mesh, hand, params, rules);
+    timings.insert("stage1_domain".to_string(), ms(t));
+    grade_built_with(domain, hand, params, friction, rules, timings)
+}
+
+/// Stage 1 under a rule set: the thesis's Effective Elevation, or under the extended rules the
+/// whole object widened so that an outer finger may overhang its ends.
+pub fn stage1_with(mesh: &Mesh, hand: &Hand, params: &PlannerParams, rules: RuleSet) -> Domain {
     let shrink = match rules {
         RuleSet::Thesis => hand.fingers.offset_mm,
         // An outer finger's centreline may lie beyond the object's end by up to the finger
         // offset less EXTENDED_MIN_OVERLAP_MM: its inner edge still overlaps the object.
         RuleSet::Extended => EXTENDED_MIN_OVERLAP_MM - hand.fingers.offset_mm,
     };
-    let domain = Domain::build_with(mesh, params, hand, shrink);
-    timings.insert("stage1_domain".to_string(), ms(t));
-    grade_built_with(domain, hand, params, friction, rules, timings)
+    Domain::build_with(mesh, params, hand, shrink)
 }
 
 /// Stages 2–3 on an already built stage-1 domain (which depends only on the mesh, the

@@ -56,6 +56,10 @@ pub struct DirectionOutcome {
     pub tilt_deg: f64,
     /// Object translation relative to the palm while the fingers closed `[mm]`.
     pub closing_translation_mm: f64,
+    /// Deepest penetration of a finger or the palm into the object at the end of closing `[mm]`
+    /// (rapier's contact depth): a grasp that holds only because a finger passed into the object
+    /// shows here (issue 14).
+    pub closing_penetration_mm: f64,
     /// Largest difference between a joint's bend after closing and its planned bend `[deg]`
     /// (negative: stopped short of the plan, i.e. contact earlier than planned).
     pub joint_error_deg: f64,
@@ -164,6 +168,8 @@ struct Closing {
     qc: UnitQuaternion<f64>,
     /// Per finger, joint bend after closing minus the plan `[deg]`.
     joint_errors_deg: Vec<[f64; 2]>,
+    /// Deepest penetration of a hand collider into the object after closing `[mm]`.
+    penetration_mm: f64,
     /// Steps taken.
     steps: usize,
     /// The contacts carrying the grip when closing ended.
@@ -372,10 +378,35 @@ fn close(scene: &mut Scene, params: &SimParams) -> Closing {
         p0,
         pc,
         qc,
+        penetration_mm: penetration_mm(scene),
         joint_errors_deg: joint_errors(scene),
         steps: close_steps,
         contacts: super::contacts::grip_contacts(scene),
     }
+}
+
+/// The deepest penetration of a hand collider into the object now `[mm]` (0 when none).
+fn penetration_mm(scene: &Scene) -> f64 {
+    let mut depth = 0.0f64;
+    for pair in scene
+        .world
+        .narrow_phase
+        .contact_pairs_with(scene.object_collider)
+    {
+        if !(scene.hand_colliders.contains(&pair.collider1)
+            || scene.hand_colliders.contains(&pair.collider2))
+        {
+            continue;
+        }
+        if let rapier3d::geometry::PairContacts::Rigid(r) = &pair.contacts {
+            for m in &r.manifolds {
+                for p in &m.points {
+                    depth = depth.max(-f64::from(p.dist));
+                }
+            }
+        }
+    }
+    depth * 1000.0
 }
 
 /// True if and only if the object touches the hand.
@@ -517,6 +548,7 @@ fn hold(
             full_rotation_deg: rotation_deg,
             tilt_deg,
             closing_translation_mm: (pc - p0).norm(),
+            closing_penetration_mm: closing.penetration_mm,
             joint_error_deg,
             joint_errors_deg,
             in_contact,

@@ -486,3 +486,21 @@ pub fn build(case: &Case) -> Scene {
         object_radius_m,
     }
 }
+
+/// The object's centre of mass `[m]` and inertia tensor about it `[kg·m²]`, aligned frame, as the
+/// rapier check has them: its collider's mass distribution scaled to `mass_kg`.
+pub fn collider_inertia(
+    object: &ObjectShape,
+    mass_kg: f64,
+) -> (nalgebra::Vector3<f64>, nalgebra::Matrix3<f64>) {
+    let unit = object.shape.mass_properties(1.0);
+    let density = mass_kg / f64::from(unit.mass()).max(f64::MIN_POSITIVE);
+    let props = object.shape.mass_properties(density as f32);
+    let m = props.reconstruct_inertia_matrix();
+    let c = props.local_com;
+    let cols = m.to_cols_array();
+    (
+        nalgebra::Vector3::new(f64::from(c.x), f64::from(c.y), f64::from(c.z)),
+        nalgebra::Matrix3::from_column_slice(&cols.map(f64::from)),
+    )
+}

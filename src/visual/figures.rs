@@ -118,8 +118,7 @@ pub fn grades(g: &GradedDomain, which: &str) -> String {
         "combined" => "Grades with significance factors (Fig. 4.6)",
         _ => "Palm grades after the third stage (Fig. 4.7)",
     };
-    // Room on the right for the legend.
-    let mut p = Plot::new(title, "grade", "Z [mm]", (-0.15, 1.45), (lo, hi), false);
+    let mut p = Plot::new(title, "grade", "Z [mm]", (-0.15, 1.1), (lo, hi), false);
     let step = g.domain.height_step_mm;
     for (z, grade) in e.iter().zip(v) {
         match grade {
@@ -310,4 +309,55 @@ pub fn finger(g: &Grasp, hand: &Hand, mesh: &Mesh, k: usize) -> String {
     p.legend("phalanx search domains", DOMAIN);
     p.legend("ALS contact lines", FINGER);
     p.finish()
+}
+
+/// For an object with no grasp: what decided it. Each constraint that rejected candidates as a
+/// bar of its count, most first (the grade figures show which elevations were graded out);
+/// with no candidate tried (the grades left none), the planner's reason in words.
+pub fn rejections(report: &crate::report::RunReport) -> String {
+    let p = &report.plan;
+    let mut counts: Vec<(&String, usize)> = p.rejections.iter().map(|(k, n)| (k, *n)).collect();
+    counts.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(b.0)));
+    let n = counts.len().max(1) as f64;
+    let max = counts.iter().map(|c| c.1).max().unwrap_or(1).max(1) as f64;
+    let mut plot = Plot::new(
+        &if counts.is_empty() {
+            "Why no grasp: no candidate left to try".to_string()
+        } else {
+            format!(
+                "Why no grasp: {} tried, rejected by",
+                crate::batch::plural(p.candidates_tried, "candidate")
+            )
+        },
+        "candidates rejected",
+        "",
+        (0.0, max * 1.05),
+        (0.0, n),
+        false,
+    );
+    for (k, (what, count)) in counts.iter().enumerate() {
+        let y = n - k as f64 - 0.5;
+        plot.hbar(y - 0.15, *count as f64, 0.35, FINGER, "rejection");
+        plot.text((0.0, y + 0.05), &format!("{what} ({count})"), 12.0);
+    }
+    if counts.is_empty() {
+        let reason = p.reason.as_deref().unwrap_or("no candidate");
+        // Wrapped by words into lines of about 80 characters.
+        let mut lines = vec![String::new()];
+        for word in reason.split_whitespace() {
+            if lines.last().is_some_and(|l| l.len() + word.len() > 80) {
+                lines.push(String::new());
+            }
+            let l = lines.last_mut().expect("one line at least");
+            if !l.is_empty() {
+                l.push(' ');
+            }
+            l.push_str(word);
+        }
+        for (k, line) in lines.iter().enumerate() {
+            plot.text((0.0, 0.8 - 0.12 * k as f64), line, 12.0);
+        }
+    }
+    plot.legend("candidates rejected by this constraint", FINGER);
+    plot.finish()
 }

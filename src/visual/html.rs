@@ -8,9 +8,101 @@ fn esc(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// The page for one scenario's run: the summary (Grasp Parameter Set, physics verdict and its
-/// numbers) and every figure, inline.
-pub fn page(report: &RunReport, figures: &[(String, String)]) -> String {
+/// The physics check in words: its verdict and numbers, or why it did not run.
+fn verdict_sentence(report: &RunReport) -> String {
+    let sim = &report.sim;
+    let word = match sim.verdict.as_str() {
+        "not_run" => "not run",
+        other => other,
+    };
+    match (sim.translation_mm, sim.rotation_deg) {
+        (Some(t), Some(r)) => format!(
+            "Physics check: {word} (moved {t:.2} mm and {r:.2} deg relative to the palm under gravity{})",
+            sim.payload_margin
+                .map(|m| format!("; payload margin {m:.2}x"))
+                .unwrap_or_default()
+        ),
+        _ => match &sim.reason {
+            Some(why) => format!("Physics check: {word} ({why})"),
+            None => format!("Physics check: {word}"),
+        },
+    }
+}
+
+/// The Grasp Parameter Set as a table (thesis 3.7), or the reason there is none.
+fn parameter_set(report: &RunReport) -> String {
+    let p = &report.plan;
+    let Some(g) = &p.grasp else {
+        return format!(
+            "<p>No grasp: {}</p>",
+            esc(p
+                .reason
+                .as_deref()
+                .unwrap_or("the planner found no feasible grasp"))
+        );
+    };
+    let mut s = String::from(
+        "<table class=\"gps\"><tr><th>Grasp condition</th><td colspan=\"3\">Passed</td></tr>",
+    );
+    s.push_str(
+        "<tr><th>Finger</th><th>theta1 [deg]</th><th>theta2 [deg]</th><th>contact</th></tr>",
+    );
+    for f in &g.fingers {
+        s.push_str(&format!(
+            "<tr><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{}</td></tr>",
+            esc(&f.name),
+            f.theta1_deg,
+            f.theta2_deg,
+            if f.tip_contact { "tip" } else { "phalanx" }
+        ));
+    }
+    let pp = &g.palm_pose;
+    let rows = [
+        ("Approach angle", format!("{:.0} deg", g.approach_angle_deg)),
+        (
+            "Palm pitch angle",
+            format!("{} deg", crate::report::fmt_signed(g.palm_pitch_deg, 1)),
+        ),
+        (
+            "Finger_1 approach elevation",
+            format!("index {}, Z = {:.1} mm", g.elevation_index, g.elevation_mm),
+        ),
+        (
+            "Axis, rules",
+            format!("{} ({})", g.axis_name, g.one_line_rules()),
+        ),
+        (
+            "Palm position (original frame)",
+            format!(
+                "({:.2}, {:.2}, {:.2}) mm",
+                pp.position_mm[0], pp.position_mm[1], pp.position_mm[2]
+            ),
+        ),
+        (
+            "Palm rotation (quaternion wxyz)",
+            format!(
+                "({:.4}, {:.4}, {:.4}, {:.4})",
+                pp.quaternion_wxyz[0],
+                pp.quaternion_wxyz[1],
+                pp.quaternion_wxyz[2],
+                pp.quaternion_wxyz[3]
+            ),
+        ),
+    ];
+    for (k, v) in rows {
+        s.push_str(&format!(
+            "<tr><th>{}</th><td colspan=\"3\">{}</td></tr>",
+            esc(k),
+            esc(&v)
+        ));
+    }
+    s.push_str("</table>");
+    s
+}
+
+/// The page for one scenario's run: the verdict in words, the Grasp Parameter Set as a table,
+/// links to the 3D scenes written (`scenes`), the full summary, and every figure, inline.
+pub fn page(report: &RunReport, figures: &[(String, String)], scenes: &[&str]) -> String {
     let mut s = String::new();
     s.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">");
     s.push_str(&format!(
@@ -20,42 +112,63 @@ pub fn page(report: &RunReport, figures: &[(String, String)]) -> String {
     s.push_str(
         "<style>body{font-family:sans-serif;margin:24px;max-width:1400px}\
          pre{background:#f4f4f4;padding:12px;white-space:pre-wrap}\
+         table.gps{border-collapse:collapse;margin-bottom:12px}\
+         table.gps th,table.gps td{border:1px solid #ccc;padding:4px 10px;text-align:left}\
+         table.gps th{background:#f4f4f4}\
          .figs{display:flex;flex-wrap:wrap;gap:16px}.fig{border:1px solid #ccc;padding:4px}\
          .verdict{font-size:20px;font-weight:bold}</style></head><body>",
     );
     s.push_str(&format!("<h1>grasp-sim: {}</h1>", esc(&report.scenario)));
-    let sim = &report.sim;
-    let verdict = match (sim.translation_mm, sim.rotation_deg) {
-        (Some(t), Some(r)) => format!(
-            "Physics check: {} (moved {t:.2} mm and {r:.2} deg relative to the palm under gravity{})",
-            sim.verdict,
-            sim.payload_margin
-                .map(|m| format!("; payload margin {m:.2}x"))
-                .unwrap_or_default()
-        ),
-        _ => format!("Physics check: {}", sim.verdict),
-    };
-    s.push_str(&format!("<p class=\"verdict\">{}</p>", esc(&verdict)));
     s.push_str(&format!(
-        "<p>Plan: {}; expected outcome {}: {}</p>",
+        "<p class=\"verdict\">{}</p>",
+        esc(&verdict_sentence(report))
+    ));
+    s.push_str(&format!(
+        "<p>Plan: {}; {}</p>",
         esc(&report.plan.status),
-        esc(&report.expect.outcome),
-        match report.expect.met {
-            Some(true) => "met",
-            Some(false) => "NOT met",
-            None => "not judged",
+        if report.expect.is_given() {
+            format!(
+                "expected outcome {}: {}",
+                esc(&report.expect.outcome),
+                match report.expect.met {
+                    Some(true) => "met",
+                    Some(false) => "NOT met",
+                    None => "not judged",
+                }
+            )
+        } else {
+            "no expectation given: nothing judged".to_string()
         }
     ));
-    s.push_str("<h2>Grasp Parameter Set</h2><pre>");
+    s.push_str("<h2>Grasp Parameter Set</h2>");
+    s.push_str(&parameter_set(report));
+    if scenes.is_empty() {
+        s.push_str("<p>3D scenes: none (no grasp to show).</p>");
+    } else {
+        let links: Vec<String> = scenes
+            .iter()
+            .map(|f| {
+                let what = if *f == "grasp_simulated.glb" {
+                    "where the physics check left the bodies"
+                } else {
+                    "the planned grasp"
+                };
+                format!("<a href=\"{f}\">{f}</a> ({what})")
+            })
+            .collect();
+        s.push_str(&format!(
+            "<p>3D scenes: {}; they open in any glTF viewer.</p>",
+            links.join(", ")
+        ));
+    }
+    s.push_str("<details><summary>Full summary</summary><pre>");
     s.push_str(&esc(&report.summary()));
-    s.push_str("</pre><h2>Figures</h2><div class=\"figs\">");
+    s.push_str("</pre></details><h2>Figures</h2><div class=\"figs\">");
     for (name, svg) in figures {
         s.push_str(&format!("<div class=\"fig\" id=\"{}\">", esc(name)));
         s.push_str(svg);
         s.push_str("</div>");
     }
-    s.push_str("</div><p>3D scenes: grasp_planned.glb (the planned grasp) and grasp_simulated.glb \
-                (where the physics check left the bodies), in this folder; they open in any glTF viewer.</p>");
-    s.push_str("</body></html>\n");
+    s.push_str("</div></body></html>\n");
     s
 }

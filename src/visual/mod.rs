@@ -50,6 +50,9 @@ pub fn write_report(
         ),
         ("grades_palm".to_string(), figures::grades(graded, "palm")),
     ];
+    if grasp.is_none() {
+        figs.push(("rejections".to_string(), figures::rejections(report)));
+    }
     if let Some(g) = grasp {
         figs.push(("palm".to_string(), figures::palm(g, hand)));
         figs.push(("finger_planes".to_string(), figures::finger_planes(g, hand)));
@@ -64,6 +67,7 @@ pub fn write_report(
         let path = dir.join(format!("{name}.svg"));
         std::fs::write(&path, svg).map_err(|e| err(&path, e))?;
     }
+    let mut scenes: Vec<&str> = Vec::new();
     if let Some(g) = grasp {
         let theta: Vec<[f64; 2]> = g
             .fingers
@@ -79,15 +83,35 @@ pub fn write_report(
         ));
         let path = dir.join("grasp_planned.glb");
         std::fs::write(&path, glb::glb(&bodies)).map_err(|e| err(&path, e))?;
+        scenes.push("grasp_planned.glb");
         if let Some(poses) = simulated.filter(|p| p.len() == planned.len() + 1) {
             let mut bodies = glb::hand_bodies(hand, &poses[..planned.len()]);
             let (t, r) = poses[planned.len()];
             bodies.push(glb::object_body(mesh, t, r));
             let path = dir.join("grasp_simulated.glb");
             std::fs::write(&path, glb::glb(&bodies)).map_err(|e| err(&path, e))?;
+            scenes.push("grasp_simulated.glb");
+        }
+    }
+    // A re-run into an old folder must not leave a scene (or a figure) this run did not make.
+    let written: Vec<String> = figs.iter().map(|(n, _)| format!("{n}.svg")).collect();
+    for stale in [
+        "grasp_planned.glb",
+        "grasp_simulated.glb",
+        "palm.svg",
+        "finger_planes.svg",
+        "finger_1.svg",
+        "finger_2.svg",
+        "finger_3.svg",
+        "rejections.svg",
+    ] {
+        let path = dir.join(stale);
+        let made = written.iter().any(|w| w == stale) || scenes.contains(&stale);
+        if !made && path.exists() {
+            std::fs::remove_file(&path).map_err(|e| err(&path, e))?;
         }
     }
     let path = dir.join("report.html");
-    std::fs::write(&path, html::page(report, &figs)).map_err(|e| err(&path, e))?;
+    std::fs::write(&path, html::page(report, &figs, &scenes)).map_err(|e| err(&path, e))?;
     Ok(figs.into_iter().map(|(n, _)| n).collect())
 }

@@ -23,6 +23,9 @@ fn esc(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
+/// Narrowest figure `[px]`: room for a title of about 80 characters.
+const MIN_WIDTH: f64 = 600.0;
+
 /// Rounded tick step for a span.
 fn tick_step(span: f64) -> f64 {
     let raw = span / 6.0;
@@ -63,6 +66,13 @@ impl Plot {
                 let scale = plot_h / (y.1 - y.0);
                 height = 900.0;
                 width = (x.1 - x.0) * scale + margin.0 + margin.1;
+                // A tall, thin object: widen the x range (same scale) so that the title and the
+                // legend still fit.
+                if width < MIN_WIDTH {
+                    let extra = (MIN_WIDTH - width) / scale / 2.0;
+                    x = (x.0 - extra, x.1 + extra);
+                    width = MIN_WIDTH;
+                }
             }
         }
         Plot {
@@ -196,10 +206,14 @@ impl Plot {
         self.legend.push((label.to_string(), color.to_string()));
     }
 
-    /// The SVG document.
+    /// The SVG document. The legend sits in a band of its own between the title and the plot
+    /// frame, so it neither covers data nor runs off the figure's edge; everything drawn in data
+    /// coordinates is clipped to the frame, so nothing spills over the titles.
     pub fn finish(&self) -> String {
         let mut s = String::new();
-        let (w, h) = (self.width, self.height);
+        let (w, h0) = (self.width, self.height);
+        let band = legend_band(&self.legend, w);
+        let h = h0 + band.height;
         let _ = writeln!(
             s,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w:.0}\" height=\"{h:.0}\" viewBox=\"0 0 {w:.0} {h:.0}\">"
@@ -211,6 +225,18 @@ impl Plot {
             w / 2.0,
             esc(&self.title)
         );
+        for (label, color, x, y) in &band.entries {
+            let _ = writeln!(
+                s,
+                "<rect x=\"{x:.0}\" y=\"{:.0}\" width=\"12\" height=\"4\" fill=\"{color}\"/><text class=\"legend\" x=\"{:.0}\" y=\"{:.0}\" font-size=\"11\" font-family=\"sans-serif\">{}</text>",
+                y - 4.0,
+                x + 18.0,
+                y + 1.0,
+                esc(label)
+            );
+        }
+        let _ = writeln!(s, "<g transform=\"translate(0 {:.0})\">", band.height);
+        let h = h0;
         // Frame, ticks and grid.
         let (l, r, t, b) = (
             self.margin.0,
@@ -263,22 +289,56 @@ impl Plot {
             (t + b) / 2.0,
             esc(&self.labels.1)
         );
+        // A clip id unique to this figure (the page inlines several SVGs, and ids are global
+        // there), derived from the title so that the output is deterministic.
+        let id = format!("frame-{:016x}", fnv1a(self.title.as_bytes()));
+        let _ = writeln!(
+            s,
+            "<clipPath id=\"{id}\"><rect x=\"{l:.1}\" y=\"{t:.1}\" width=\"{:.1}\" height=\"{:.1}\"/></clipPath>",
+            r - l,
+            b - t
+        );
+        let _ = writeln!(s, "<g clip-path=\"url(#{id})\">");
         s.push_str(&self.body);
-        for (k, (label, color)) in self.legend.iter().enumerate() {
-            let y = t + 14.0 + 16.0 * k as f64;
-            let _ = writeln!(
-                s,
-                "<rect x=\"{:.0}\" y=\"{:.0}\" width=\"12\" height=\"4\" fill=\"{color}\"/><text x=\"{:.0}\" y=\"{:.0}\" font-size=\"11\" font-family=\"sans-serif\">{}</text>",
-                r - 170.0,
-                y - 4.0,
-                r - 152.0,
-                y + 1.0,
-                esc(label)
-            );
-        }
-        s.push_str("</svg>\n");
+        s.push_str("</g>\n</g>\n</svg>\n");
         s
     }
+}
+
+/// Where the legend entries go: rows between the title and the frame, as many entries to a row
+/// as fit the figure's width.
+struct LegendBand {
+    height: f64,
+    entries: Vec<(String, String, f64, f64)>,
+}
+
+fn legend_band(legend: &[(String, String)], width: f64) -> LegendBand {
+    // 11 px sans-serif: about 6.2 px a character, plus the swatch and a gap.
+    let (left, right) = (60.0, width - 10.0);
+    let (mut x, mut row) = (left, 0usize);
+    let mut entries = Vec::new();
+    for (label, color) in legend {
+        let w = 18.0 + 6.2 * label.chars().count() as f64 + 16.0;
+        if x > left && x + w > right {
+            row += 1;
+            x = left;
+        }
+        entries.push((label.clone(), color.clone(), x, 44.0 + 16.0 * row as f64));
+        x += w;
+    }
+    let height = if legend.is_empty() {
+        0.0
+    } else {
+        16.0 * (row + 1) as f64 + 6.0
+    };
+    LegendBand { height, entries }
+}
+
+/// FNV-1a, 64 bits: a stable hash for ids.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(*b)).wrapping_mul(0x0100_0000_01b3)
+    })
 }
 
 fn fmt_tick(v: f64) -> String {

@@ -5,6 +5,7 @@ mod cli;
 mod export;
 mod formats;
 mod geometry;
+mod issue16;
 mod planner;
 mod real_meshes;
 mod sim;

@@ -425,3 +425,25 @@ fn a_bar_with_bosses_is_held_with_the_palm_backed_off() {
     );
     assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim.translation_mm);
 }
+
+#[test]
+fn a_slot_too_wide_to_close_is_reported_open() {
+    // A D40 cylinder with a 50 deg slot down its whole side (20 facets missing): no small hole to
+    // close, no gap of one segment to join; the vertical slices through the slot stay open and
+    // the run says so instead of dropping them.
+    let n = 144;
+    let slotted: Vec<Tri> = cylinder([0.0, 0.0, 0.0], 20.0, 124.0, n)
+        .into_iter()
+        .enumerate()
+        .filter(|(i, _)| !(i / 4 < 20 && i % 4 < 2))
+        .map(|(_, t)| t)
+        .collect();
+    let r = run_soup(&slotted, false);
+    assert!(r.object.boundary_edges > 0);
+    assert!(r.plan.open_slices > 0, "no open slice reported");
+    assert!(
+        r.warnings.iter().any(|w| w.contains("stay open")),
+        "{:?}",
+        r.warnings
+    );
+}

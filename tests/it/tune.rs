@@ -49,14 +49,17 @@ fn settings_that_must_rank_differently_do_and_geometry_is_built_once() {
     );
     let cup_no_pitch = &r.settings[0].objects[0];
     assert_eq!(cup_no_pitch.status, "ungraspable");
-    // Loading, alignment and the vertical slices are done once per object, not per setting:
-    // neither swept parameter changes the AngularStep or the HeightStep.
+    // Loading, alignment and the vertical slices are done once per object and per axis and
+    // rule set planned, not per setting: neither swept parameter changes the AngularStep or the
+    // HeightStep. The cup without pitch is planned on all 12 (3 axes x 2 senses x 2 rule sets),
+    // with pitch and D40 on the thesis's axis only: 12 + 1 stage-1 domains for 4 settings.
     assert_eq!(r.counters.objects_loaded, 2);
-    assert_eq!(r.counters.domains_built, 2);
+    assert_eq!(r.counters.domains_built, 13);
     assert_eq!(r.counters.plans, 8);
     // A grasp found by several settings is simulated once.
     assert!(r.counters.sim_reused > 0, "{:?}", r.counters);
-    // Sweeping the AngularStep does build one domain per value and object.
+    // Sweeping the AngularStep does build one domain per value, object and axis planned (both
+    // objects are grasped on the thesis's axis at 10 and 20 deg).
     let r = tune(
         &items,
         &default_template(),
