@@ -1,5 +1,5 @@
-//! The contacts that carry the grip: the narrow phase's contact points between the hand's
-//! colliders and the object where the solver pushed at the last step, in the object's frame.
+//! The contacts that carry the grip: the contact points between the hand's colliders and the
+//! object where the solver pushed at the last step, in the object's frame.
 //!
 //! The object body starts at the identity pose, so its local frame is the aligned object frame
 //! (in metres); points are reported in it in millimetres, as [`crate::quality`] takes them.
@@ -61,7 +61,10 @@ pub fn grip_contacts(scene: &Scene) -> Vec<GripContact> {
             continue;
         };
         let co_pose = *obj_collider.position();
-        for m in pair.manifolds() {
+        // The solver's manifolds, not the narrow phase's: against a compound object (a convex
+        // decomposition) rapier merges the per-part manifolds that share a normal into clusters
+        // and solves those, so only the clusters carry impulses.
+        for m in pair.solver_manifolds() {
             // `data.normal` points from collider 1 to collider 2 (world frame).
             let n_world = if object_first {
                 -m.data.normal
@@ -73,7 +76,14 @@ pub fn grip_contacts(scene: &Scene) -> Vec<GripContact> {
                 if p.data.impulse <= 0.0 {
                     continue;
                 }
-                let local = if object_first { p.local_p1 } else { p.local_p2 };
+                // In the part's frame for a plain manifold of a compound, in the collider's
+                // for a cluster (which has no part pose).
+                let (local, part) = if object_first {
+                    (p.local_p1, m.subshape_pos1())
+                } else {
+                    (p.local_p2, m.subshape_pos2())
+                };
+                let local = part.map_or(local, |pose| pose.transform_point(local));
                 let world_p = co_pose.transform_point(local);
                 let in_obj = obj_pose.inverse_transform_point(world_p);
                 let mm = convert::vector_mm(in_obj);

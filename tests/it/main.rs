@@ -7,6 +7,7 @@ mod formats;
 mod geometry;
 mod issue16;
 mod planner;
+mod quality;
 mod real_meshes;
 mod sim;
 mod thesis_table;
