@@ -221,7 +221,11 @@ pub fn metrics(points: &[Wrench]) -> (SpaceMetrics, Option<String>) {
 struct Hull {
     facets: Vec<([f64; 6], f64)>,
     volume: f64,
+    /// Indices into the input of the hull's vertices, sorted.
     vertices: Vec<usize>,
+    /// True if and only if qhull needed joggled input (QJ); the tests check the retry.
+    #[cfg_attr(not(test), allow(dead_code))]
+    joggled: bool,
 }
 
 /// The hull of `points` by qhull (`Qt`), or `None` when qhull fails (or panics).
@@ -242,11 +246,13 @@ fn hull(points: &[Wrench]) -> Option<Hull> {
     std::panic::catch_unwind(move || {
         // Qt first; where qhull meets a precision error on nearly degenerate input (duplicate
         // contacts, a contact's coplanar edges), joggled input (QJ) as qhull's docs advise.
+        let mut joggled = false;
         let qh = qhull::Qh::builder()
             .compute(true)
             .triangulate(true)
             .build_managed(6, coords.clone())
             .or_else(|_| {
+                joggled = true;
                 qhull::Qh::builder()
                     .compute(true)
                     .qhull_args(["QJ"])
@@ -266,9 +272,13 @@ fn hull(points: &[Wrench]) -> Option<Hull> {
                 .iter()
                 .filter_map(|v| v.point().and_then(|p| p.try_into().ok()))
                 .collect();
+            // qhull's own point id: under QJ qhull works on a joggled copy of the points,
+            // which `Vertex::index` does not expect (it asserts in debug builds).
             for v in f.vertices()?.iter() {
-                if let Some(i) = v.index(&qh) {
-                    vertices.push(i);
+                if let Ok(i) = usize::try_from(v.point_id(&qh).ok()?) {
+                    if i < points.len() {
+                        vertices.push(i);
+                    }
                 }
             }
             if vs.len() == 6 {
@@ -282,6 +292,7 @@ fn hull(points: &[Wrench]) -> Option<Hull> {
             facets,
             volume,
             vertices,
+            joggled,
         })
     })
     .ok()
@@ -551,6 +562,35 @@ mod tests {
         assert_eq!(m.epsilon, 0.0);
         assert!((m.volume - 64.0).abs() < 1e-6);
         assert!(note.unwrap().contains("outside"));
+    }
+
+    #[test]
+    fn duplicated_points_go_through_joggled_input_and_keep_their_indices() {
+        // Every vertex of the cube [−1, 1]^6 twice, 1e-10 apart (as rapier reports a contact
+        // twice when two manifolds see it): qhull meets a precision error and the retry joggles the
+        // input (QJ), a copy qhull makes of it; the hull's vertices must still be given as
+        // indices into the input (a debug build used to panic there).
+        let cube: Vec<Wrench> = (0..64u32)
+            .map(|b| std::array::from_fn(|i| if b >> i & 1 == 1 { 1.0 } else { -1.0 }))
+            .collect();
+        let twice: Vec<Wrench> = cube
+            .iter()
+            .copied()
+            .chain(cube.iter().enumerate().map(|(k, w)| {
+                std::array::from_fn(|i| w[i] + 1e-10 * (((k * 7 + i * 3) % 5) as f64 - 2.0))
+            }))
+            .collect();
+        let h = hull(&twice).expect("the joggled retry gives a hull");
+        assert!(h.joggled);
+        let mut corners: Vec<usize> = h.vertices.iter().map(|&i| i % 64).collect();
+        corners.sort_unstable();
+        corners.dedup();
+        assert_eq!(corners, (0..64).collect::<Vec<_>>());
+        assert!(h.vertices.iter().all(|&i| i < twice.len()));
+        let (m, note) = metrics(&twice);
+        assert!(note.is_none(), "{note:?}");
+        assert!((m.epsilon - 1.0).abs() < 1e-6, "epsilon {}", m.epsilon);
+        assert!((m.volume - 64.0).abs() < 1e-3, "volume {}", m.volume);
     }
 
     /// Contacts at the vertices of a regular tetrahedron (four) or on the equator 120° apart
