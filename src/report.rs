@@ -233,8 +233,12 @@ impl GraspReport {
             ),
             None => "; not checked".to_string(),
         };
+        let quality = match &self.quality {
+            Some(q) => format!("; epsilon {:.3} ({} contacts)", q.epsilon, q.source),
+            None => String::new(),
+        };
         format!(
-            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{check}",
+            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{check}{quality}",
             self.axis_name,
             self.approach_angle_deg,
             self.elevation_index,
@@ -543,6 +547,9 @@ impl RunReport {
             (None, None) => self.sim.verdict.clone(),
         };
         let _ = writeln!(s, "  Sim         {sim_line}");
+        if let Some(q) = &self.quality {
+            let _ = writeln!(s, "  Quality     {}", quality_line(q));
+        }
         let _ = writeln!(s, "  Result      {}", self.result_sentence());
         if self.expect.is_given() {
             let met = match self.expect.met {
@@ -598,6 +605,31 @@ impl RunReport {
             ),
         }
     }
+}
+
+/// The summary's quality line: epsilon and volume, what they were computed from, and why
+/// epsilon is 0 when it is.
+fn quality_line(q: &crate::quality::Quality) -> String {
+    let closure = if q.force_closure {
+        "force closure".to_string()
+    } else {
+        format!(
+            "not force closure: {}",
+            q.note.as_deref().unwrap_or("the origin is not inside")
+        )
+    };
+    let from = match q.source {
+        "sim" => "at the end of closing",
+        _ => "planned",
+    };
+    format!(
+        "epsilon {:.3} ({closure}), volume {:.3e} (L1 grasp wrench space, {} cone edges, mu {}); {} {from}",
+        q.epsilon,
+        q.volume,
+        q.cone_edges,
+        q.friction,
+        crate::batch::plural(q.contacts.len(), "contact")
+    )
 }
 
 /// Significant digits kept in reported JSON figures: float noise from the arithmetic

@@ -71,3 +71,58 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
     );
     assert!(q.volume > 1e-3, "volume {}", q.volume);
 }
+
+#[test]
+fn the_summary_gives_epsilon_and_the_json_has_it_per_candidate() {
+    // With the check: epsilon from the contacts at the end of closing.
+    let out = crate::succeed(crate::grasp_sim().args(["scenarios/cup.toml"]));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("  Quality     "))
+        .unwrap_or_else(|| panic!("no quality line in\n{text}"));
+    assert!(
+        line.contains("epsilon 0.132 (force closure)")
+            && line.contains("8 cone edges, mu 0.3")
+            && line.contains("17 contacts at the end of closing"),
+        "{line}"
+    );
+    // Without it: from the planned contacts (palm and the phalanges of every ALS), for every
+    // candidate collected.
+    let out = crate::succeed(crate::grasp_sim().args([
+        "--no-sim",
+        "--candidates",
+        "3",
+        "--json",
+        "scenarios/cup.toml",
+    ]));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let q = &v["quality"];
+    assert_eq!(q["source"], "planned");
+    assert_eq!(q["contacts"].as_array().unwrap().len(), 20);
+    let eps = q["epsilon"].as_f64().unwrap();
+    assert!((eps - 0.1806).abs() < 1e-3, "planned epsilon {eps}");
+    let grasps = v["plan"]["grasps"].as_array().unwrap();
+    assert_eq!(grasps.len(), 3);
+    for g in grasps {
+        assert_eq!(g["quality"]["source"], "planned");
+        assert_eq!(g["quality"]["force_closure"], true);
+        assert!(g["quality"]["epsilon"].as_f64().unwrap() > 0.17, "{g}");
+    }
+    assert_eq!(grasps[0]["quality"]["epsilon"], q["epsilon"]);
+    let out = crate::succeed(crate::grasp_sim().args([
+        "--no-sim",
+        "--candidates",
+        "3",
+        "scenarios/cup.toml",
+    ]));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("; not checked; epsilon 0.181 (planned contacts)"),
+        "{text}"
+    );
+    assert!(
+        text.contains("Quality     epsilon 0.181 (force closure)"),
+        "{text}"
+    );
+}
