@@ -19,8 +19,10 @@
 //! (assets/objects/train/) or `bundled`.
 //!
 //! Writes `OUT_DIR/quality_study.csv` (one row per grasp; the time columns are wall clock, the
-//! rest is the same run after run), `OUT_DIR/quality_study.md` (statistics and the full table)
-//! and `OUT_DIR/quality_epsilon_payload.svg`, and prints the statistics.
+//! rest is the same run after run), `OUT_DIR/quality_study_run.txt` (run time, scenarios
+//! without a grasp), then, from those two, `OUT_DIR/quality_study.md` (statistics and the full
+//! table) and `OUT_DIR/quality_epsilon_payload.svg`, and prints the statistics.
+//! `quality_study OUT_DIR --report-only` writes the last two again from the first two.
 
 use grasp_sim::scenario::{GravityMode, MassSpec, Scenario};
 use grasp_sim::{mesh, plan, quality, select, sim};
@@ -374,7 +376,8 @@ fn main() {
     let mut args = std::env::args().skip(1);
     let usage =
         "usage: quality_study OUT_DIR [--candidates N] [--gravity both|down] SCENARIO.toml... \
-                 (options apply to the scenarios after them)";
+                 (options apply to the scenarios after them)\n       \
+                 quality_study OUT_DIR --report-only (statistics and plot again from the CSV)";
     let Some(out) = args.next().filter(|a| !a.starts_with("--")) else {
         eprintln!("{usage}");
         std::process::exit(2);
@@ -407,6 +410,17 @@ fn main() {
         std::process::exit(2);
     }
     let out = PathBuf::from(out);
+    if files.len() == 1 && files[0].0 == "--report-only" {
+        let read = |name: &str| {
+            std::fs::read_to_string(out.join(name)).unwrap_or_else(|e| {
+                eprintln!("quality_study: {}: {e}", out.join(name).display());
+                std::process::exit(2);
+            })
+        };
+        let csv = read("quality_study.csv");
+        report(&out, &parse_csv(&csv), &read("quality_study_run.txt"));
+        return;
+    }
     std::fs::create_dir_all(&out).expect("creating the output folder");
     let t_all = Instant::now();
 
@@ -466,8 +480,64 @@ fn main() {
             r.ms_quality
         );
     }
-    std::fs::write(out.join("quality_study.csv"), csv).expect("writing the CSV");
+    std::fs::write(out.join("quality_study.csv"), &csv).expect("writing the CSV");
+    let mut note = format!("Whole run {:.0} s.\n", t_all.elapsed().as_secs_f64());
+    if !skipped.is_empty() {
+        let _ = writeln!(note, "\nNo grasp to check ({}):\n", skipped.len());
+        for s in &skipped {
+            let _ = writeln!(note, "- {s}");
+        }
+    }
+    std::fs::write(out.join("quality_study_run.txt"), &note).expect("writing the run note");
+    // The statistics from the CSV as written, so `--report-only` gives them again exactly.
+    report(&out, &parse_csv(&csv), &note);
+}
 
+/// Reads back the CSV [`main`] writes.
+fn parse_csv(csv: &str) -> Vec<Row> {
+    let verdict = |v: &str| match v {
+        "hold" => Some(sim::Verdict::Hold),
+        "slip" => Some(sim::Verdict::Slip),
+        "drop" => Some(sim::Verdict::Drop),
+        _ => None,
+    };
+    csv.lines()
+        .skip(1)
+        .map(|line| {
+            let c: Vec<&str> = line.split(',').collect();
+            let f = |i: usize| c[i].parse::<f64>().expect("a number in the CSV");
+            Row {
+                set: match c[0] {
+                    "real" => "real",
+                    "tuning" => "tuning",
+                    _ => "bundled",
+                },
+                scenario: c[1].to_string(),
+                candidate: c[2].parse().expect("a candidate number"),
+                axis: c[3].to_string(),
+                rules: c[4].to_string(),
+                grade: f(5),
+                eps_sim: f(6),
+                vol_sim: f(7),
+                eps_sim_linf: c[8].parse().ok(),
+                contacts_sim: c[9].parse().expect("a contact count"),
+                eps_plan: f(10),
+                vol_plan: f(11),
+                payload: f(12),
+                down: verdict(c[13]).expect("a down verdict"),
+                six: verdict(c[14]),
+                ms_down: f(15),
+                ms_six: f(16),
+                ms_payload: f(17),
+                ms_quality: f(18),
+            }
+        })
+        .collect()
+}
+
+/// Writes `quality_study.md` (statistics, costs, `note`, the table) and the SVG, and prints
+/// the statistics.
+fn report(out: &Path, rows: &[Row], note: &str) {
     let all: Vec<&Row> = rows.iter().collect();
     let mut md = String::new();
     md.push_str(&statistics("All", &all));
@@ -493,8 +563,7 @@ fn main() {
         md,
         "\nCost per grasp, wall clock, release build (median / 90th percentile / largest): \
          quality (sim contacts, L1 and L-inf) {:.2} / {:.2} / {:.0} ms; physics check `down` \
-         {:.0} / {:.0} / {:.0} ms; `six` {:.0} / {:.0} / {:.0} ms; payload search {:.0} / {:.0} / {:.0} ms. \
-         Whole run {:.0} s.",
+         {:.0} / {:.0} / {:.0} ms; `six` {:.0} / {:.0} / {:.0} ms; payload search {:.0} / {:.0} / {:.0} ms.",
         median(rows.iter().map(|r| r.ms_quality).collect()),
         quantile(rows.iter().map(|r| r.ms_quality).collect(), 0.9),
         quantile(rows.iter().map(|r| r.ms_quality).collect(), 1.0),
@@ -507,21 +576,15 @@ fn main() {
         median(rows.iter().map(|r| r.ms_payload).collect()),
         quantile(rows.iter().map(|r| r.ms_payload).collect(), 0.9),
         quantile(rows.iter().map(|r| r.ms_payload).collect(), 1.0),
-        t_all.elapsed().as_secs_f64()
     );
-    if !skipped.is_empty() {
-        let _ = writeln!(md, "\nNo grasp to check ({}):\n", skipped.len());
-        for s in &skipped {
-            let _ = writeln!(md, "- {s}");
-        }
-    }
+    md.push_str(note);
     print!("{md}");
     let _ = writeln!(
         md,
         "\n| set | object | # | axis | rules | grade | epsilon (sim) | volume (sim) | contacts (sim) | epsilon (planned) | payload | down | six |"
     );
     let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for r in &rows {
+    for r in rows {
         let _ = writeln!(
             md,
             "| {} | {} | {} | {} | {} | {:.2} | {:.4} | {:.2e} | {} | {:.4} | {:.1} | {} | {} |",
@@ -541,7 +604,7 @@ fn main() {
         );
     }
     std::fs::write(out.join("quality_study.md"), md).expect("writing the Markdown");
-    plot(&out.join("quality_epsilon_payload.svg"), &rows).expect("writing the SVG");
+    plot(&out.join("quality_epsilon_payload.svg"), rows).expect("writing the SVG");
 }
 
 fn plot(path: &Path, rows: &[Row]) -> Result<(), Box<dyn std::error::Error>> {
@@ -561,7 +624,7 @@ fn plot(path: &Path, rows: &[Row]) -> Result<(), Box<dyn std::error::Error>> {
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(50)
-        .build_cartesian_2d(0.0..xmax, 0.0..70.0)?;
+        .build_cartesian_2d(0.0..xmax, 0.0..88.0)?;
     chart
         .configure_mesh()
         .x_desc("Ferrari-Canny epsilon (L1)")
