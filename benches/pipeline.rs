@@ -8,14 +8,19 @@
 //! - `plan_scaling/*`: the planner on the cup as AngularStep and HeightStep change.
 //! - `sim/*`: the physics check of the planned D40 grasp: `down`, `six` and `payload` (fast
 //!   protocol), `full_down` and `full_six` (the full-length reference).
+//! - `quality/*`: the analytic grasp quality (issue 18) of the planned grasp of D40, the cup
+//!   and the chapter 4 object, from the contacts at the end of the `down` check's closing
+//!   (`sim_*`) and from the planned contacts (`planned_*`), beside that same `down` check
+//!   (`check_down_*`), so the ratio comes from one run.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use grasp_sim::hand::Hand;
 use grasp_sim::mesh::{align, mass_properties};
 use grasp_sim::objects;
 use grasp_sim::plan::plan;
+use grasp_sim::quality;
 use grasp_sim::scenario::{GravityMode, PlannerParams, Protocol, SimParams};
-use grasp_sim::sim::{check_with_payload, Case, ObjectShape, SimHand};
+use grasp_sim::sim::{check, check_with_payload, Case, ObjectShape, SimHand};
 use grasp_sim::slice::{slice, Plane};
 use std::collections::BTreeMap;
 use std::hint::black_box;
@@ -180,11 +185,54 @@ fn bench_sim(c: &mut Criterion) {
     g.finish();
 }
 
+fn bench_quality(c: &mut Criterion) {
+    let hand = thesis_hand();
+    let mut g = c.benchmark_group("quality");
+    g.sample_size(10);
+    let objects = objects::thesis_objects();
+    for name in ["cylinder_d40", "cup", "chapter4"] {
+        let mesh = &objects.iter().find(|(n, _)| *n == name).expect(name).1;
+        let a = align(mesh);
+        let (_, found) = plan(
+            &a.mesh,
+            &hand,
+            &PlannerParams::default(),
+            0.3,
+            1,
+            &mut BTreeMap::new(),
+        );
+        let grasp = &found.grasps[0];
+        let pose = SimHand::from_grasp(grasp);
+        let volume = mass_properties(&a.mesh).volume_mm3;
+        let shape = ObjectShape::from_mesh(&a.mesh, volume);
+        let params = SimParams::default();
+        let case = Case {
+            hand: &hand,
+            pose: &pose,
+            object: &shape,
+            mass_kg: 500.0 * volume * 1e-9,
+            friction: 0.3,
+            params: &params,
+        };
+        let outcome = check(&case);
+        g.bench_function(format!("check_down_{name}"), |b| b.iter(|| check(&case)));
+        g.bench_function(
+            format!("sim_{name}_{}_contacts", outcome.grip_contacts.len()),
+            |b| b.iter(|| quality::of_grasp(grasp, &a, Some(&outcome), &hand, 0.3)),
+        );
+        g.bench_function(format!("planned_{name}"), |b| {
+            b.iter(|| quality::of_grasp(grasp, &a, None, &hand, 0.3))
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
     bench_slice,
     bench_kinematics,
     bench_plan,
-    bench_sim
+    bench_sim,
+    bench_quality
 );
 criterion_main!(benches);

@@ -24,6 +24,7 @@ pub mod hand;
 pub mod mesh;
 pub mod objects;
 pub mod plan;
+pub mod quality;
 pub mod report;
 pub mod scenario;
 pub mod select;
@@ -180,11 +181,22 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         .iter()
         .filter(|s| s.open_count() > 0)
         .count();
-    let all_grasps: Vec<report::GraspReport> = selection
+    let qualities: Vec<quality::Quality> = selection
         .candidates
         .iter()
         .map(|c| {
-            grasp_report(
+            let aligned = &selection.axes[c.axis_plan].aligned;
+            let (h, mu) = (&scenario.hand, scenario.object.friction);
+            quality::of_grasp(&c.grasp, aligned, c.check.as_ref(), h, mu)
+        })
+        .collect();
+    let all_grasps: Vec<report::GraspReport> = selection
+        .candidates
+        .iter()
+        .zip(&qualities)
+        .map(|(c, q)| report::GraspReport {
+            quality: Some(report::GraspQuality::of(q)),
+            ..grasp_report(
                 &c.grasp,
                 &selection.axes[c.axis_plan].aligned,
                 c.check.as_ref(),
@@ -271,6 +283,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         plan,
         sim,
         expect,
+        quality: selection.chosen.map(|i| qualities[i].clone()),
         warnings: loaded
             .warnings()
             .into_iter()
@@ -520,6 +533,7 @@ fn grasp_report(
             translation_mm: o.translation_mm,
             rotation_deg: o.rotation_deg,
         }),
+        quality: None,
     }
 }
 

@@ -19,6 +19,10 @@ pub struct RunReport {
     pub sim: SimReport,
     /// Whether the scenario's expectations were met.
     pub expect: ExpectReport,
+    /// The chosen grasp's analytic quality (Ferrari–Canny epsilon and volume, with its
+    /// contacts); `null` without a grasp. From the physics check's contacts when it ran on
+    /// the grasp (`quality.source` = `sim`), else from the planned contacts (`planned`).
+    pub quality: Option<crate::quality::Quality>,
     /// One-line warnings about the input (repairs made, an open surface, ...).
     pub warnings: Vec<String>,
 }
@@ -139,6 +143,41 @@ pub struct GraspReport {
     /// The physics check on this grasp, when it ran on it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub check: Option<CandidateCheck>,
+    /// This grasp's analytic quality, without its contacts (the chosen grasp's are in the
+    /// report's `quality`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub quality: Option<GraspQuality>,
+}
+
+/// A candidate grasp's analytic quality in brief.
+#[derive(Debug, Clone, Serialize)]
+pub struct GraspQuality {
+    /// `sim` or `planned` contacts.
+    pub source: &'static str,
+    /// L1 Ferrari–Canny epsilon (0: not force closure).
+    pub epsilon: f64,
+    /// L1 wrench-space volume.
+    pub volume: f64,
+    /// L∞ epsilon, when computed.
+    pub epsilon_linf: Option<f64>,
+    /// True if and only if the origin lies strictly inside the wrench space.
+    pub force_closure: bool,
+    /// Number of contacts.
+    pub contacts: usize,
+}
+
+impl GraspQuality {
+    /// The brief of `q`.
+    pub fn of(q: &crate::quality::Quality) -> GraspQuality {
+        GraspQuality {
+            source: q.source,
+            epsilon: q.epsilon,
+            volume: q.volume,
+            epsilon_linf: q.linf.map(|m| m.epsilon),
+            force_closure: q.force_closure,
+            contacts: q.contacts.len(),
+        }
+    }
 }
 
 impl GraspReport {
@@ -194,8 +233,12 @@ impl GraspReport {
             ),
             None => "; not checked".to_string(),
         };
+        let quality = match &self.quality {
+            Some(q) => format!("; epsilon {:.3} ({} contacts)", q.epsilon, q.source),
+            None => String::new(),
+        };
         format!(
-            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{check}",
+            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{check}{quality}",
             self.axis_name,
             self.approach_angle_deg,
             self.elevation_index,
@@ -508,6 +551,9 @@ impl RunReport {
             (None, None) => self.sim.verdict.clone(),
         };
         let _ = writeln!(s, "  Sim         {sim_line}");
+        if let Some(q) = &self.quality {
+            let _ = writeln!(s, "  Quality     {}", quality_line(q));
+        }
         let _ = writeln!(s, "  Result      {}", self.result_sentence());
         if self.expect.is_given() {
             let met = match self.expect.met {
@@ -563,6 +609,31 @@ impl RunReport {
             ),
         }
     }
+}
+
+/// The summary's quality line: epsilon and volume, what they were computed from, and why
+/// epsilon is 0 when it is.
+fn quality_line(q: &crate::quality::Quality) -> String {
+    let closure = if q.force_closure {
+        "force closure".to_string()
+    } else {
+        format!(
+            "not force closure: {}",
+            q.note.as_deref().unwrap_or("the origin is not inside")
+        )
+    };
+    let from = match q.source {
+        "sim" => "at the end of closing",
+        _ => "planned",
+    };
+    format!(
+        "epsilon {:.3} ({closure}), volume {:.3e} (L1 grasp wrench space, {} cone edges, mu {}); {} {from}",
+        q.epsilon,
+        q.volume,
+        q.cone_edges,
+        q.friction,
+        crate::batch::plural(q.contacts.len(), "contact")
+    )
 }
 
 /// Significant digits kept in reported JSON figures: float noise from the arithmetic

@@ -39,6 +39,11 @@ pub struct AlsAngles {
     pub is_tip_contact: bool,
     /// Gap Space between the palm surface and the object in this plane `[mm]`.
     pub gap_mm: f64,
+    /// Where phalanx 1 and phalanx 2 touch, in the finger slice plane's 2D coordinates
+    /// `[mm]`, each with the unit direction in which the phalanx pushes (its contact surface's
+    /// inward normal); `None` for an ALS reported with its finger's angles because it met
+    /// nothing (extended rules).
+    pub contacts: Option<[(Point2<f64>, Vector2<f64>); 2]>,
 }
 
 /// A positioned finger: its three ALS.
@@ -156,6 +161,7 @@ fn place_finger_extended(
         .fold(f64::NEG_INFINITY, f64::max);
     let finger = AlsAngles {
         theta2_deg: theta2,
+        contacts: als[0].as_ref().ok().and_then(|a| a.contacts),
         ..*first
     };
     if touching.iter().any(|a| {
@@ -166,7 +172,13 @@ fn place_finger_extended(
     }
     relaxations.sort();
     relaxations.dedup();
-    let pick = |r: &Result<AlsAngles, FingerRejection>| *r.as_ref().unwrap_or(&finger);
+    let pick = |r: &Result<AlsAngles, FingerRejection>| match r {
+        Ok(a) => *a,
+        Err(_) => AlsAngles {
+            contacts: None,
+            ..finger
+        },
+    };
     Ok(FingerPlacement {
         name,
         top: pick(&als[1]),
@@ -229,7 +241,7 @@ pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, Finge
         .map(|(a, _)| *a)
         .filter(|p| (p - j1).norm() <= reach1)
         .collect();
-    let (bend1, _) = first_contact(&domain1, j1, straight1, usable1, o)
+    let (bend1, along1) = first_contact(&domain1, j1, straight1, usable1, o)
         .ok_or(FingerRejection::Phalanx1NoContact)?;
     let theta1 = 180.0 - bend1.to_degrees();
     let [lo1, hi1] = hand.joints.theta1_range_deg;
@@ -287,11 +299,23 @@ pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, Finge
         return Err(FingerRejection::Phalanx2Penetration);
     }
     let is_tip_contact = along2 >= usable2.1 - 1e-6;
+    // The contacts on the contact lines, a finger offset inside the centrelines, mirrored back.
+    let n_d1 = inward_normal(&d1);
+    let unmirror = |p: Point2<f64>, n: Vector2<f64>| {
+        (
+            Point2::new(p.x, mirror * p.y),
+            Vector2::new(n.x, mirror * n.y),
+        )
+    };
     Ok(AlsAngles {
         theta1_deg: theta1,
         theta2_deg: theta2,
         is_tip_contact,
         gap_mm,
+        contacts: Some([
+            unmirror(j1 + d1 * along1 + n_d1 * o, n_d1),
+            unmirror(j2 + e * along2 + n_e * o, n_e),
+        ]),
     })
 }
 

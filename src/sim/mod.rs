@@ -25,6 +25,7 @@
 //! relative to the palm during the hold gives the verdict: `hold` within the thresholds, `slip`
 //! beyond them while still touching the hand, `drop` when it has left the hand.
 
+pub mod contacts;
 pub mod convert;
 pub mod protocol;
 pub mod scene;

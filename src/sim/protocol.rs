@@ -102,6 +102,9 @@ pub struct SimOutcome {
     /// Where the first gravity direction's run left the bodies (aligned frame, metres): the
     /// palm, phalanx 1 and 2 of each finger, then the object.
     pub final_poses: Vec<(Vector3<f64>, nalgebra::UnitQuaternion<f64>)>,
+    /// The contacts that carried the grip at the end of closing (gravity still off; the first
+    /// direction's closing under the `full` protocol): [`super::contacts::grip_contacts`].
+    pub grip_contacts: Vec<super::contacts::GripContact>,
 }
 
 /// Standard gravity `[m/s²]`.
@@ -171,6 +174,8 @@ struct Closing {
     penetration_mm: f64,
     /// Steps taken.
     steps: usize,
+    /// The contacts carrying the grip when closing ended.
+    contacts: Vec<super::contacts::GripContact>,
 }
 
 /// A scene with the hand closed on the object and gravity still off: the state every gravity
@@ -237,9 +242,11 @@ fn check_full(case: &Case) -> SimOutcome {
     let mut outcomes = Vec::new();
     let mut steps = 0;
     let mut final_poses = Vec::new();
+    let mut grip_contacts = None;
     for g in directions(params.gravity) {
         let mut scene = build(case);
         let closing = close(&mut scene, params);
+        grip_contacts.get_or_insert_with(|| closing.contacts.clone());
         let (o, n) = hold(
             &mut scene,
             g,
@@ -254,7 +261,10 @@ fn check_full(case: &Case) -> SimOutcome {
         outcomes.push(o);
         steps += closing.steps + n;
     }
-    summarise(outcomes, steps, params, t0, final_poses)
+    SimOutcome {
+        grip_contacts: grip_contacts.unwrap_or_default(),
+        ..summarise(outcomes, steps, params, t0, final_poses)
+    }
 }
 
 /// The `fast` protocol from a closed scene, with the object's mass multiplied by `k`: each
@@ -282,13 +292,16 @@ pub fn check_closed(closed: &Closed, case: &Case, k: f64, t0: Instant) -> SimOut
         .collect();
     let steps = closed.closing.steps + runs.iter().map(|r| r.1).sum::<usize>();
     let final_poses = runs[0].2.clone();
-    summarise(
-        runs.into_iter().map(|r| r.0).collect(),
-        steps,
-        params,
-        t0,
-        final_poses,
-    )
+    SimOutcome {
+        grip_contacts: closed.closing.contacts.clone(),
+        ..summarise(
+            runs.into_iter().map(|r| r.0).collect(),
+            steps,
+            params,
+            t0,
+            final_poses,
+        )
+    }
 }
 
 fn summarise(
@@ -316,6 +329,7 @@ fn summarise(
         directions: outcomes,
         wall_ms: t0.elapsed().as_secs_f64() * 1000.0,
         final_poses,
+        grip_contacts: Vec::new(),
     }
 }
 
@@ -369,6 +383,7 @@ fn close(scene: &mut Scene, params: &SimParams) -> Closing {
         penetration_mm: penetration_mm(scene),
         joint_errors_deg: joint_errors(scene),
         steps: close_steps,
+        contacts: super::contacts::grip_contacts(scene),
     }
 }
 

@@ -9,6 +9,7 @@ mod geometry;
 mod isolation;
 mod issue16;
 mod planner;
+mod quality;
 mod real_meshes;
 mod resume;
 mod sim;

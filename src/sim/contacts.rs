@@ -1,0 +1,103 @@
+//! The contacts that carry the grip: the contact points between the hand's colliders and the
+//! object where the solver pushed at the last step, in the object's frame.
+//!
+//! The object body starts at the identity pose, so its local frame is the aligned object frame
+//! (in metres); points are reported in it in millimetres, as [`crate::quality`] takes them.
+
+use super::convert;
+use super::scene::Scene;
+use rapier3d::prelude::*;
+
+/// One contact point between the hand and the object.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GripContact {
+    /// Contact point on the object, aligned object frame `[mm]`.
+    pub point_mm: [f64; 3],
+    /// Unit direction in which the hand pushes the object, aligned object frame.
+    pub normal: [f64; 3],
+    /// The finger's index in the hand, `None` for the palm.
+    pub finger: Option<usize>,
+    /// 1 or 2 for a phalanx (the thinned tip counts as phalanx 2), 0 for the palm.
+    pub phalanx: u8,
+    /// The normal force the solver applied at the last step `[N]`.
+    pub force_n: f64,
+}
+
+/// The contacts between the hand and the object that carried force at the last step (a
+/// positive normal impulse), in a fixed order (by finger, phalanx, then as rapier lists them).
+pub fn grip_contacts(scene: &Scene) -> Vec<GripContact> {
+    let world = &scene.world;
+    let dt = f64::from(world.integration_parameters.dt);
+    let Some(obj) = world.bodies.get(scene.object) else {
+        return Vec::new();
+    };
+    let obj_pose = *obj.position();
+    let part_of = |c: ColliderHandle| -> Option<(Option<usize>, u8)> {
+        let body = world.colliders.get(c)?.parent()?;
+        if body == scene.palm {
+            return Some((None, 0));
+        }
+        scene
+            .fingers
+            .iter()
+            .enumerate()
+            .find_map(|(i, &(b1, b2, _, _))| {
+                (body == b1)
+                    .then_some((Some(i), 1))
+                    .or((body == b2).then_some((Some(i), 2)))
+            })
+    };
+    let mut out = Vec::new();
+    for pair in world.narrow_phase.contact_pairs_with(scene.object_collider) {
+        let (hand, object_first) = if pair.collider1 == scene.object_collider {
+            (pair.collider2, true)
+        } else {
+            (pair.collider1, false)
+        };
+        let Some((finger, phalanx)) = part_of(hand) else {
+            continue;
+        };
+        let Some(obj_collider) = world.colliders.get(scene.object_collider) else {
+            continue;
+        };
+        let co_pose = *obj_collider.position();
+        // The solver's manifolds, not the narrow phase's: against a compound object (a convex
+        // decomposition) rapier merges the per-part manifolds that share a normal into clusters
+        // and solves those, so only the clusters carry impulses.
+        for m in pair.solver_manifolds() {
+            // `data.normal` points from collider 1 to collider 2 (world frame).
+            let n_world = if object_first {
+                -m.data.normal
+            } else {
+                m.data.normal
+            };
+            let n_obj = obj_pose.rotation.inverse() * n_world;
+            for p in &m.points {
+                if p.data.impulse <= 0.0 {
+                    continue;
+                }
+                // In the part's frame for a plain manifold of a compound, in the collider's
+                // for a cluster (which has no part pose).
+                let (local, part) = if object_first {
+                    (p.local_p1, m.subshape_pos1())
+                } else {
+                    (p.local_p2, m.subshape_pos2())
+                };
+                let local = part.map_or(local, |pose| pose.transform_point(local));
+                let world_p = co_pose.transform_point(local);
+                let in_obj = obj_pose.inverse_transform_point(world_p);
+                let mm = convert::vector_mm(in_obj);
+                let n = convert::vector_mm(n_obj) * convert::M_PER_MM;
+                out.push(GripContact {
+                    point_mm: [mm.x, mm.y, mm.z],
+                    normal: [n.x, n.y, n.z],
+                    finger,
+                    phalanx,
+                    force_n: f64::from(p.data.impulse) / dt,
+                });
+            }
+        }
+    }
+    out.sort_by_key(|c| (c.finger.map_or(0, |i| i + 1), c.phalanx));
+    out
+}
