@@ -37,6 +37,12 @@ pub struct Cli {
     #[arg(long)]
     pub payload: bool,
 
+    /// Also compute the analytic grasp quality (Ferrari-Canny epsilon and volume of the grasp
+    /// wrench space, docs/QUALITY.md) of every grasp reported: a 6-D convex hull per grasp, about
+    /// 0.1-0.3 s each.
+    #[arg(long)]
+    pub quality: bool,
+
     /// Write each planned grasp as an MJCF scene for MuJoCo into DIR/<scenario>/ (scene.xml,
     /// the object's STL, protocol.json for scripts/mujoco_replay.py).
     #[arg(long, value_name = "DIR")]
@@ -112,6 +118,9 @@ pub enum Command {
         /// As `batch --payload`.
         #[arg(long)]
         payload: bool,
+        /// As `batch --quality`.
+        #[arg(long)]
+        quality: bool,
     },
     /// Sweep planner parameters over a grid and rank the settings by simulated outcomes (hold
     /// rate, then mean payload margin, then mean translation); writes tune.csv, tune.json and
@@ -200,6 +209,12 @@ pub struct BatchArgs {
     /// Also find each grasp's payload margin.
     #[arg(long)]
     pub payload: bool,
+
+    /// Also compute the analytic grasp quality (Ferrari-Canny epsilon and volume of the grasp
+    /// wrench space, docs/QUALITY.md) of every grasp reported: a 6-D convex hull per grasp, about
+    /// 0.1-0.3 s each.
+    #[arg(long)]
+    pub quality: bool,
 }
 
 fn positive_seconds(s: &str) -> Result<f64, String> {

@@ -63,6 +63,9 @@ pub struct RunOptions {
     pub no_sim: bool,
     /// Find the payload margin by bisection (several more physics runs).
     pub payload: bool,
+    /// Compute the analytic grasp quality of every grasp reported (`quality`, docs/QUALITY.md):
+    /// a 6-D convex hull per grasp, so off by default.
+    pub quality: bool,
     /// How many feasible grasps to collect, in search order (the thesis stops at 1).
     pub candidates: usize,
     /// With the physics check: check candidates in search order until one holds or this many
@@ -84,6 +87,7 @@ impl Default for RunOptions {
         RunOptions {
             no_sim: false,
             payload: false,
+            quality: false,
             candidates: 1,
             max_checked: None,
             export_mjcf: None,
@@ -181,13 +185,15 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         .iter()
         .filter(|s| s.open_count() > 0)
         .count();
-    let qualities: Vec<quality::Quality> = selection
+    let qualities: Vec<Option<quality::Quality>> = selection
         .candidates
         .iter()
         .map(|c| {
-            let aligned = &selection.axes[c.axis_plan].aligned;
-            let (h, mu) = (&scenario.hand, scenario.object.friction);
-            quality::of_grasp(&c.grasp, aligned, c.check.as_ref(), h, mu)
+            options.quality.then(|| {
+                let aligned = &selection.axes[c.axis_plan].aligned;
+                let (h, mu) = (&scenario.hand, scenario.object.friction);
+                quality::of_grasp(&c.grasp, aligned, c.check.as_ref(), h, mu)
+            })
         })
         .collect();
     let all_grasps: Vec<report::GraspReport> = selection
@@ -195,7 +201,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         .iter()
         .zip(&qualities)
         .map(|(c, q)| report::GraspReport {
-            quality: Some(report::GraspQuality::of(q)),
+            quality: q.as_ref().map(report::GraspQuality::of),
             ..grasp_report(
                 &c.grasp,
                 &selection.axes[c.axis_plan].aligned,
@@ -283,7 +289,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         plan,
         sim,
         expect,
-        quality: selection.chosen.map(|i| qualities[i].clone()),
+        quality: selection.chosen.and_then(|i| qualities[i].clone()),
         warnings: loaded
             .warnings()
             .into_iter()

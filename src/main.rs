@@ -37,6 +37,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
             units,
             no_sim,
             payload,
+            quality,
         }) => {
             return batch_worker(
                 &path,
@@ -46,6 +47,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
                 &RunOptions {
                     no_sim,
                     payload,
+                    quality,
                     ..RunOptions::default()
                 },
             )
@@ -75,6 +77,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
     let options = RunOptions {
         no_sim: cli.no_sim,
         payload: cli.payload,
+        quality: cli.quality,
         candidates: cli.candidates as usize,
         max_checked: cli.max_checked.map(|n| n as usize),
         export_mjcf: cli.export_mjcf,
@@ -353,6 +356,7 @@ fn batch(args: &cli::BatchArgs) -> anyhow::Result<u8> {
     let options = RunOptions {
         no_sim: args.no_sim,
         payload: args.payload,
+        quality: args.quality,
         ..RunOptions::default()
     };
     let template = batch_template(args.template.as_deref(), args.units.as_deref())?;
@@ -552,6 +556,9 @@ fn batch_worker_command(
     }
     if args.payload {
         wargs.push("--payload".into());
+    }
+    if args.quality {
+        wargs.push("--quality".into());
     }
     Ok(grasp_sim::batch::Worker {
         program,

@@ -3,6 +3,13 @@
 
 use grasp_sim::scenario::Scenario;
 use grasp_sim::{mesh, run, RunOptions};
+
+fn with_quality() -> RunOptions {
+    RunOptions {
+        quality: true,
+        ..RunOptions::default()
+    }
+}
 use parry3d::query::PointQuery;
 use parry3d::shape::TriMesh;
 
@@ -30,7 +37,7 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
     // impulses: reading the per-part manifolds found no force-carrying contact on most
     // compound objects (epsilon 0 on grasps that held 27x their weight).
     let s = Scenario::load(&crate::root().join("scenarios/chapter4.toml")).unwrap();
-    let r = run(&s, &RunOptions::default()).unwrap();
+    let r = run(&s, &with_quality()).unwrap();
     assert_eq!(r.sim.verdict, "hold");
     assert!(
         r.sim
@@ -75,21 +82,22 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
 #[test]
 fn the_summary_gives_epsilon_and_the_json_has_it_per_candidate() {
     // With the check: epsilon from the contacts at the end of closing.
-    let out = crate::succeed(crate::grasp_sim().args(["scenarios/cup.toml"]));
+    let out = crate::succeed(crate::grasp_sim().args(["--quality", "scenarios/cup.toml"]));
     let text = String::from_utf8(out.stdout).unwrap();
     let line = text
         .lines()
         .find(|l| l.starts_with("  Quality     "))
         .unwrap_or_else(|| panic!("no quality line in\n{text}"));
     assert!(
-        line.contains("epsilon 0.132 (force closure)")
+        line.contains("epsilon 0.120 (force closure)")
             && line.contains("8 cone edges, mu 0.3")
-            && line.contains("17 contacts at the end of closing"),
+            && line.contains("10 contacts at the end of closing"),
         "{line}"
     );
     // Without it: from the planned contacts (palm and the phalanges of every ALS), for every
     // candidate collected.
     let out = crate::succeed(crate::grasp_sim().args([
+        "--quality",
         "--no-sim",
         "--candidates",
         "3",
@@ -111,6 +119,7 @@ fn the_summary_gives_epsilon_and_the_json_has_it_per_candidate() {
     }
     assert_eq!(grasps[0]["quality"]["epsilon"], q["epsilon"]);
     let out = crate::succeed(crate::grasp_sim().args([
+        "--quality",
         "--no-sim",
         "--candidates",
         "3",
@@ -125,4 +134,28 @@ fn the_summary_gives_epsilon_and_the_json_has_it_per_candidate() {
         text.contains("Quality     epsilon 0.181 (force closure)"),
         "{text}"
     );
+}
+
+#[test]
+fn quality_is_computed_only_when_asked() {
+    // A 6-D hull per grasp costs 0.1-0.3 s: without --quality a run computes none.
+    let out = crate::succeed(crate::grasp_sim().args([
+        "--no-sim",
+        "--candidates",
+        "2",
+        "--json",
+        "scenarios/cup.toml",
+    ]));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(
+        v.get("quality").is_none_or(|q| q.is_null()),
+        "{}",
+        v["quality"]
+    );
+    for g in v["plan"]["grasps"].as_array().unwrap() {
+        assert!(g.get("quality").is_none_or(|q| q.is_null()), "{g}");
+    }
+    let out = crate::succeed(crate::grasp_sim().args(["--no-sim", "scenarios/cup.toml"]));
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(!text.contains("Quality     "), "{text}");
 }
