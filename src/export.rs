@@ -13,12 +13,11 @@
 //! planned joint angles); gravity as in the scenario. `protocol.json` beside it carries what the
 //! replay script needs to run the same protocol (scripts/mujoco_replay.py).
 
-use crate::hand::{Hand, Side};
+use crate::hand::{bend, palm_rotation, Hand, HandBox};
 use crate::mesh::{AlignedObject, Mesh};
 use crate::scenario::{GravityMode, SimParams};
-use crate::sim::scene::bend;
 use crate::sim::Case;
-use nalgebra::{Point3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, UnitQuaternion, Vector3};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -66,11 +65,14 @@ fn quat(q: &UnitQuaternion<f64>) -> String {
     format!("{:.12} {:.12} {:.12} {:.12}", q.w, q.i, q.j, q.k)
 }
 
-fn side_sign(side: Side) -> f64 {
-    match side {
-        Side::Left => 1.0,
-        Side::Right => -1.0,
-    }
+/// An MJCF box geom `name` of `b` (millimetres, written in metres), with `extra` attributes.
+fn box_geom(s: &mut String, indent: &str, name: &str, b: &HandBox, extra: &str) {
+    let _ = writeln!(
+        s,
+        "{indent}<geom name=\"{name}\" type=\"box\" size=\"{}\" pos=\"{}\"{extra}/>",
+        v3(&(b.half_extents * MM)),
+        v3(&(b.centre * MM))
+    );
 }
 
 /// Writes `scene.xml`, the object's mesh file(s) and `protocol.json` into `dir`.
@@ -86,15 +88,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     let case = &input.case;
     let hand = case.hand;
     let sim = case.params;
-    let [x, y, z] = case.pose.axes;
-    let r_palm = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
-        nalgebra::Matrix3::from_columns(&[x, y, z]),
-    ));
-    let o = hand.fingers.offset_mm;
-    let (l1, l2) = (hand.phalanx_1.length_mm, hand.phalanx_2.length_mm);
-    let l2c = l2 - hand.phalanx_2.unusable_distal_mm;
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
+    let r_palm = palm_rotation(&case.pose.axes);
     let mu = case.friction;
     let finger_density = sim.finger_density_kg_m3;
     let lim = |r: [f64; 2]| (bend(r[1]), bend(r[0]));
@@ -175,24 +169,13 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
         v3(&palm_pos),
         quat(&r_palm)
     );
-    let _ = writeln!(
-        s,
-        "      <geom name=\"palm\" type=\"box\" size=\"{}\" pos=\"{}\"/>",
-        v3(&(Vector3::new(
-            hand.palm.offset_mm / 2.0,
-            hand.palm.half_width_mm,
-            (h_hi - h_lo) / 2.0 + m
-        ) * MM)),
-        v3(&(Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (h_hi + h_lo) / 2.0) * MM))
-    );
+    box_geom(&mut s, "      ", "palm", &hand.palm_box(), "");
+    let density = format!(" density=\"{finger_density}\"");
     for f in &hand.finger_list {
-        let sd = side_sign(f.side);
+        let sd = f.side.sign();
         let n = &f.name;
-        let anchor = Vector3::new(
-            hand.joints.setback_mm,
-            sd * hand.joints.lateral_mm,
-            f.height_mm,
-        ) * MM;
+        let (p1, p2) = hand.phalanx_boxes(f.side);
+        let anchor = hand.joint1_anchor_mm(f) * MM;
         let _ = writeln!(
             s,
             "      <body name=\"{n}_phalanx_1\" pos=\"{}\">",
@@ -202,35 +185,19 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
             s,
             "        <joint name=\"{n}_joint_1\" type=\"hinge\" axis=\"0 0 {sd}\" range=\"{lo1:.9} {hi1:.9}\" damping=\"0\"/>"
         );
-        let _ = writeln!(
-            s,
-            "        <geom name=\"{n}_phalanx_1\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
-            v3(&(Vector3::new(o, l1 / 2.0, o) * MM)),
-            v3(&(Vector3::new(0.0, sd * l1 / 2.0, 0.0) * MM))
-        );
+        box_geom(&mut s, "        ", &format!("{n}_phalanx_1"), &p1, &density);
         let _ = writeln!(
             s,
             "        <body name=\"{n}_phalanx_2\" pos=\"{}\">",
-            v3(&(Vector3::new(0.0, sd * l1, 0.0) * MM))
+            v3(&(hand.joint2_anchor_mm(f.side) * MM))
         );
         let _ = writeln!(
             s,
             "          <joint name=\"{n}_joint_2\" type=\"hinge\" axis=\"0 0 {sd}\" range=\"{lo2:.9} {hi2:.9}\" damping=\"0\"/>"
         );
-        let _ = writeln!(
-            s,
-            "          <geom name=\"{n}_phalanx_2\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
-            v3(&(Vector3::new(o, l2c / 2.0, o) * MM)),
-            v3(&(Vector3::new(0.0, sd * l2c / 2.0, 0.0) * MM))
-        );
-        if l2 > l2c + 1e-9 {
-            let t = hand.fingers.tip_thickness_mm;
-            let _ = writeln!(
-                s,
-                "          <geom name=\"{n}_tip\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
-                v3(&(Vector3::new(t / 2.0, (l2 - l2c) / 2.0, o) * MM)),
-                v3(&(Vector3::new(o - t / 2.0, sd * (l2 + l2c) / 2.0, 0.0) * MM))
-            );
+        // The contact part of phalanx 2, then its thinned tip if it has one.
+        for (b, part) in p2.iter().zip(["phalanx_2", "tip"]) {
+            box_geom(&mut s, "          ", &format!("{n}_{part}"), b, &density);
         }
         let _ = writeln!(s, "        </body>");
         let _ = writeln!(s, "      </body>");
@@ -370,9 +337,7 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
     };
     std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
     let o = hand.fingers.offset_mm * MM;
-    let (l1, l2) = (hand.phalanx_1.length_mm * MM, hand.phalanx_2.length_mm * MM);
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
+    let l2 = hand.phalanx_2.length_mm * MM;
     let rho = sim.finger_density_kg_m3;
     let mut s = String::new();
     let _ = writeln!(s, "<?xml version=\"1.0\"?>");
@@ -399,26 +364,25 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
         let _ = writeln!(s, "    <collision>{geometry}</collision>");
         let _ = writeln!(s, "  </link>");
     };
+    let palm = hand.palm_box();
     boxed(
         &mut s,
         "palm",
-        Vector3::new(
-            hand.palm.offset_mm,
-            2.0 * hand.palm.half_width_mm,
-            h_hi - h_lo + 2.0 * m,
-        ) * MM,
-        Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (h_hi + h_lo) / 2.0) * MM,
+        palm.half_extents * (2.0 * MM),
+        palm.centre * MM,
     );
     let lim = |r: [f64; 2]| (bend(r[1]), bend(r[0]));
     for f in &hand.finger_list {
-        let sd = side_sign(f.side);
+        let sd = f.side.sign();
         let n = &f.name;
+        let (p1, _) = hand.phalanx_boxes(f.side);
         boxed(
             &mut s,
             &format!("{n}_phalanx_1"),
-            Vector3::new(2.0 * o, l1, 2.0 * o),
-            Vector3::new(0.0, sd * l1 / 2.0, 0.0),
+            p1.half_extents * (2.0 * MM),
+            p1.centre * MM,
         );
+        // Phalanx 2 as one box over its whole length: the URDF leaves out the thinned tip.
         boxed(
             &mut s,
             &format!("{n}_phalanx_2"),
@@ -430,18 +394,14 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
                 1,
                 "palm".to_string(),
                 format!("{n}_phalanx_1"),
-                Vector3::new(
-                    hand.joints.setback_mm,
-                    sd * hand.joints.lateral_mm,
-                    f.height_mm,
-                ) * MM,
+                hand.joint1_anchor_mm(f) * MM,
                 lim(hand.joints.theta1_range_deg),
             ),
             (
                 2,
                 format!("{n}_phalanx_1"),
                 format!("{n}_phalanx_2"),
-                Vector3::new(0.0, sd * l1, 0.0),
+                hand.joint2_anchor_mm(f.side) * MM,
                 lim(hand.joints.theta2_range_deg),
             ),
         ] {

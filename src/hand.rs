@@ -11,6 +11,9 @@
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
+mod geometry;
+pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
+
 /// The hands built into the binary, by name: found wherever grasp-sim runs, without a path.
 pub const BUNDLED: [(&str, &str); 2] = [
     ("thesis", include_str!("../assets/hands/thesis.toml")),

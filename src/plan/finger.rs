@@ -22,7 +22,7 @@ use super::geom2::ConvexPolygon;
 use super::kinematics::{inward_normal, phalanx1_direction};
 use super::palm::{PalmPlacement, PENETRATION_TOL_MM};
 use super::{Relaxation, RuleSet};
-use crate::hand::{Hand, Side};
+use crate::hand::Hand;
 use crate::mesh::Mesh;
 use crate::slice::{slice, Slice};
 use nalgebra::{Point2, Rotation2, Vector2};
@@ -94,10 +94,7 @@ pub fn place_finger(
 ) -> Result<FingerPlacement, FingerRejection> {
     let f = &hand.finger_list[k];
     let o = hand.fingers.offset_mm;
-    let mirror = match f.side {
-        Side::Left => 1.0,
-        Side::Right => -1.0,
-    };
+    let mirror = f.side.sign();
     let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
         let s = slice(mesh, &palm.finger_plane(f.height_mm + dz)).bridged(2.0 * o);
         place_als(&s, hand, mirror)

@@ -177,17 +177,18 @@ pub fn place_palm_with(
     let mut centre = p1 - up * h1;
     let mut backed_off_mm = 0.0;
     if back_off {
-        let depth = penetration_depth(&vslice, centre, up, back, [h_lo - m, h_hi + m]);
+        let depth = penetration_depth(&vslice, centre, up, back, hand.palm_z_range_mm());
         if depth > PENETRATION_TOL_MM {
             centre += back * depth;
             backed_off_mm = depth;
         }
     }
+    let [p_lo, p_hi] = hand.palm_z_range_mm();
     let outline = ConvexPolygon::new(vec![
-        centre + up * (h_lo - m),
-        centre + up * (h_hi + m),
-        centre + up * (h_hi + m) + back * hand.palm.offset_mm,
-        centre + up * (h_lo - m) + back * hand.palm.offset_mm,
+        centre + up * p_lo,
+        centre + up * p_hi,
+        centre + up * p_hi + back * hand.palm.offset_mm,
+        centre + up * p_lo + back * hand.palm.offset_mm,
     ]);
     for c in &vslice.contours {
         for i in 0..c.segment_count() {

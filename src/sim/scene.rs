@@ -1,10 +1,10 @@
 //! Building the rapier scene: palm, phalanges, joints with motors, and the object.
 
 use super::convert;
-use crate::hand::{Hand, Side};
+use crate::hand::{palm_rotation, BodyPose, Hand, HandBox};
 use crate::mesh::Mesh;
 use crate::scenario::SimParams;
-use nalgebra::{Point3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, Vector3};
 use rapier3d::parry::transformation::vhacd::VHACDParameters;
 use rapier3d::prelude::*;
 
@@ -184,11 +184,8 @@ impl Scene {
     }
 }
 
-/// Bend from straight of a joint at interior angle `theta_deg` `[rad]`: the joint value used
-/// by the rapier scene and by the MJCF and URDF exports alike.
-pub fn bend(theta_deg: f64) -> f64 {
-    (180.0 - theta_deg).to_radians()
-}
+/// The joint value of an interior angle (see [`crate::hand::bend`]).
+pub use crate::hand::bend;
 
 /// What one physics check is about: the hand, where it is and how it is planned to close, the
 /// object and its physical properties, and the protocol's parameters.
@@ -218,101 +215,10 @@ impl Case<'_> {
     }
 }
 
-/// A box of the hand, in its body's frame `[mm]`: half extents and centre.
-#[derive(Debug, Clone, Copy)]
-struct HandBox {
-    half: Vector3<f64>,
-    centre: Vector3<f64>,
-}
-
-impl HandBox {
-    fn shape(&self) -> SharedShape {
-        let h = convert::vector_m(&self.half);
-        SharedShape::cuboid(h.x, h.y, h.z)
-    }
-}
-
-/// The palm box in the palm's frame: `offset_mm` deep behind the contact surface (palm x points
-/// away from the object), as wide as the palm, and as tall as the fingers' span plus the margin.
-fn palm_box(hand: &Hand) -> HandBox {
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
-    let (z_lo, z_hi) = (h_lo - m, h_hi + m);
-    HandBox {
-        half: Vector3::new(
-            hand.palm.offset_mm / 2.0,
-            hand.palm.half_width_mm,
-            (z_hi - z_lo) / 2.0,
-        ),
-        centre: Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (z_hi + z_lo) / 2.0),
-    }
-}
-
-/// The boxes of phalanx 1 and of phalanx 2 (its contact part, then its thinned tip if it has
-/// one), each in its phalanx's frame, for a finger on side `s` (±1).
-fn phalanx_boxes(hand: &Hand, s: f64) -> (HandBox, Vec<HandBox>) {
-    let o = hand.fingers.offset_mm;
-    let (l1, l2) = (hand.phalanx_1.length_mm, hand.phalanx_2.length_mm);
-    let l2_contact = l2 - hand.phalanx_2.unusable_distal_mm;
-    let p1 = HandBox {
-        half: Vector3::new(o, l1 / 2.0, o),
-        centre: Vector3::new(0.0, s * l1 / 2.0, 0.0),
-    };
-    let mut p2 = vec![HandBox {
-        half: Vector3::new(o, l2_contact / 2.0, o),
-        centre: Vector3::new(0.0, s * l2_contact / 2.0, 0.0),
-    }];
-    if l2 > l2_contact + 1e-9 {
-        // The thinned tip (thesis Fig. 3.8): its contact side recedes to the tip thickness.
-        let t = hand.fingers.tip_thickness_mm;
-        p2.push(HandBox {
-            half: Vector3::new(t / 2.0, (l2 - l2_contact) / 2.0, o),
-            centre: Vector3::new(o - t / 2.0, s * (l2 + l2_contact) / 2.0, 0.0),
-        });
-    }
-    (p1, p2)
-}
-
-/// The side of a finger as a sign: +1 on the left, −1 on the right.
-fn side_sign(side: Side) -> f64 {
-    match side {
-        Side::Left => 1.0,
-        Side::Right => -1.0,
-    }
-}
-
-/// The palm's rotation from its axes (aligned frame).
-fn palm_rotation(pose: &SimHand) -> UnitQuaternion<f64> {
-    let [x, y, z] = pose.axes;
-    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
-        nalgebra::Matrix3::from_columns(&[x, y, z]),
-    ))
-}
-
-/// Frames of a finger's phalanx 1 and 2 (joint position `[mm]` and rotation, aligned frame)
-/// with the palm at `origin`, turned `r_palm`, and the joints bent `b1`, `b2` `[rad]`. A
-/// phalanx's frame is its parent's turned by side × bend about the palm's z: the revolute
-/// joint's angle about (0, 0, side) is then the bend itself.
-fn finger_frames(
-    hand: &Hand,
-    finger: &crate::hand::Finger,
-    origin: &Point3<f64>,
-    r_palm: &UnitQuaternion<f64>,
-    b1: f64,
-    b2: f64,
-) -> [(Point3<f64>, UnitQuaternion<f64>); 2] {
-    let s = side_sign(finger.side);
-    let turn = |b: f64| UnitQuaternion::from_axis_angle(&Vector3::z_axis(), s * b);
-    let anchor1 = Vector3::new(
-        hand.joints.setback_mm,
-        s * hand.joints.lateral_mm,
-        finger.height_mm,
-    );
-    let r1 = r_palm * turn(b1);
-    let j1 = origin + r_palm * anchor1;
-    let r2 = r1 * turn(b2);
-    let j2 = j1 + r1 * Vector3::new(0.0, s * hand.phalanx_1.length_mm, 0.0);
-    [(j1, r1), (j2, r2)]
+/// The collision shape of a hand box `[m]`.
+fn box_shape(b: &HandBox) -> SharedShape {
+    let h = convert::vector_m(&b.half_extents);
+    SharedShape::cuboid(h.x, h.y, h.z)
 }
 
 /// Where the check starts (docs/SIM.md, "Starting clear"): the palm at the planned pose, backed
@@ -346,19 +252,20 @@ pub struct Start {
 const START_TOLERANCE_MM: f64 = 0.1;
 
 /// Depth of the deepest overlap of `boxes` (posed by `frame`) with the object `[mm]`, 0 if none.
-fn overlap_mm(
-    object: &SharedShape,
-    frame: &(Point3<f64>, UnitQuaternion<f64>),
-    boxes: &[HandBox],
-) -> f64 {
+fn overlap_mm(object: &SharedShape, frame: &BodyPose, boxes: &[HandBox]) -> f64 {
     let at_origin = Pose::IDENTITY;
     boxes
         .iter()
         .map(|b| {
             let c = frame.0 + frame.1 * b.centre;
             let pose = convert::pose(&c, &frame.1);
-            match rapier3d::parry::query::contact(&pose, &*b.shape().0, &at_origin, &*object.0, 0.0)
-            {
+            match rapier3d::parry::query::contact(
+                &pose,
+                &*box_shape(b).0,
+                &at_origin,
+                &*object.0,
+                0.0,
+            ) {
                 Ok(Some(contact)) => (-f64::from(contact.dist) / convert::M_PER_MM).max(0.0),
                 _ => 0.0,
             }
@@ -375,8 +282,8 @@ pub fn start(case: &Case) -> Start {
         params,
         ..
     } = *case;
-    let r_palm = palm_rotation(pose);
-    let palm = [palm_box(hand)];
+    let r_palm = palm_rotation(&pose.axes);
+    let palm = [hand.palm_box()];
     let limits1 = [
         bend(hand.joints.theta1_range_deg[1]),
         bend(hand.joints.theta1_range_deg[0]),
@@ -413,11 +320,11 @@ pub fn start(case: &Case) -> Start {
     let mut open_bend = Vec::new();
     let mut open_margin = Vec::new();
     for (f, [t1, t2]) in hand.finger_list.iter().zip(&pose.theta_deg) {
-        let (p1, p2) = phalanx_boxes(hand, side_sign(f.side));
+        let (p1, p2) = hand.phalanx_boxes(f.side);
         let at = |m: f64| {
             let b1 = (bend(*t1) - m.to_radians()).max(limits1[0]);
             let b2 = (bend(*t2) - m.to_radians()).max(limits2[0]);
-            let [f1, f2] = finger_frames(hand, f, &origin, &r_palm, b1, b2);
+            let [f1, f2] = hand.finger_poses(f, &(origin, r_palm), [b1, b2]);
             let d = overlap_mm(&object.shape, &f1, &[p1]).max(overlap_mm(&object.shape, &f2, &p2));
             ([b1, b2], d)
         };
@@ -495,7 +402,7 @@ pub fn build(case: &Case) -> Scene {
     ip.contact_softness = SpringCoefficients::new(hz, 10.0);
     ip.static_contact_softness = SpringCoefficients::new(hz, 10.0);
 
-    let r_palm = palm_rotation(pose);
+    let r_palm = palm_rotation(&pose.axes);
     let start = start(case);
     // The palm never moves during the check: a fixed body. (A kinematic body here made rapier
     // refresh the palm's contacts irregularly: the object, pressed against the palm, sank into it
@@ -504,14 +411,13 @@ pub fn build(case: &Case) -> Scene {
     let palm = world
         .bodies
         .insert(RigidBodyBuilder::fixed().pose(convert::pose(&start.origin_mm, &r_palm)));
-    let mm = |v: f64| (v * convert::M_PER_MM) as f32;
     let collider = |b: &HandBox| {
-        ColliderBuilder::new(b.shape())
+        ColliderBuilder::new(box_shape(b))
             .translation(convert::vector_m(&b.centre))
             .friction(friction as f32)
     };
     let mut hand_colliders = vec![world.colliders.insert_with_parent(
-        collider(&palm_box(hand)),
+        collider(&hand.palm_box()),
         palm,
         &mut world.bodies,
     )];
@@ -539,11 +445,11 @@ pub fn build(case: &Case) -> Scene {
         .zip(&pose.theta_deg)
         .zip(&start.open_bend_rad)
     {
-        let s = side_sign(f.side);
-        let (p1, p2) = phalanx_boxes(hand, s);
+        let s = f.side.sign();
+        let (p1, p2) = hand.phalanx_boxes(f.side);
         // Start open (see [`Start`]), so contact is made by closing along the planned path.
         let [(j1, r1), (j2, r2)] =
-            finger_frames(hand, f, &start.origin_mm, &r_palm, *open1, *open2);
+            hand.finger_poses(f, &(start.origin_mm, r_palm), [*open1, *open2]);
         let b1 = world.bodies.insert(
             RigidBodyBuilder::dynamic()
                 .pose(convert::pose(&j1, &r1))
@@ -555,13 +461,8 @@ pub fn build(case: &Case) -> Scene {
             &mut world.bodies,
         ));
         let axis = Vector::new(0.0, 0.0, s as f32);
-        let anchor1_mm = Vector3::new(
-            hand.joints.setback_mm,
-            s * hand.joints.lateral_mm,
-            f.height_mm,
-        );
         let joint1 = RevoluteJointBuilder::new(axis)
-            .local_anchor1(convert::vector_m(&anchor1_mm))
+            .local_anchor1(convert::vector_m(&hand.joint1_anchor_mm(f)))
             .local_anchor2(Vector::ZERO)
             .limits(limits1)
             .motor_model(MotorModel::ForceBased)
@@ -590,7 +491,7 @@ pub fn build(case: &Case) -> Scene {
         }
         // Joint 2 is held at its open angle until released (see `Scene::release_joint2`).
         let joint2 = RevoluteJointBuilder::new(axis)
-            .local_anchor1(Vector::new(0.0, s as f32 * mm(l1), 0.0))
+            .local_anchor1(convert::vector_m(&hand.joint2_anchor_mm(f.side)))
             .local_anchor2(Vector::ZERO)
             .limits(limits2)
             .motor_model(MotorModel::ForceBased)
@@ -645,8 +546,8 @@ pub fn build(case: &Case) -> Scene {
     // Reach: the palm box's farthest corner, or a finger's joint 1 plus phalanx 1 plus the
     // farthest point of phalanx 2 (or its tip) from joint 2, whichever is larger; the finger
     // boxes are 2 × offset thick and wide.
-    let pb = palm_box(hand);
-    let mut reach_mm = (pb.centre.abs() + pb.half).norm();
+    let pb = hand.palm_box();
+    let mut reach_mm = (pb.centre.abs() + pb.half_extents).norm();
     let (o, l2) = (hand.fingers.offset_mm, hand.phalanx_2.length_mm);
     for f in &hand.finger_list {
         let anchor = Vector3::new(hand.joints.setback_mm, hand.joints.lateral_mm, f.height_mm);
@@ -751,8 +652,8 @@ mod tests {
         assert!(
             overlap_mm(
                 &object.shape,
-                &(s.origin_mm, palm_rotation(&pose)),
-                &[palm_box(&hand)]
+                &(s.origin_mm, palm_rotation(&pose.axes)),
+                &[hand.palm_box()]
             ) <= START_TOLERANCE_MM
         );
     }
