@@ -215,18 +215,20 @@ pub fn grade_elevations(domain: &Domain, p: &CurvatureParams) -> Vec<Grade> {
 /// was graded with `p.ungraspable_grade` instead (always false when that is `None`).
 pub fn grade_elevations_marked(domain: &Domain, p: &CurvatureParams) -> (Vec<Grade>, Vec<bool>) {
     domain
-        .elevations
+        .crossings
         .iter()
-        .map(|&z| {
+        .map(|row| {
             let mut sum = 0.0;
             let mut floored = false;
-            for (k, s) in domain.slices.iter().enumerate() {
-                let Some((left, right)) = domain.touches(k, z) else {
+            for ((s, touches), &[lo, hi]) in
+                domain.slices.iter().zip(row).zip(&domain.slice_z_range_mm)
+            {
+                let Some((left, right)) = touches else {
                     return (None, false);
                 };
-                let zr = z_range(&s.contours);
-                let l = grade_side(&s.contours[left.contour], &left, -1.0, zr, p).grade;
-                let r = grade_side(&s.contours[right.contour], &right, 1.0, zr, p).grade;
+                let zr = (lo, hi);
+                let l = grade_side(&s.contours[left.contour], left, -1.0, zr, p).grade;
+                let r = grade_side(&s.contours[right.contour], right, 1.0, zr, p).grade;
                 let g = p.ungraspable_grade;
                 floored |= l.is_err() || r.is_err();
                 match (l.ok().or(g), r.ok().or(g)) {
@@ -238,15 +240,6 @@ pub fn grade_elevations_marked(domain: &Domain, p: &CurvatureParams) -> (Vec<Gra
             (grade, floored && grade.is_some())
         })
         .unzip()
-}
-
-fn z_range(contours: &[Contour]) -> (f64, f64) {
-    contours
-        .iter()
-        .flat_map(|c| c.points.iter())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
-            (a.min(q.y), b.max(q.y))
-        })
 }
 
 /// Grades one touch point. `side` is +1 for the right side (outward is +s) and −1 for the left;
@@ -522,7 +515,8 @@ mod tests {
         let c = contour(profile);
         let (l, r) = crate::plan::domain::outermost_crossings(std::slice::from_ref(&c), z)
             .expect("the line cuts the contour");
-        let zr = z_range(std::slice::from_ref(&c));
+        let [lo, hi] = crate::plan::domain::z_range(std::slice::from_ref(&c));
+        let zr = (lo, hi);
         let right = grade_side(&c, &r, 1.0, zr, &params());
         let left = grade_side(&c, &l, -1.0, zr, &params());
         assert_eq!(

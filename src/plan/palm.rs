@@ -86,8 +86,27 @@ pub fn place_palm_with(
     pitch_range_rad: f64,
     back_off: bool,
 ) -> Result<PalmPlacement, PalmRejection> {
+    let vslice = vertical_slice(mesh, hand, approach_rad);
+    place_palm_on(&vslice, hand, z1, approach_rad, pitch_range_rad, back_off)
+}
+
+/// The vertical slice the palm is placed in at approach angle `approach_rad`, bridged to the
+/// finger width: it depends on the angle only, so a search cuts it once per angle and hands it
+/// to [`place_palm_on`] for every elevation.
+pub fn vertical_slice(mesh: &Mesh, hand: &Hand, approach_rad: f64) -> Slice {
+    slice(mesh, &Plane::vertical(approach_rad)).bridged(hand.finger_width_mm())
+}
+
+/// [`place_palm_with`] in `vslice`, the [`vertical_slice`] at `approach_rad`.
+pub fn place_palm_on(
+    vslice: &Slice,
+    hand: &Hand,
+    z1: f64,
+    approach_rad: f64,
+    pitch_range_rad: f64,
+    back_off: bool,
+) -> Result<PalmPlacement, PalmRejection> {
     let plane = Plane::vertical(approach_rad);
-    let vslice = slice(mesh, &plane).bridged(hand.finger_width_mm());
     let h1 = hand.finger_list[0].height_mm;
     let (h_lo, h_hi) = hand.finger_height_span();
     let m = hand.palm.margin_mm;
@@ -177,7 +196,7 @@ pub fn place_palm_with(
     let mut centre = p1 - up * h1;
     let mut backed_off_mm = 0.0;
     if back_off {
-        let depth = penetration_depth(&vslice, centre, up, back, hand.palm_z_range_mm());
+        let depth = penetration_depth(vslice, centre, up, back, hand.palm_z_range_mm());
         if depth > PENETRATION_TOL_MM {
             centre += back * depth;
             backed_off_mm = depth;
@@ -212,7 +231,7 @@ pub fn place_palm_with(
         origin: plane.to_3d(&centre),
         axes: [x_p, y_p, z_p],
         contacts,
-        slice: vslice,
+        slice: vslice.clone(),
         backed_off_mm,
     })
 }
