@@ -783,3 +783,123 @@ mod suggestion_tests {
         assert_eq!(did_you_mean("", keys), None);
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scenario with the given extra TOML after a minimal `[object]` table.
+    fn parse(object_extra: &str, rest: &str) -> Result<Scenario, ScenarioError> {
+        let text = format!("[object]\nmesh = \"cup.stl\"\n{object_extra}\n{rest}");
+        Scenario::parse(&text, Path::new("/nowhere/cup_test.toml"))
+    }
+
+    #[test]
+    fn defaults_fill_what_a_minimal_scenario_leaves_out() {
+        let s = parse("", "").unwrap();
+        assert_eq!(s.name, "cup_test");
+        assert_eq!(s.object.mesh, PathBuf::from("/nowhere/cup.stl"));
+        assert_eq!(s.object.mass, MassSpec::Density(DEFAULT_DENSITY_KG_M3));
+        assert_eq!(s.object.friction, 0.3);
+        assert_eq!(s.hand.name, "thesis");
+        assert_eq!(s.hand_file, PathBuf::from("<bundled hand thesis>"));
+        assert_eq!(s.planner, PlannerParams::default());
+        assert_eq!(s.sim, SimParams::default());
+        assert!(s.expect.is_none());
+    }
+
+    #[test]
+    fn values_given_are_kept() {
+        let table = [
+            ("mass_kg = 0.2", MassSpec::Mass(0.2)),
+            ("density_kg_m3 = 1000.0", MassSpec::Density(1000.0)),
+        ];
+        for (line, mass) in table {
+            assert_eq!(parse(line, "").unwrap().object.mass, mass, "{line}");
+        }
+        let text =
+            "name = \"x\"\n[object]\nmesh = \"m.stl\"\nfriction = 0.8\n[hand]\nfile = \"bh8\"\n";
+        let s = Scenario::parse(text, Path::new("s.toml")).unwrap();
+        assert_eq!(
+            (s.name.as_str(), s.object.friction, s.hand.name.as_str()),
+            ("x", 0.8, "bh8")
+        );
+    }
+
+    #[test]
+    fn out_of_range_values_name_their_key() {
+        let table = [
+            ("mass_kg = 1.0\ndensity_kg_m3 = 1.0", "", "object.mass_kg"),
+            ("mass_kg = 0.0", "", "object.mass_kg"),
+            ("density_kg_m3 = -5.0", "", "object.density_kg_m3"),
+            ("friction = 0.0", "", "object.friction"),
+            ("friction = 2.5", "", "object.friction"),
+            ("", "[sim]\nduration_s = 0.0", "sim.duration_s"),
+            ("", "[sim]\ntimestep_s = 0.1", "sim.timestep_s"),
+            ("", "[sim]\nmax_checked = 0", "sim.max_checked"),
+            (
+                "",
+                "[sim]\nsolver_iterations = 101",
+                "sim.solver_iterations",
+            ),
+            ("", "[sim]\nsqueeze_deg = -1.0", "sim.squeeze_deg"),
+            (
+                "",
+                "[sim]\nmotor_damping_nms_per_rad = -1.0",
+                "sim.motor_damping_nms_per_rad",
+            ),
+            (
+                "",
+                "[sim]\noverride_angles = [[90.0, 90.0]]",
+                "sim.override_angles",
+            ),
+            (
+                "",
+                "[sim]\noverride_angles = [[90.0, 90.0], [90.0, 0.0], [90.0, 90.0]]",
+                "sim.override_angles",
+            ),
+            (
+                "",
+                "[expect]\noutcome = \"hold\"\ntheta_deg = [[90.0, 90.0]]",
+                "expect.theta_deg",
+            ),
+            (
+                "",
+                "[hand]\noverrides = { \"palm.offset_mm\" = -1.0 }",
+                "palm.offset_mm",
+            ),
+            (
+                "",
+                "[hand]\noverrides = { \"palm.ofset_mm\" = 1.0 }",
+                "hand.overrides.\"palm.ofset_mm\"",
+            ),
+        ];
+        for (object_extra, rest, expected) in table {
+            let err = parse(object_extra, rest).unwrap_err();
+            let key = match &err {
+                ScenarioError::Invalid { key, .. } => key.clone(),
+                ScenarioError::Hand(HandError::Invalid { key, .. }) => key.clone(),
+                other => panic!("{object_extra:?} {rest:?}: {other}"),
+            };
+            assert_eq!(key, expected, "{object_extra:?} {rest:?}: {err}");
+        }
+    }
+
+    #[test]
+    fn unknown_keys_and_wrong_types_are_parse_errors_with_the_key() {
+        let table = [
+            ("colour = \"red\"", "", "colour"),
+            ("friction = \"high\"", "", "friction"),
+            ("", "[planner]\nheight_stp_mm = 2.5", "height_stp_mm"),
+            ("", "[sim]\nduration_s = \"long\"", "duration_s"),
+        ];
+        for (object_extra, rest, key) in table {
+            match parse(object_extra, rest) {
+                Err(ScenarioError::Parse { message, .. }) => {
+                    assert!(message.contains(key), "{key}: {message}")
+                }
+                other => panic!("{key}: {other:?}"),
+            }
+        }
+    }
+}

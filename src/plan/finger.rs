@@ -346,3 +346,53 @@ fn circle_crossings(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>, r: f64) -> V
         .map(|t| a + d * t)
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::palm::place_palm;
+
+    fn thesis_hand() -> Hand {
+        let (_, text) = crate::hand::bundled("thesis").unwrap();
+        Hand::parse(text, std::path::Path::new("thesis.toml"), &[]).unwrap()
+    }
+
+    #[test]
+    fn fingers_wrap_the_d40_cylinder_at_the_thesis_angles() {
+        // Thesis 5.2: θ1 72.2°, θ2 90° on the D40 cylinder, within the 3° a scenario's `[expect]`
+        // allows by default. This mesh (144 facets) gives 72.11° and 91.81°, phalanx 2 touching
+        // with its tip; every finger and each of its three ALS alike (the wall is straight).
+        let hand = thesis_hand();
+        let mesh = crate::objects::cylinder(40.0, 124.0);
+        let palm = place_palm(&mesh, &hand, 80.0, 0.0, 0.2).unwrap();
+        for k in 0..hand.finger_list.len() {
+            let f = place_finger(&mesh, &hand, &palm, k, [5.0, 5.0], RuleSet::Thesis).unwrap();
+            assert_eq!(f.name, hand.finger_list[k].name);
+            assert!(f.relaxations.is_empty());
+            for als in [f.top, f.centre, f.bottom] {
+                let (t1, t2) = (als.theta1_deg, als.theta2_deg);
+                assert!(
+                    (t1 - 72.2).abs() < 3.0 && (t2 - 90.0).abs() < 3.0,
+                    "finger {k}: ({t1:.3}, {t2:.3}), thesis (72.2, 90)"
+                );
+                assert!(
+                    (t1 - 72.11).abs() < 0.01 && (t2 - 91.81).abs() < 0.01,
+                    "finger {k}: ({t1:.3}, {t2:.3}), expected (72.11, 91.81)"
+                );
+                assert!(als.is_tip_contact, "finger {k}");
+                assert_eq!(als.gap_mm, 0.0, "finger {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_finger_rejects_what_it_cannot_wrap() {
+        // A D10 rod is thinner than the smallest graspable diameter (17.4 mm): phalanx 1 would
+        // have to close beyond joint 1's 45° to reach it.
+        let hand = thesis_hand();
+        let rod = crate::objects::cylinder(10.0, 124.0);
+        let palm = place_palm(&rod, &hand, 80.0, 0.0, 0.2).unwrap();
+        let r = place_finger(&rod, &hand, &palm, 0, [5.0, 5.0], RuleSet::Thesis);
+        assert_eq!(r, Err(FingerRejection::Theta1OutOfRange));
+    }
+}
