@@ -15,7 +15,7 @@
 
 use crate::hand::{bend, palm_rotation, Hand, HandBox};
 use crate::mesh::{AlignedObject, Mesh};
-use crate::scenario::{GravityMode, SimParams};
+use crate::sim::params::{GravityMode, SimParams};
 use crate::sim::scene::Start;
 use crate::sim::Case;
 use nalgebra::{Point3, UnitQuaternion, Vector3};

@@ -174,7 +174,7 @@ impl Hand {
     pub fn load(path: &Path, overrides: &[(String, f64)]) -> Result<Hand, HandError> {
         let text = std::fs::read_to_string(path).map_err(|e| HandError::Io {
             path: path.to_path_buf(),
-            message: crate::scenario::io_message(&e),
+            message: crate::messages::io_message(&e),
         })?;
         Hand::parse(&text, path, overrides)
     }
@@ -189,13 +189,13 @@ impl Hand {
             message,
         };
         let mut doc: toml::Table = toml::from_str(text)
-            .map_err(|e: toml::de::Error| parse_err(crate::scenario::toml_message(&e, text)))?;
+            .map_err(|e: toml::de::Error| parse_err(crate::messages::toml_message(&e, text)))?;
         for (key, value) in overrides {
             set_number(&mut doc, key, *value).map_err(|problem| {
                 let mut keys = Vec::new();
                 number_keys(&doc, "", &mut keys);
                 let problem =
-                    match crate::scenario::did_you_mean(key, keys.iter().map(|k| k.as_str())) {
+                    match crate::messages::did_you_mean(key, keys.iter().map(|k| k.as_str())) {
                         Some(k) => format!("{problem}; did you mean `{k}`?"),
                         None => problem,
                     };
@@ -210,12 +210,12 @@ impl Hand {
         // edited table (the line is then that of the hand file as written, if any).
         let hand: Hand = if overrides.is_empty() {
             toml::from_str(text)
-                .map_err(|e: toml::de::Error| parse_err(crate::scenario::toml_message(&e, text)))?
+                .map_err(|e: toml::de::Error| parse_err(crate::messages::toml_message(&e, text)))?
         } else {
             toml::Value::Table(doc)
                 .try_into()
                 .map_err(|e: toml::de::Error| {
-                    parse_err(crate::scenario::with_suggestion(
+                    parse_err(crate::messages::with_suggestion(
                         &e.message().replace('\n', " "),
                     ))
                 })?

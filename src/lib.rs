@@ -22,6 +22,7 @@ pub mod batch;
 pub mod export;
 pub mod hand;
 pub mod mesh;
+mod messages;
 pub mod objects;
 pub mod plan;
 pub mod report;

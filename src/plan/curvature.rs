@@ -61,9 +61,9 @@
 //! - An elevation is ungraspable if it is ungraspable in any slice (the palm may approach from
 //!   any angle, and the search must not waste time on a level with a sharp edge somewhere).
 
+use super::PlannerParams;
 use super::{Domain, Grade, Touch};
 use crate::hand::Hand;
-use crate::scenario::PlannerParams;
 use crate::slice::Contour;
 use nalgebra::Vector2;
 use std::f64::consts::PI;

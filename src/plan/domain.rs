@@ -10,9 +10,9 @@
 //! The slices are computed once here and reused by every later stage (and by a tuner sweeping
 //! parameters that do not change them).
 
+use super::PlannerParams;
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::scenario::PlannerParams;
 use crate::slice::{slice, Contour, Plane, Slice};
 use nalgebra::Point2;
 

@@ -16,10 +16,10 @@
 
 use super::diameter::DiameterGrades;
 use super::kinematics::GraspableRange;
+use super::PlannerParams;
 use super::RuleSet;
 use super::{Domain, Grade};
 use crate::hand::Hand;
-use crate::scenario::PlannerParams;
 
 /// Per-index grade vectors (index i at position i − 1), `None` where ungraspable.
 #[derive(Debug, Clone, PartialEq)]

@@ -8,10 +8,10 @@ use super::palm::{
     penetration_depth, place_palm_on, vertical_slice, PalmPlacement, PalmRejection,
     PENETRATION_TOL_MM,
 };
+use super::PlannerParams;
 use super::{GradedDomain, Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::scenario::PlannerParams;
 use crate::slice::Slice;
 use std::collections::BTreeMap;
 

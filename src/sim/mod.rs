@@ -26,6 +26,7 @@
 //! beyond them while still touching the hand, `drop` when it has left the hand.
 
 pub mod convert;
+pub mod params;
 pub mod protocol;
 pub mod scene;
 

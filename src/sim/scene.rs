@@ -1,9 +1,9 @@
 //! Building the rapier scene: palm, phalanges, joints with motors, and the object.
 
 use super::convert;
+use super::params::SimParams;
 use crate::hand::{palm_rotation, BodyPose, Hand, HandBox};
 use crate::mesh::Mesh;
-use crate::scenario::SimParams;
 use nalgebra::{Point3, Vector3};
 use rapier3d::parry::transformation::vhacd::VHACDParameters;
 use rapier3d::prelude::*;
