@@ -25,6 +25,13 @@ pub fn bundled(name: &str) -> Option<(&'static str, &'static str)> {
     BUNDLED.iter().copied().find(|(n, _)| *n == name)
 }
 
+/// The bundled thesis hand, parsed: the hand most unit tests plan with.
+#[cfg(test)]
+pub(crate) fn thesis_for_tests() -> Hand {
+    let (_, text) = bundled("thesis").expect("the thesis hand is bundled");
+    Hand::parse(text, Path::new("thesis.toml"), &[]).expect("the thesis hand parses")
+}
+
 /// Problems with a hand file.
 #[derive(Debug, thiserror::Error)]
 pub enum HandError {

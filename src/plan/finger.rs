@@ -352,10 +352,7 @@ mod tests {
     use super::*;
     use crate::plan::palm::place_palm;
 
-    fn thesis_hand() -> Hand {
-        let (_, text) = crate::hand::bundled("thesis").unwrap();
-        Hand::parse(text, std::path::Path::new("thesis.toml"), &[]).unwrap()
-    }
+    use crate::hand::thesis_for_tests as thesis_hand;
 
     #[test]
     fn fingers_wrap_the_d40_cylinder_at_the_thesis_angles() {

@@ -72,22 +72,8 @@ pub fn place_palm(
     approach_rad: f64,
     pitch_range_rad: f64,
 ) -> Result<PalmPlacement, PalmRejection> {
-    place_palm_with(mesh, hand, z1, approach_rad, pitch_range_rad, false)
-}
-
-/// [`place_palm`]; with `back_off`, a palm outline that takes in part of the object in the
-/// vertical plane is moved back along its normal until it only touches (the extended rules'
-/// [`super::Relaxation::PalmBackedOff`]) instead of being rejected.
-pub fn place_palm_with(
-    mesh: &Mesh,
-    hand: &Hand,
-    z1: f64,
-    approach_rad: f64,
-    pitch_range_rad: f64,
-    back_off: bool,
-) -> Result<PalmPlacement, PalmRejection> {
     let vslice = vertical_slice(mesh, hand, approach_rad);
-    place_palm_on(&vslice, hand, z1, approach_rad, pitch_range_rad, back_off)
+    place_palm_on(&vslice, hand, z1, approach_rad, pitch_range_rad, false)
 }
 
 /// The vertical slice the palm is placed in at approach angle `approach_rad`, bridged to the
@@ -97,7 +83,10 @@ pub fn vertical_slice(mesh: &Mesh, hand: &Hand, approach_rad: f64) -> Slice {
     slice(mesh, &Plane::vertical(approach_rad)).bridged(hand.finger_width_mm())
 }
 
-/// [`place_palm_with`] in `vslice`, the [`vertical_slice`] at `approach_rad`.
+/// [`place_palm`] in `vslice`, the [`vertical_slice`] at `approach_rad`; with `back_off`, a
+/// palm outline that takes in part of the object in the vertical plane is moved back along its
+/// normal until it only touches (the extended rules' [`super::Relaxation::PalmBackedOff`])
+/// instead of being rejected.
 pub fn place_palm_on(
     vslice: &Slice,
     hand: &Hand,
@@ -293,10 +282,7 @@ mod tests {
     use crate::slice::Contour;
     use std::f64::consts::FRAC_PI_2;
 
-    fn thesis_hand() -> Hand {
-        let (_, text) = crate::hand::bundled("thesis").unwrap();
-        Hand::parse(text, std::path::Path::new("thesis.toml"), &[]).unwrap()
-    }
+    use crate::hand::thesis_for_tests as thesis_hand;
 
     #[test]
     fn the_palm_lies_flat_on_a_cylinder_from_any_side() {

@@ -254,12 +254,8 @@ fn explain(
 mod tests {
     use super::*;
     use crate::plan::kinematics::graspable_range;
-    use std::path::Path;
 
-    fn thesis_hand() -> Hand {
-        let (_, text) = crate::hand::bundled("thesis").unwrap();
-        Hand::parse(text, Path::new("thesis.toml"), &[]).unwrap()
-    }
+    use crate::hand::thesis_for_tests as thesis_hand;
 
     /// Stage 3 on the D40 × 124 cylinder's domain (45 indexed elevations, 2.5 mm apart; the
     /// fingers 10 indices apart) with the given curvature and diameter grades per index.
