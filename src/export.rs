@@ -43,7 +43,8 @@ pub struct ExportInput<'a> {
     pub case: Case<'a>,
 }
 
-const MM: f64 = 1e-3;
+/// Metres per millimetre: the one conversion the rapier scene uses too.
+const MM: f64 = crate::sim::convert::M_PER_MM;
 
 /// MuJoCo's timestep in the exported scene `[s]` (see [`write_mjcf`]).
 pub const MUJOCO_TIMESTEP_S: f64 = 2e-4;

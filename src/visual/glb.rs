@@ -4,6 +4,7 @@
 
 use crate::hand::{bend, palm_rotation, Hand};
 use crate::mesh::Mesh;
+use crate::sim::convert::M_PER_MM;
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
 /// One body: a triangle mesh in its own frame and its pose.
@@ -47,9 +48,9 @@ pub fn object_body(mesh: &Mesh, translation: Vector3<f64>, rotation: UnitQuatern
             .iter()
             .map(|v| {
                 [
-                    (v.x * 1e-3) as f32,
-                    (v.y * 1e-3) as f32,
-                    (v.z * 1e-3) as f32,
+                    (v.x * M_PER_MM) as f32,
+                    (v.y * M_PER_MM) as f32,
+                    (v.z * M_PER_MM) as f32,
                 ]
             })
             .collect(),
@@ -63,7 +64,7 @@ pub fn object_body(mesh: &Mesh, translation: Vector3<f64>, rotation: UnitQuatern
 /// The hand's bodies in their local frames (as in the rapier scene) with the given poses, in
 /// the order palm, then phalanx 1 and 2 of each finger.
 pub fn hand_bodies(hand: &Hand, poses: &[(Vector3<f64>, UnitQuaternion<f64>)]) -> Vec<Body> {
-    let mm = 1e-3;
+    let mm = M_PER_MM;
     let o = hand.fingers.offset_mm * mm;
     let [z_lo, z_hi] = hand.palm_z_range_mm();
     let mut bodies = Vec::new();
@@ -114,7 +115,7 @@ pub fn planned_poses(
     let bends: Vec<[f64; 2]> = theta_deg.iter().map(|t| t.map(bend)).collect();
     hand.body_poses(&(*origin_mm, palm_rotation(axes)), &bends)
         .into_iter()
-        .map(|(p, r)| (p.coords * 1e-3, r))
+        .map(|(p, r)| (p.coords * M_PER_MM, r))
         .collect()
 }
 
