@@ -13,12 +13,12 @@
 //! planned joint angles); gravity as in the scenario. `protocol.json` beside it carries what the
 //! replay script needs to run the same protocol (scripts/mujoco_replay.py).
 
-use crate::hand::{Hand, Side};
+use crate::hand::{bend, palm_rotation, Hand, HandBox};
 use crate::mesh::{AlignedObject, Mesh};
-use crate::scenario::{GravityMode, SimParams};
-use crate::sim::scene::bend;
+use crate::sim::params::{GravityMode, SimParams};
+use crate::sim::scene::Start;
 use crate::sim::Case;
-use nalgebra::{Point3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, UnitQuaternion, Vector3};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -43,7 +43,8 @@ pub struct ExportInput<'a> {
     pub case: Case<'a>,
 }
 
-const MM: f64 = 1e-3;
+/// Metres per millimetre: the one conversion the rapier scene uses too.
+const MM: f64 = crate::sim::convert::M_PER_MM;
 
 /// MuJoCo's timestep in the exported scene `[s]` (see [`write_mjcf`]).
 pub const MUJOCO_TIMESTEP_S: f64 = 2e-4;
@@ -66,11 +67,14 @@ fn quat(q: &UnitQuaternion<f64>) -> String {
     format!("{:.12} {:.12} {:.12} {:.12}", q.w, q.i, q.j, q.k)
 }
 
-fn side_sign(side: Side) -> f64 {
-    match side {
-        Side::Left => 1.0,
-        Side::Right => -1.0,
-    }
+/// An MJCF box geom `name` of `b` (millimetres, written in metres), with `extra` attributes.
+fn box_geom(s: &mut String, indent: &str, name: &str, b: &HandBox, extra: &str) {
+    let _ = writeln!(
+        s,
+        "{indent}<geom name=\"{name}\" type=\"box\" size=\"{}\" pos=\"{}\"{extra}/>",
+        v3(&(b.half_extents * MM)),
+        v3(&(b.centre * MM))
+    );
 }
 
 /// Writes `scene.xml`, the object's mesh file(s) and `protocol.json` into `dir`.
@@ -78,32 +82,62 @@ fn side_sign(side: Side) -> f64 {
 /// # Errors
 /// [`ExportError`] naming the file that could not be written.
 pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
-    let err = |path: &Path, e: std::io::Error| ExportError {
+    std::fs::create_dir_all(dir).map_err(|e| io_error(dir, e))?;
+    let case = &input.case;
+    let meshes = object_meshes(input);
+    for (name, mesh) in &meshes {
+        let path = dir.join(format!("{name}.stl"));
+        std::fs::write(&path, mesh.to_binary_stl()).map_err(|e| io_error(&path, e))?;
+    }
+    // Where the rapier check starts: the palm backed off and the fingers opened clear of the
+    // object's collider (`sim::scene::start`).
+    let start = crate::sim::scene::start(case);
+    let keys = Keyframes::new(case, &start);
+
+    let mut s = String::new();
+    let _ = writeln!(s, "<mujoco model=\"grasp-sim {}\">", input.name);
+    mjcf_options(&mut s, case, &meshes);
+    let _ = writeln!(s, "  <worldbody>");
+    mjcf_hand(&mut s, case, &start);
+    mjcf_object(&mut s, case, &meshes);
+    let _ = writeln!(s, "  </worldbody>");
+    mjcf_contacts(&mut s, case.hand);
+    mjcf_actuators(&mut s, case);
+    keys.write(&mut s);
+    let _ = writeln!(s, "</mujoco>");
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, s).map_err(|e| io_error(&path, e))?;
+
+    let path = dir.join("protocol.json");
+    std::fs::write(
+        &path,
+        serde_json::to_string_pretty(&protocol(input, &keys)).unwrap_or_default(),
+    )
+    .map_err(|e| io_error(&path, e))?;
+    Ok(())
+}
+
+fn io_error(path: &Path, e: std::io::Error) -> ExportError {
+    ExportError {
         path: path.to_path_buf(),
         message: e.to_string(),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
-    let case = &input.case;
-    let hand = case.hand;
-    let sim = case.params;
-    let [x, y, z] = case.pose.axes;
-    let r_palm = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
-        nalgebra::Matrix3::from_columns(&[x, y, z]),
-    ));
-    let o = hand.fingers.offset_mm;
-    let (l1, l2) = (hand.phalanx_1.length_mm, hand.phalanx_2.length_mm);
-    let l2c = l2 - hand.phalanx_2.unusable_distal_mm;
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
-    let mu = case.friction;
-    let finger_density = sim.finger_density_kg_m3;
-    let lim = |r: [f64; 2]| (bend(r[1]), bend(r[0]));
-    let (lo1, hi1) = lim(hand.joints.theta1_range_deg);
-    let (lo2, hi2) = lim(hand.joints.theta2_range_deg);
+    }
+}
 
-    // Object meshes: one hull, or the decomposition's parts, in metres.
+/// The joint ranges as bends `[(lo1, hi1), (lo2, hi2)]` `[rad]`.
+fn bend_limits(hand: &Hand) -> [(f64, f64); 2] {
+    let lim = |r: [f64; 2]| (bend(r[1]), bend(r[0]));
+    [
+        lim(hand.joints.theta1_range_deg),
+        lim(hand.joints.theta2_range_deg),
+    ]
+}
+
+/// The object's meshes, in metres: the convex decomposition's parts when the check used one,
+/// else the aligned mesh.
+fn object_meshes(input: &ExportInput) -> Vec<(String, Mesh)> {
     let mut meshes: Vec<(String, Mesh)> = Vec::new();
-    match case.object.shape.as_compound() {
+    match input.case.object.shape.as_compound() {
         Some(compound) => {
             for (k, (_, part)) in compound.shapes().iter().enumerate() {
                 if let Some(poly) = part.as_convex_polyhedron() {
@@ -134,16 +168,14 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
             meshes.push(("object".to_string(), mesh));
         }
     }
-    for (name, mesh) in &meshes {
-        let path = dir.join(format!("{name}.stl"));
-        std::fs::write(&path, mesh.to_binary_stl()).map_err(|e| err(&path, e))?;
-    }
+    meshes
+}
 
-    let mut s = String::new();
-    let g = match sim.gravity {
+/// `<compiler>`, `<option>`, `<default>` and `<asset>`.
+fn mjcf_options(s: &mut String, case: &Case, meshes: &[(String, Mesh)]) {
+    let g = match case.params.gravity {
         GravityMode::Down | GravityMode::Six => "0 0 -9.81",
     };
-    let _ = writeln!(s, "<mujoco model=\"grasp-sim {}\">", input.name);
     let _ = writeln!(s, "  <compiler angle=\"radian\" autolimits=\"true\"/>");
     // MuJoCo integrates actuator stiffness explicitly: a 20–200 N·m/rad servo on a phalanx of
     // about 1.5e-5 kg·m² (natural frequency 1,100–3,700 rad/s) is unstable at rapier's 1 ms
@@ -155,44 +187,36 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     let _ = writeln!(s, "  <default>");
     let _ = writeln!(
         s,
-        "    <geom friction=\"{mu} 0 0\" condim=\"3\" solref=\"{:.6} 1\"/>",
+        "    <geom friction=\"{} 0 0\" condim=\"3\" solref=\"{:.6} 1\"/>",
+        case.friction,
         2.0 * MUJOCO_TIMESTEP_S
     );
     let _ = writeln!(s, "  </default>");
     let _ = writeln!(s, "  <asset>");
-    for (name, _) in &meshes {
+    for (name, _) in meshes {
         let _ = writeln!(s, "    <mesh name=\"{name}\" file=\"{name}.stl\"/>");
     }
     let _ = writeln!(s, "  </asset>");
-    let _ = writeln!(s, "  <worldbody>");
-    // Where the rapier check starts: the palm backed off and the fingers opened clear of the
-    // object's collider (`sim::scene::start`).
-    let start = crate::sim::scene::start(case);
-    let palm_pos = start.origin_mm.coords * MM;
+}
+
+/// The palm body welded at the start pose, and each finger's two phalanx bodies with their
+/// hinges, nested in it.
+fn mjcf_hand(s: &mut String, case: &Case, start: &Start) {
+    let hand = case.hand;
+    let [(lo1, hi1), (lo2, hi2)] = bend_limits(hand);
     let _ = writeln!(
         s,
         "    <body name=\"palm\" pos=\"{}\" quat=\"{}\">",
-        v3(&palm_pos),
-        quat(&r_palm)
+        v3(&(start.origin_mm.coords * MM)),
+        quat(&palm_rotation(&case.pose.axes))
     );
-    let _ = writeln!(
-        s,
-        "      <geom name=\"palm\" type=\"box\" size=\"{}\" pos=\"{}\"/>",
-        v3(&(Vector3::new(
-            hand.palm.offset_mm / 2.0,
-            hand.palm.half_width_mm,
-            (h_hi - h_lo) / 2.0 + m
-        ) * MM)),
-        v3(&(Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (h_hi + h_lo) / 2.0) * MM))
-    );
+    box_geom(s, "      ", "palm", &hand.palm_box(), "");
+    let density = format!(" density=\"{}\"", case.params.finger_density_kg_m3);
     for f in &hand.finger_list {
-        let sd = side_sign(f.side);
+        let sd = f.side.sign();
         let n = &f.name;
-        let anchor = Vector3::new(
-            hand.joints.setback_mm,
-            sd * hand.joints.lateral_mm,
-            f.height_mm,
-        ) * MM;
+        let (p1, p2) = hand.phalanx_boxes(f.side);
+        let anchor = hand.joint1_anchor_mm(f) * MM;
         let _ = writeln!(
             s,
             "      <body name=\"{n}_phalanx_1\" pos=\"{}\">",
@@ -202,43 +226,30 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
             s,
             "        <joint name=\"{n}_joint_1\" type=\"hinge\" axis=\"0 0 {sd}\" range=\"{lo1:.9} {hi1:.9}\" damping=\"0\"/>"
         );
-        let _ = writeln!(
-            s,
-            "        <geom name=\"{n}_phalanx_1\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
-            v3(&(Vector3::new(o, l1 / 2.0, o) * MM)),
-            v3(&(Vector3::new(0.0, sd * l1 / 2.0, 0.0) * MM))
-        );
+        box_geom(s, "        ", &format!("{n}_phalanx_1"), &p1, &density);
         let _ = writeln!(
             s,
             "        <body name=\"{n}_phalanx_2\" pos=\"{}\">",
-            v3(&(Vector3::new(0.0, sd * l1, 0.0) * MM))
+            v3(&(hand.joint2_anchor_mm(f.side) * MM))
         );
         let _ = writeln!(
             s,
             "          <joint name=\"{n}_joint_2\" type=\"hinge\" axis=\"0 0 {sd}\" range=\"{lo2:.9} {hi2:.9}\" damping=\"0\"/>"
         );
-        let _ = writeln!(
-            s,
-            "          <geom name=\"{n}_phalanx_2\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
-            v3(&(Vector3::new(o, l2c / 2.0, o) * MM)),
-            v3(&(Vector3::new(0.0, sd * l2c / 2.0, 0.0) * MM))
-        );
-        if l2 > l2c + 1e-9 {
-            let t = hand.fingers.tip_thickness_mm;
-            let _ = writeln!(
-                s,
-                "          <geom name=\"{n}_tip\" type=\"box\" size=\"{}\" pos=\"{}\" density=\"{finger_density}\"/>",
-                v3(&(Vector3::new(t / 2.0, (l2 - l2c) / 2.0, o) * MM)),
-                v3(&(Vector3::new(o - t / 2.0, sd * (l2 + l2c) / 2.0, 0.0) * MM))
-            );
+        // The contact part of phalanx 2, then its thinned tip if it has one.
+        for (b, part) in p2.iter().zip(["phalanx_2", "tip"]) {
+            box_geom(s, "          ", &format!("{n}_{part}"), b, &density);
         }
         let _ = writeln!(s, "        </body>");
         let _ = writeln!(s, "      </body>");
     }
     let _ = writeln!(s, "    </body>");
-    // The object: free, at the origin of the aligned frame, with the mass distribution the rapier
-    // check gives it: its collider's (convex hull or decomposition) at the scenario's mass. (The
-    // mesh's own surface integral is no inertia at all for an open mesh.)
+}
+
+/// The object: free, at the origin of the aligned frame, with the mass distribution the rapier
+/// check gives it: its collider's (convex hull or decomposition) at the scenario's mass. (The
+/// mesh's own surface integral is no inertia at all for an open mesh.)
+fn mjcf_object(s: &mut String, case: &Case, meshes: &[(String, Mesh)]) {
     let (c, inertia) = crate::sim::collider_inertia(case.object, case.mass_kg);
     let _ = writeln!(s, "    <body name=\"object\" pos=\"0 0 0\">");
     let _ = writeln!(s, "      <freejoint name=\"object\"/>");
@@ -254,17 +265,19 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
         inertia[(0, 2)],
         inertia[(1, 2)]
     );
-    for (name, _) in &meshes {
+    for (name, _) in meshes {
         let _ = writeln!(
             s,
             "      <geom name=\"{name}\" type=\"mesh\" mesh=\"{name}\" mass=\"0\"/>"
         );
     }
     let _ = writeln!(s, "    </body>");
-    let _ = writeln!(s, "  </worldbody>");
-    // As in the rapier check (one multibody, self-contacts off), the hand's bodies never collide
-    // with each other; MuJoCo only filters parent-child pairs, and not those of a body welded to
-    // the world such as the palm, so every pair is listed.
+}
+
+/// As in the rapier check (one multibody, self-contacts off), the hand's bodies never collide
+/// with each other; MuJoCo only filters parent-child pairs, and not those of a body welded to
+/// the world such as the palm, so every pair is listed.
+fn mjcf_contacts(s: &mut String, hand: &Hand) {
     let mut hand_bodies = vec!["palm".to_string()];
     for f in &hand.finger_list {
         hand_bodies.push(format!("{}_phalanx_1", f.name));
@@ -277,14 +290,20 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
         }
     }
     let _ = writeln!(s, "  </contact>");
-    let _ = writeln!(s, "  <actuator>");
+}
+
+/// A position actuator per joint, with the rapier check's gains and torque limit.
+fn mjcf_actuators(s: &mut String, case: &Case) {
+    let sim = case.params;
+    let limits = bend_limits(case.hand);
     let (kp, kv, tau) = (
         sim.motor_stiffness_nm_per_rad,
         sim.motor_damping_nms_per_rad,
         sim.torque_limit_nm,
     );
-    for f in &hand.finger_list {
-        for (j, (lo, hi)) in [(1, (lo1, hi1)), (2, (lo2, hi2))] {
+    let _ = writeln!(s, "  <actuator>");
+    for f in &case.hand.finger_list {
+        for (j, (lo, hi)) in [(1, limits[0]), (2, limits[1])] {
             let _ = writeln!(
                 s,
                 "    <position name=\"{n}_joint_{j}\" joint=\"{n}_joint_{j}\" kp=\"{kp}\" kv=\"{kv}\" forcerange=\"{:.6} {tau:.6}\" ctrlrange=\"{lo:.9} {hi:.9}\"/>",
@@ -294,68 +313,87 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
         }
     }
     let _ = writeln!(s, "  </actuator>");
+}
 
-    // Keyframes: joint values are bends; the object's free joint is at rest at the origin.
-    let mut open = Vec::new();
-    let mut planned = Vec::new();
-    let mut ctrl = Vec::new();
-    for ([t1, t2], [o1, o2]) in case.pose.theta_deg.iter().zip(&start.open_bend_rad) {
-        let (b1, b2) = (bend(*t1), bend(*t2));
-        open.push(*o1);
-        open.push(*o2);
-        planned.push(b1);
-        planned.push(b2);
-        ctrl.push((b1 + sim.squeeze_deg.to_radians()).clamp(lo1, hi1));
-        ctrl.push((b2 + sim.squeeze2_deg.to_radians()).clamp(lo2, hi2));
+/// The joint values of the keyframes, two per finger, as bends `[rad]`.
+struct Keyframes {
+    /// Where the check starts.
+    open: Vec<f64>,
+    /// The planned angles.
+    planned: Vec<f64>,
+    /// The motor targets: planned plus the squeeze, within the limits.
+    ctrl: Vec<f64>,
+}
+
+impl Keyframes {
+    fn new(case: &Case, start: &Start) -> Keyframes {
+        let sim = case.params;
+        let [(lo1, hi1), (lo2, hi2)] = bend_limits(case.hand);
+        let mut k = Keyframes {
+            open: Vec::new(),
+            planned: Vec::new(),
+            ctrl: Vec::new(),
+        };
+        for ([t1, t2], [o1, o2]) in case.pose.theta_deg.iter().zip(&start.open_bend_rad) {
+            let (b1, b2) = (bend(*t1), bend(*t2));
+            k.open.push(*o1);
+            k.open.push(*o2);
+            k.planned.push(b1);
+            k.planned.push(b2);
+            k.ctrl
+                .push((b1 + sim.squeeze_deg.to_radians()).clamp(lo1, hi1));
+            k.ctrl
+                .push((b2 + sim.squeeze2_deg.to_radians()).clamp(lo2, hi2));
+        }
+        k
     }
-    let join = |v: &[f64]| {
-        v.iter()
-            .map(|x| format!("{x:.9}"))
-            .collect::<Vec<_>>()
-            .join(" ")
-    };
-    let _ = writeln!(s, "  <keyframe>");
-    let _ = writeln!(
-        s,
-        "    <key name=\"open\" qpos=\"{} 0 0 0 1 0 0 0\" ctrl=\"{}\"/>",
-        join(&open),
-        join(&open)
-    );
-    let _ = writeln!(
-        s,
-        "    <key name=\"planned\" qpos=\"{} 0 0 0 1 0 0 0\" ctrl=\"{}\"/>",
-        join(&planned),
-        join(&ctrl)
-    );
-    let _ = writeln!(s, "  </keyframe>");
-    let _ = writeln!(s, "</mujoco>");
-    let path = dir.join("scene.xml");
-    std::fs::write(&path, s).map_err(|e| err(&path, e))?;
 
-    let protocol = serde_json::json!({
+    /// `<keyframe>`: `open` and `planned`; the object's free joint at rest at the origin.
+    fn write(&self, s: &mut String) {
+        let join = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x:.9}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
+        let _ = writeln!(s, "  <keyframe>");
+        let _ = writeln!(
+            s,
+            "    <key name=\"open\" qpos=\"{} 0 0 0 1 0 0 0\" ctrl=\"{}\"/>",
+            join(&self.open),
+            join(&self.open)
+        );
+        let _ = writeln!(
+            s,
+            "    <key name=\"planned\" qpos=\"{} 0 0 0 1 0 0 0\" ctrl=\"{}\"/>",
+            join(&self.planned),
+            join(&self.ctrl)
+        );
+        let _ = writeln!(s, "  </keyframe>");
+    }
+}
+
+/// `protocol.json`: what scripts/mujoco_replay.py needs to run the check's protocol.
+fn protocol(input: &ExportInput, keys: &Keyframes) -> serde_json::Value {
+    let case = &input.case;
+    let sim = case.params;
+    serde_json::json!({
         "scenario": input.name,
-        "fingers": hand.finger_list.iter().map(|f| f.name.clone()).collect::<Vec<_>>(),
-        "planned_bend_rad": planned,
-        "open_bend_rad": open,
-        "target_bend_rad": ctrl,
+        "fingers": case.hand.finger_list.iter().map(|f| f.name.clone()).collect::<Vec<_>>(),
+        "planned_bend_rad": keys.planned,
+        "open_bend_rad": keys.open,
+        "target_bend_rad": keys.ctrl,
         "close_duration_s": sim.close_duration_s,
         "duration_s": sim.duration_s,
         "joint1_lock_torque_nm": sim.joint1_lock_torque_nm,
-        "motor_stiffness_nm_per_rad": kp,
+        "motor_stiffness_nm_per_rad": sim.motor_stiffness_nm_per_rad,
         "hold_translation_mm": sim.hold_translation_mm,
         "hold_rotation_deg": sim.hold_rotation_deg,
         "gravity": match sim.gravity { GravityMode::Down => "down", GravityMode::Six => "six" },
         "is_revolution": case.object.is_revolution,
         "mass_kg": case.mass_kg,
-        "friction": mu,
-    });
-    let path = dir.join("protocol.json");
-    std::fs::write(
-        &path,
-        serde_json::to_string_pretty(&protocol).unwrap_or_default(),
-    )
-    .map_err(|e| err(&path, e))?;
-    Ok(())
+        "friction": case.friction,
+    })
 }
 
 /// Writes the hand (palm and six phalanges, revolute joints with limits and effort) as
@@ -364,15 +402,9 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
 /// # Errors
 /// [`ExportError`] naming the file that could not be written.
 pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), ExportError> {
-    let err = |path: &Path, e: std::io::Error| ExportError {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
+    std::fs::create_dir_all(dir).map_err(|e| io_error(dir, e))?;
     let o = hand.fingers.offset_mm * MM;
-    let (l1, l2) = (hand.phalanx_1.length_mm * MM, hand.phalanx_2.length_mm * MM);
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
+    let l2 = hand.phalanx_2.length_mm * MM;
     let rho = sim.finger_density_kg_m3;
     let mut s = String::new();
     let _ = writeln!(s, "<?xml version=\"1.0\"?>");
@@ -399,26 +431,25 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
         let _ = writeln!(s, "    <collision>{geometry}</collision>");
         let _ = writeln!(s, "  </link>");
     };
+    let palm = hand.palm_box();
     boxed(
         &mut s,
         "palm",
-        Vector3::new(
-            hand.palm.offset_mm,
-            2.0 * hand.palm.half_width_mm,
-            h_hi - h_lo + 2.0 * m,
-        ) * MM,
-        Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (h_hi + h_lo) / 2.0) * MM,
+        palm.half_extents * (2.0 * MM),
+        palm.centre * MM,
     );
     let lim = |r: [f64; 2]| (bend(r[1]), bend(r[0]));
     for f in &hand.finger_list {
-        let sd = side_sign(f.side);
+        let sd = f.side.sign();
         let n = &f.name;
+        let (p1, _) = hand.phalanx_boxes(f.side);
         boxed(
             &mut s,
             &format!("{n}_phalanx_1"),
-            Vector3::new(2.0 * o, l1, 2.0 * o),
-            Vector3::new(0.0, sd * l1 / 2.0, 0.0),
+            p1.half_extents * (2.0 * MM),
+            p1.centre * MM,
         );
+        // Phalanx 2 as one box over its whole length: the URDF leaves out the thinned tip.
         boxed(
             &mut s,
             &format!("{n}_phalanx_2"),
@@ -430,18 +461,14 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
                 1,
                 "palm".to_string(),
                 format!("{n}_phalanx_1"),
-                Vector3::new(
-                    hand.joints.setback_mm,
-                    sd * hand.joints.lateral_mm,
-                    f.height_mm,
-                ) * MM,
+                hand.joint1_anchor_mm(f) * MM,
                 lim(hand.joints.theta1_range_deg),
             ),
             (
                 2,
                 format!("{n}_phalanx_1"),
                 format!("{n}_phalanx_2"),
-                Vector3::new(0.0, sd * l1, 0.0),
+                hand.joint2_anchor_mm(f.side) * MM,
                 lim(hand.joints.theta2_range_deg),
             ),
         ] {
@@ -462,5 +489,5 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
     }
     let _ = writeln!(s, "</robot>");
     let path = dir.join("hand.urdf");
-    std::fs::write(&path, s).map_err(|e| err(&path, e))
+    std::fs::write(&path, s).map_err(|e| io_error(&path, e))
 }

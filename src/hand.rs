@@ -11,6 +11,9 @@
 use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
+mod geometry;
+pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
+
 /// The hands built into the binary, by name: found wherever grasp-sim runs, without a path.
 pub const BUNDLED: [(&str, &str); 2] = [
     ("thesis", include_str!("../assets/hands/thesis.toml")),
@@ -20,6 +23,13 @@ pub const BUNDLED: [(&str, &str); 2] = [
 /// The bundled hand called `name` (e.g. `thesis`), as `(name, TOML)`.
 pub fn bundled(name: &str) -> Option<(&'static str, &'static str)> {
     BUNDLED.iter().copied().find(|(n, _)| *n == name)
+}
+
+/// The bundled thesis hand, parsed: the hand most unit tests plan with.
+#[cfg(test)]
+pub(crate) fn thesis_for_tests() -> Hand {
+    let (_, text) = bundled("thesis").expect("the thesis hand is bundled");
+    Hand::parse(text, Path::new("thesis.toml"), &[]).expect("the thesis hand parses")
 }
 
 /// Problems with a hand file.
@@ -171,7 +181,7 @@ impl Hand {
     pub fn load(path: &Path, overrides: &[(String, f64)]) -> Result<Hand, HandError> {
         let text = std::fs::read_to_string(path).map_err(|e| HandError::Io {
             path: path.to_path_buf(),
-            message: crate::scenario::io_message(&e),
+            message: crate::messages::io_message(&e),
         })?;
         Hand::parse(&text, path, overrides)
     }
@@ -186,13 +196,13 @@ impl Hand {
             message,
         };
         let mut doc: toml::Table = toml::from_str(text)
-            .map_err(|e: toml::de::Error| parse_err(crate::scenario::toml_message(&e, text)))?;
+            .map_err(|e: toml::de::Error| parse_err(crate::messages::toml_message(&e, text)))?;
         for (key, value) in overrides {
             set_number(&mut doc, key, *value).map_err(|problem| {
                 let mut keys = Vec::new();
                 number_keys(&doc, "", &mut keys);
                 let problem =
-                    match crate::scenario::did_you_mean(key, keys.iter().map(|k| k.as_str())) {
+                    match crate::messages::did_you_mean(key, keys.iter().map(|k| k.as_str())) {
                         Some(k) => format!("{problem}; did you mean `{k}`?"),
                         None => problem,
                     };
@@ -207,12 +217,12 @@ impl Hand {
         // edited table (the line is then that of the hand file as written, if any).
         let hand: Hand = if overrides.is_empty() {
             toml::from_str(text)
-                .map_err(|e: toml::de::Error| parse_err(crate::scenario::toml_message(&e, text)))?
+                .map_err(|e: toml::de::Error| parse_err(crate::messages::toml_message(&e, text)))?
         } else {
             toml::Value::Table(doc)
                 .try_into()
                 .map_err(|e: toml::de::Error| {
-                    parse_err(crate::scenario::with_suggestion(
+                    parse_err(crate::messages::with_suggestion(
                         &e.message().replace('\n', " "),
                     ))
                 })?
@@ -382,4 +392,205 @@ fn set_number(doc: &mut toml::Table, key: &str, value: f64) -> Result<(), String
         };
     }
     Err("is empty".to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::{Point3, UnitQuaternion, Vector3};
+    use std::f64::consts::FRAC_PI_2;
+
+    fn thesis(overrides: &[(&str, f64)]) -> Result<Hand, HandError> {
+        let (_, text) = bundled("thesis").unwrap();
+        let overrides: Vec<(String, f64)> =
+            overrides.iter().map(|(k, v)| (k.to_string(), *v)).collect();
+        Hand::parse(text, Path::new("thesis.toml"), &overrides)
+    }
+
+    fn close(a: Vector3<f64>, b: Vector3<f64>) -> bool {
+        (a - b).norm() < 1e-9
+    }
+
+    #[test]
+    fn derived_quantities_of_the_thesis_hand() {
+        let h = thesis(&[]).unwrap();
+        assert_eq!(h.finger_width_mm(), 14.0);
+        assert_eq!(h.finger_height_span(), (-25.0, 25.0));
+        assert_eq!(h.palm_height_mm(), 64.0);
+        assert_eq!(h.palm_z_range_mm(), [-32.0, 32.0]);
+        let palm = h.palm_box();
+        assert_eq!(palm.half_extents, Vector3::new(5.0, 36.7, 32.0));
+        assert_eq!(palm.centre, Vector3::new(5.0, 0.0, 0.0));
+    }
+
+    #[test]
+    fn sides_bends_and_anchors() {
+        assert_eq!(Side::Left.sign(), 1.0);
+        assert_eq!(Side::Right.sign(), -1.0);
+        for (theta, expected) in [
+            (180.0, 0.0),
+            (90.0, FRAC_PI_2),
+            (45.0, 3.0 * FRAC_PI_2 / 2.0),
+        ] {
+            assert!((bend(theta) - expected).abs() < 1e-12, "bend({theta})");
+        }
+        let h = thesis(&[]).unwrap();
+        let table = [
+            (
+                0,
+                Vector3::new(5.8, 36.7, 25.0),
+                Vector3::new(0.0, 61.0, 0.0),
+            ),
+            (
+                1,
+                Vector3::new(5.8, -36.7, 0.0),
+                Vector3::new(0.0, -61.0, 0.0),
+            ),
+            (
+                2,
+                Vector3::new(5.8, 36.7, -25.0),
+                Vector3::new(0.0, 61.0, 0.0),
+            ),
+        ];
+        for (k, joint1, joint2) in table {
+            let f = &h.finger_list[k];
+            assert_eq!(h.joint1_anchor_mm(f), joint1, "{}", f.name);
+            assert_eq!(h.joint2_anchor_mm(f.side), joint2, "{}", f.name);
+        }
+    }
+
+    #[test]
+    fn phalanx_boxes_with_and_without_a_thinned_tip() {
+        // The thesis hand's phalanx 2 may touch with its tip: no thinned part.
+        let h = thesis(&[]).unwrap();
+        let (p1, p2) = h.phalanx_boxes(Side::Right);
+        assert_eq!(p1.half_extents, Vector3::new(7.0, 30.5, 7.0));
+        assert_eq!(p1.centre, Vector3::new(0.0, -30.5, 0.0));
+        assert_eq!(p2.len(), 1);
+        assert_eq!(p2[0].half_extents, Vector3::new(7.0, 10.0, 7.0));
+        // 4 mm unusable at the far end: a 16 mm contact part and a 4 mm tip, 4 mm thick, flush
+        // with the back of the finger.
+        let h = thesis(&[("phalanx_2.unusable_distal_mm", 4.0)]).unwrap();
+        let (_, p2) = h.phalanx_boxes(Side::Left);
+        assert_eq!(p2.len(), 2);
+        assert_eq!(p2[0].half_extents, Vector3::new(7.0, 8.0, 7.0));
+        assert_eq!(p2[0].centre, Vector3::new(0.0, 8.0, 0.0));
+        assert_eq!(p2[1].half_extents, Vector3::new(2.0, 2.0, 7.0));
+        assert_eq!(p2[1].centre, Vector3::new(5.0, 18.0, 0.0));
+    }
+
+    #[test]
+    fn forward_kinematics_curls_both_sides_towards_the_object() {
+        let h = thesis(&[]).unwrap();
+        let palm = (Point3::origin(), UnitQuaternion::identity());
+        // (finger, bends, joint 2, phalanx 2's axis along the finger): straight, then joint 1
+        // at 90° (phalanx 1 points at the object, −x), then both at 90° (phalanx 2 turns back
+        // across the palm).
+        let table = [
+            (0, [0.0, 0.0], Vector3::new(5.8, 97.7, 25.0), Vector3::y()),
+            (
+                0,
+                [FRAC_PI_2, 0.0],
+                Vector3::new(-55.2, 36.7, 25.0),
+                -Vector3::x(),
+            ),
+            (
+                1,
+                [FRAC_PI_2, 0.0],
+                Vector3::new(-55.2, -36.7, 0.0),
+                Vector3::x(),
+            ),
+            (
+                0,
+                [FRAC_PI_2, FRAC_PI_2],
+                Vector3::new(-55.2, 36.7, 25.0),
+                -Vector3::y(),
+            ),
+        ];
+        for (k, bends, joint2, axis) in table {
+            let f = &h.finger_list[k];
+            let [(j1, _), (j2, r2)] = h.finger_poses(f, &palm, bends);
+            assert!(
+                close(j1.coords, h.joint1_anchor_mm(f)),
+                "{k} {bends:?}: {j1}"
+            );
+            assert!(close(j2.coords, joint2), "{k} {bends:?}: {j2}");
+            // Phalanx 2's own y axis, as seen from the finger's side.
+            let along = r2 * Vector3::y() * f.side.sign();
+            let expected = if f.side == Side::Left { axis } else { -axis };
+            assert!(close(along, expected), "{k} {bends:?}: {along}");
+        }
+        let poses = h.body_poses(&palm, &[[0.0, 0.0]; 3]);
+        assert_eq!(poses.len(), 7);
+        assert_eq!(poses[0], palm);
+    }
+
+    #[test]
+    fn a_rotated_palm_carries_the_fingers() {
+        let h = thesis(&[]).unwrap();
+        let axes = [Vector3::y(), -Vector3::x(), Vector3::z()];
+        let r = palm_rotation(&axes);
+        for (k, a) in axes.iter().enumerate() {
+            let mut e = Vector3::zeros();
+            e[k] = 1.0;
+            assert!(close(r * e, *a), "axis {k}");
+        }
+        let origin = Point3::new(10.0, 0.0, 50.0);
+        let [(j1, _), _] = h.finger_poses(&h.finger_list[0], &(origin, r), [0.0, 0.0]);
+        // (5.8, 36.7, 25) in the palm frame: x → +y, y → −x.
+        assert!(
+            close(j1.coords, Vector3::new(10.0 - 36.7, 5.8, 75.0)),
+            "{j1}"
+        );
+    }
+
+    #[test]
+    fn out_of_range_values_name_their_key() {
+        let table: [(&[(&str, f64)], &str); 6] = [
+            (&[("palm.offset_mm", -1.0)], "palm.offset_mm"),
+            (&[("fingers.gap_mm", 0.0)], "fingers.gap_mm"),
+            (&[("palm.margin_mm", -0.5)], "palm.margin_mm"),
+            (
+                &[("fingers.tip_thickness_mm", 8.0)],
+                "fingers.tip_thickness_mm",
+            ),
+            (
+                &[
+                    ("phalanx_1.unusable_proximal_mm", 30.0),
+                    ("phalanx_1.unusable_distal_mm", 31.0),
+                ],
+                "phalanx_1",
+            ),
+            (&[("phalanx_1.length_mm", 400.0)], "phalanx_1.length_mm"),
+        ];
+        for (overrides, expected) in table {
+            match thesis(overrides) {
+                Err(HandError::Invalid { key, .. }) => assert_eq!(key, expected, "{overrides:?}"),
+                other => panic!("{overrides:?}: {other:?}"),
+            }
+        }
+    }
+
+    #[test]
+    fn a_mistyped_override_is_named_with_a_suggestion() {
+        let table = [
+            (
+                "palm.offest_mm",
+                "names no key of the hand file; did you mean `palm.offset_mm`?",
+            ),
+            ("name", "is not a number in the hand file"),
+            ("palm", "is not a number in the hand file"),
+            ("nothing.like.it", "names no key of the hand file"),
+        ];
+        for (key, expected) in table {
+            match thesis(&[(key, 1.0)]) {
+                Err(HandError::BadOverride {
+                    key: k, problem, ..
+                }) => {
+                    assert_eq!((k.as_str(), problem.as_str()), (key, expected))
+                }
+                other => panic!("{key}: {other:?}"),
+            }
+        }
+    }
 }

@@ -22,6 +22,7 @@ pub mod batch;
 pub mod export;
 pub mod hand;
 pub mod mesh;
+mod messages;
 pub mod objects;
 pub mod plan;
 pub mod quality;
@@ -498,11 +499,7 @@ fn grasp_report(
     aligned: &mesh::AlignedObject,
     check: Option<&sim::SimOutcome>,
 ) -> report::GraspReport {
-    let [x, y, z] = g.palm.axes;
-    let m = nalgebra::Matrix3::from_columns(&[x, y, z]);
-    let r_aligned = nalgebra::UnitQuaternion::from_rotation_matrix(
-        &nalgebra::Rotation3::from_matrix_unchecked(m),
-    );
+    let r_aligned = hand::palm_rotation(&g.palm.axes);
     let r_original = aligned.to_aligned.rotation.inverse() * r_aligned;
     let als = |a: &plan::finger::AlsAngles| [a.theta1_deg, a.theta2_deg];
     report::GraspReport {

@@ -627,3 +627,99 @@ fn close_gaps(contours: Vec<Contour>, r: f64) -> Vec<Contour> {
         grown.outline(&OutlineStyle::new(-r).line_join(LineJoin::Bevel))
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::objects::{cylinder, prism};
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn planes_map_points_both_ways() {
+        let p = Point3::new(3.0, 4.0, 5.0);
+        let table = [
+            (Plane::vertical(0.0), Point2::new(3.0, 5.0), -4.0),
+            (Plane::vertical(FRAC_PI_2), Point2::new(4.0, 5.0), 3.0),
+            (Plane::horizontal(2.0), Point2::new(3.0, 4.0), 3.0),
+        ];
+        for (plane, q, distance) in table {
+            assert!((plane.to_2d(&p) - q).norm() < 1e-12, "{plane:?}");
+            assert!((plane.distance(&p) - distance).abs() < 1e-12, "{plane:?}");
+            let back = plane.to_3d(&plane.to_2d(&p));
+            assert!((plane.distance(&back)).abs() < 1e-12, "{plane:?}");
+        }
+    }
+
+    #[test]
+    fn a_box_cut_three_ways() {
+        // 40 (x) × 100 (y) × 80 (z) mm about the z axis.
+        let b = prism(40.0, 100.0, 80.0);
+        // (plane, contours, area, length): a cut across the middle, two vertical cuts through the
+        // axis (s along x, then along y) and a plane above the box.
+        let table = [
+            (Plane::horizontal(40.0), 1, 4000.0, 280.0),
+            (Plane::vertical(0.0), 1, 3200.0, 240.0),
+            (Plane::vertical(FRAC_PI_2), 1, 8000.0, 360.0),
+            (Plane::horizontal(90.0), 0, 0.0, 0.0),
+        ];
+        for (plane, count, area, length) in table {
+            let s = slice(&b, &plane);
+            assert_eq!(s.contours.len(), count, "{plane:?}");
+            assert_eq!(s.open_count(), 0, "{plane:?}");
+            let a: f64 = s.contours.iter().map(Contour::signed_area).sum();
+            let l: f64 = s.contours.iter().map(Contour::length).sum();
+            assert!(
+                (a - area).abs() < 1e-6,
+                "{plane:?}: area {a}, expected {area}"
+            );
+            assert!(
+                (l - length).abs() < 1e-6,
+                "{plane:?}: length {l}, expected {length}"
+            );
+            assert!(s.contours.iter().all(|c| !c.is_hole()));
+        }
+    }
+
+    #[test]
+    fn a_cylinder_cut_across_is_nearly_a_circle() {
+        let c = cylinder(40.0, 124.0);
+        let s = slice(&c, &Plane::horizontal(62.0));
+        assert_eq!(s.contours.len(), 1);
+        let area = s.contours[0].signed_area();
+        let circle = PI * 20.0 * 20.0;
+        assert!(
+            area < circle && area > 0.99 * circle,
+            "area {area}, circle {circle}"
+        );
+        // Every outward normal points away from the axis.
+        let c0 = &s.contours[0];
+        for i in 0..c0.segment_count() {
+            let (a, b) = c0.segment(i);
+            let mid = (a.coords + b.coords) / 2.0;
+            assert!(c0.normals[i].dot(&mid) > 0.0, "segment {i}");
+        }
+    }
+
+    #[test]
+    fn polylines_count_their_segments() {
+        let square = vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(1.0, 0.0),
+            Point2::new(1.0, 1.0),
+            Point2::new(0.0, 1.0),
+        ];
+        let table = [(true, 4, 1.0, 4.0), (false, 3, 1.0, 3.0)];
+        for (closed, segments, area, length) in table {
+            let c = Contour::from_polyline(square.clone(), closed);
+            assert_eq!(c.segment_count(), segments);
+            assert_eq!(c.signed_area(), area);
+            assert_eq!(c.length(), length);
+        }
+        // Counter-clockwise: the first segment's outward normal points down (−y).
+        let c = Contour::from_polyline(square.clone(), true);
+        assert_eq!(c.normals[0], Vector2::new(0.0, -1.0));
+        let mut reversed = square;
+        reversed.reverse();
+        assert!(Contour::from_polyline(reversed, true).is_hole());
+    }
+}

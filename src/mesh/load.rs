@@ -125,7 +125,7 @@ pub fn load_mesh(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError>
     })?;
     let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
-        message: crate::scenario::io_message(&e),
+        message: crate::messages::io_message(&e),
     })?;
     parse_mesh(&bytes, path, format, unit)
 }
@@ -535,7 +535,7 @@ pub fn load_stl(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> 
     }
     let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
-        message: crate::scenario::io_message(&e),
+        message: crate::messages::io_message(&e),
     })?;
     parse_stl(&bytes, path, unit)
 }

@@ -31,9 +31,9 @@
 //! the finger, so thinning below the finger matters less than above it.
 //!
 //! Choices where the thesis is silent (all parameters in [`CurvatureParams`]):
-//! - Segment-length rules: the walk on each side stops once it is more than the finger's
-//!   thickness (2 × finger offset) from the touch point ("too long stops the count"); a segment
-//!   longer than half that counts twice ("long reduces the count"); a segment shorter than a
+//! - Segment-length rules: the walk on each side stops once it is more than the reach (below)
+//!   from the touch point ("too long stops the count"); a segment at least half the reach long
+//!   counts twice ("long reduces the count"); a segment shorter than a
 //!   tenth of the finger offset is skipped (its turn is kept, it is not counted), at most 5
 //!   times; at most `curvature_segments` (3) segments are counted.
 //! - The reach is 1.5 × finger offset (10.5 mm for the thesis hand). Two facts of the thesis fix
@@ -61,9 +61,9 @@
 //! - An elevation is ungraspable if it is ungraspable in any slice (the palm may approach from
 //!   any angle, and the search must not waste time on a level with a sharp edge somewhere).
 
+use super::PlannerParams;
 use super::{Domain, Grade, Touch};
 use crate::hand::Hand;
-use crate::scenario::PlannerParams;
 use crate::slice::Contour;
 use nalgebra::Vector2;
 use std::f64::consts::PI;
@@ -73,7 +73,8 @@ use std::f64::consts::PI;
 pub struct CurvatureParams {
     /// Segments counted on each side (thesis: 3).
     pub segments: usize,
-    /// How far along the contour a walk looks `[mm]` (default: finger thickness).
+    /// How far along the contour a walk looks `[mm]` (default: 1.5 × finger offset, see the
+    /// module docs).
     pub reach_mm: f64,
     /// A segment at least this long counts twice `[mm]`.
     pub long_mm: f64,
@@ -215,18 +216,21 @@ pub fn grade_elevations(domain: &Domain, p: &CurvatureParams) -> Vec<Grade> {
 /// was graded with `p.ungraspable_grade` instead (always false when that is `None`).
 pub fn grade_elevations_marked(domain: &Domain, p: &CurvatureParams) -> (Vec<Grade>, Vec<bool>) {
     domain
-        .elevations
+        .crossings
         .iter()
-        .map(|&z| {
+        .map(|row| {
             let mut sum = 0.0;
             let mut floored = false;
-            for (k, s) in domain.slices.iter().enumerate() {
-                let Some((left, right)) = domain.touches(k, z) else {
+            for ((s, touches), &[lo, hi]) in
+                domain.slices.iter().zip(row).zip(&domain.slice_z_range_mm)
+            {
+                let Some((left, right)) = touches else {
                     return (None, false);
                 };
-                let zr = z_range(&s.contours);
-                let l = grade_side(&s.contours[left.contour], &left, -1.0, zr, p).grade;
-                let r = grade_side(&s.contours[right.contour], &right, 1.0, zr, p).grade;
+                let zr = (lo, hi);
+                let l = grade_side(&s.contours[left.contour], left, SliceSide::Left, zr, p).grade;
+                let r =
+                    grade_side(&s.contours[right.contour], right, SliceSide::Right, zr, p).grade;
                 let g = p.ungraspable_grade;
                 floored |= l.is_err() || r.is_err();
                 match (l.ok().or(g), r.ok().or(g)) {
@@ -240,21 +244,38 @@ pub fn grade_elevations_marked(domain: &Domain, p: &CurvatureParams) -> (Vec<Gra
         .unzip()
 }
 
-fn z_range(contours: &[Contour]) -> (f64, f64) {
-    contours
-        .iter()
-        .flat_map(|c| c.points.iter())
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), q| {
-            (a.min(q.y), b.max(q.y))
-        })
+/// Which side of a vertical slice a touch point is on: outward is +s on the right, −s on the
+/// left.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SliceSide {
+    /// The side of smaller s.
+    Left,
+    /// The side of larger s.
+    Right,
 }
 
-/// Grades one touch point. `side` is +1 for the right side (outward is +s) and −1 for the left;
-/// `z_range` is the slice's lowest and highest elevation.
+impl SliceSide {
+    /// The outward sense of s: −1 on the left, +1 on the right.
+    fn outward(self) -> f64 {
+        match self {
+            SliceSide::Left => -1.0,
+            SliceSide::Right => 1.0,
+        }
+    }
+}
+
+/// Which way a walk goes in elevation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Vertical {
+    Up,
+    Down,
+}
+
+/// Grades one touch point on `side`; `z_range` is the slice's lowest and highest elevation.
 pub fn grade_side(
     c: &Contour,
     touch: &Touch,
-    side: f64,
+    side: SliceSide,
     z_range: (f64, f64),
     p: &CurvatureParams,
 ) -> SideGrade {
@@ -263,7 +284,7 @@ pub fn grade_side(
     // Which way along the contour is up on this segment.
     let forward_is_up = dz > 0.0;
     let up_dir = if forward_is_up { b - a } else { a - b };
-    let slope = angle_of(up_dir, side, true);
+    let slope = angle_of(up_dir, side, Vertical::Up);
     let slope_deg = slope.to_degrees();
     let mut out = SideGrade {
         grade: Err(Ungraspable::SharpChange),
@@ -279,8 +300,13 @@ pub fn grade_side(
         out.grade = Err(Ungraspable::Slope(slope_deg));
         return out;
     }
-    let above = walk(c, touch, forward_is_up, side, true, z_range.1, p);
-    let below = walk(c, touch, !forward_is_up, side, false, z_range.0, p);
+    let from = WalkStart {
+        contour: c,
+        touch,
+        side,
+    };
+    let above = from.walk(forward_is_up, Vertical::Up, z_range.1, p);
+    let below = from.walk(!forward_is_up, Vertical::Down, z_range.0, p);
     if above.sharp || below.sharp {
         return out;
     }
@@ -351,9 +377,12 @@ pub fn grade_side(
 
 /// Angle of a direction from "straight on" along the walk, outward positive: `atan2(ds, dz)`
 /// with `ds` the outward component and `dz` the component along the walk's vertical sense.
-fn angle_of(v: Vector2<f64>, side: f64, up: bool) -> f64 {
-    let ds = side * v.x;
-    let dz = if up { v.y } else { -v.y };
+fn angle_of(v: Vector2<f64>, side: SliceSide, vertical: Vertical) -> f64 {
+    let ds = side.outward() * v.x;
+    let dz = match vertical {
+        Vertical::Up => v.y,
+        Vertical::Down => -v.y,
+    };
     ds.atan2(dz)
 }
 
@@ -368,100 +397,107 @@ struct Walk {
     reached_end: Option<f64>,
 }
 
-/// Walks from the touch point along the contour (`forward`: increasing index), measuring the
-/// weighted outward turn. `up` says whether this walk goes up; `z_end` is the slice's top (for
-/// an upward walk) or bottom.
-fn walk(
-    c: &Contour,
-    touch: &Touch,
-    forward: bool,
-    side: f64,
-    up: bool,
-    z_end: f64,
-    p: &CurvatureParams,
-) -> Walk {
-    let n = c.points.len();
-    let seg_count = c.segment_count();
-    let mut result = Walk {
-        trend: 0.0,
-        cumulative: 0.0,
-        nearest_turn: f64::INFINITY,
-        sharp: false,
-        reached_end: None,
-    };
-    // The first vertex reached, and the direction of travel along the touched segment.
-    let (mut vertex, first_dir) = if forward {
-        let v = (touch.segment + 1) % n;
-        (v, c.points[v] - touch.point)
-    } else {
-        (touch.segment, c.points[touch.segment] - touch.point)
-    };
-    let (a, b) = c.segment(touch.segment);
-    let seg_dir = if forward { b - a } else { a - b };
-    let mut prev = angle_of(
-        if first_dir.norm() > 0.0 {
-            first_dir
-        } else {
-            seg_dir
-        },
-        side,
-        up,
-    );
-    let mut dist = first_dir.norm();
-    let mut counted = 0usize;
-    let mut skips = 0usize;
-    let is_end = |z: f64| {
-        if up {
-            z >= z_end - 1e-9
-        } else {
-            z <= z_end + 1e-9
-        }
-    };
-    for _ in 0..seg_count {
-        if dist > p.reach_mm || counted >= p.segments {
-            break;
-        }
-        if is_end(c.points[vertex].y) && result.reached_end.is_none() {
-            result.reached_end = Some(dist);
-        }
-        // The segment leaving `vertex` in the walk's direction.
-        let next = if forward {
-            if !c.is_closed && vertex + 1 >= n {
-                break;
-            }
-            (vertex + 1) % n
-        } else {
-            if !c.is_closed && vertex == 0 {
-                break;
-            }
-            (vertex + n - 1) % n
+/// Where the walks of one touch point start: its contour, the touch point and its side.
+struct WalkStart<'a> {
+    contour: &'a Contour,
+    touch: &'a Touch,
+    side: SliceSide,
+}
+
+impl WalkStart<'_> {
+    /// Walks from the touch point along the contour (`forward`: increasing index), measuring the
+    /// weighted outward turn, going `vertical`; `z_end` is the slice's top (for an upward walk)
+    /// or bottom.
+    fn walk(&self, forward: bool, vertical: Vertical, z_end: f64, p: &CurvatureParams) -> Walk {
+        let WalkStart {
+            contour: c,
+            touch,
+            side,
+        } = *self;
+        let up = vertical == Vertical::Up;
+        let n = c.points.len();
+        let seg_count = c.segment_count();
+        let mut result = Walk {
+            trend: 0.0,
+            cumulative: 0.0,
+            nearest_turn: f64::INFINITY,
+            sharp: false,
+            reached_end: None,
         };
-        let v = c.points[next] - c.points[vertex];
-        let len = v.norm();
-        if len < p.short_mm && skips < p.max_skips {
-            skips += 1;
+        // The first vertex reached, and the direction of travel along the touched segment.
+        let (mut vertex, first_dir) = if forward {
+            let v = (touch.segment + 1) % n;
+            (v, c.points[v] - touch.point)
+        } else {
+            (touch.segment, c.points[touch.segment] - touch.point)
+        };
+        let (a, b) = c.segment(touch.segment);
+        let seg_dir = if forward { b - a } else { a - b };
+        let mut prev = angle_of(
+            if first_dir.norm() > 0.0 {
+                first_dir
+            } else {
+                seg_dir
+            },
+            side,
+            vertical,
+        );
+        let mut dist = first_dir.norm();
+        let mut counted = 0usize;
+        let mut skips = 0usize;
+        let is_end = |z: f64| {
+            if up {
+                z >= z_end - 1e-9
+            } else {
+                z <= z_end + 1e-9
+            }
+        };
+        for _ in 0..seg_count {
+            if dist > p.reach_mm || counted >= p.segments {
+                break;
+            }
+            if is_end(c.points[vertex].y) && result.reached_end.is_none() {
+                result.reached_end = Some(dist);
+            }
+            // The segment leaving `vertex` in the walk's direction.
+            let next = if forward {
+                if !c.is_closed && vertex + 1 >= n {
+                    break;
+                }
+                (vertex + 1) % n
+            } else {
+                if !c.is_closed && vertex == 0 {
+                    break;
+                }
+                (vertex + n - 1) % n
+            };
+            let v = c.points[next] - c.points[vertex];
+            let len = v.norm();
+            if len < p.short_mm && skips < p.max_skips {
+                skips += 1;
+                dist += len;
+                vertex = next;
+                continue;
+            }
+            let psi = angle_of(v, side, vertical);
+            let turn = wrap(psi - prev);
+            if turn.abs().to_degrees() > p.sharp_turn_deg && dist <= p.sharp_distance_mm {
+                result.sharp = true;
+            }
+            result.cumulative += turn;
+            if result.cumulative.abs() > result.trend.abs() {
+                result.trend = result.cumulative;
+            }
+            if turn.abs().to_degrees() > p.deadzone_deg {
+                result.nearest_turn = result.nearest_turn.min(dist);
+            }
+            prev = psi;
+            counted += if len >= p.long_mm { 2 } else { 1 };
             dist += len;
             vertex = next;
-            continue;
         }
-        let psi = angle_of(v, side, up);
-        let turn = wrap(psi - prev);
-        if turn.abs().to_degrees() > p.sharp_turn_deg && dist <= p.sharp_distance_mm {
-            result.sharp = true;
-        }
-        result.cumulative += turn;
-        if result.cumulative.abs() > result.trend.abs() {
-            result.trend = result.cumulative;
-        }
-        if turn.abs().to_degrees() > p.deadzone_deg {
-            result.nearest_turn = result.nearest_turn.min(dist);
-        }
-        prev = psi;
-        counted += if len >= p.long_mm { 2 } else { 1 };
-        dist += len;
-        vertex = next;
+        result
     }
-    result
 }
 
 fn wrap(a: f64) -> f64 {
@@ -522,9 +558,10 @@ mod tests {
         let c = contour(profile);
         let (l, r) = crate::plan::domain::outermost_crossings(std::slice::from_ref(&c), z)
             .expect("the line cuts the contour");
-        let zr = z_range(std::slice::from_ref(&c));
-        let right = grade_side(&c, &r, 1.0, zr, &params());
-        let left = grade_side(&c, &l, -1.0, zr, &params());
+        let [lo, hi] = crate::plan::domain::z_range(std::slice::from_ref(&c));
+        let zr = (lo, hi);
+        let right = grade_side(&c, &r, SliceSide::Right, zr, &params());
+        let left = grade_side(&c, &l, SliceSide::Left, zr, &params());
         assert_eq!(
             right.category, left.category,
             "mirror: {right:?} vs {left:?}"

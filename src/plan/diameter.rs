@@ -1,8 +1,8 @@
 //! Stage 2: grading by Effective Diameter (thesis 3.4.3.2, Fig. 3.16).
 //!
 //! The thickness of a vertical slice at an indexed elevation is the distance between its
-//! outermost left and right crossings; the Effective Diameter is its mean over the slices. An
-//! elevation whose Effective Diameter lies outside the graspable range is ungraspable. The others
+//! outermost left and right crossings (found once, by stage 1: [`Domain::crossings`]); the
+//! Effective Diameter is its mean over the slices. An elevation whose Effective Diameter lies outside the graspable range is ungraspable. The others
 //! are graded by the smallest graspable Effective Diameter among them divided by their own, so
 //! the thinnest graspable elevation grades 1 and thicker ones less ("normalised by their least
 //! graspable value"; smaller is better for an enveloping grasp).
@@ -21,16 +21,14 @@ pub struct DiameterGrades {
 /// Grades every indexed elevation of `domain` against the graspable `range` `[min, max]` `[mm]`.
 pub fn grade_elevations(domain: &Domain, range: [f64; 2]) -> DiameterGrades {
     let diameters_mm: Vec<f64> = domain
-        .elevations
+        .crossings
         .iter()
-        .map(|&z| {
+        .map(|row| {
             let mut sum = 0.0;
             let mut n = 0usize;
-            for k in 0..domain.slices.len() {
-                if let Some((l, r)) = domain.touches(k, z) {
-                    sum += r.point.x - l.point.x;
-                    n += 1;
-                }
+            for (l, r) in row.iter().flatten() {
+                sum += r.point.x - l.point.x;
+                n += 1;
             }
             if n == domain.slices.len() && n > 0 {
                 sum / n as f64

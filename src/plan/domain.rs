@@ -10,9 +10,9 @@
 //! The slices are computed once here and reused by every later stage (and by a tuner sweeping
 //! parameters that do not change them).
 
+use super::PlannerParams;
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::scenario::PlannerParams;
 use crate::slice::{slice, Contour, Plane, Slice};
 use nalgebra::Point2;
 
@@ -32,6 +32,12 @@ pub struct Domain {
     /// The elevations every vertical slice spans (the thesis's Effective Elevation before the
     /// finger offset is taken off) `[mm]`.
     pub span_mm: [f64; 2],
+    /// Each slice's lowest and highest elevation `[lo, hi]` `[mm]`, in the order of `slices`.
+    pub slice_z_range_mm: Vec<[f64; 2]>,
+    /// The outermost crossings of each indexed elevation with each slice, found once here for
+    /// every stage that grades by them: `crossings[i][k]` is [`Domain::touches`]`(k,
+    /// elevations[i])`.
+    pub crossings: Vec<Vec<Option<(Touch, Touch)>>>,
     /// Outward directions of the object's large flat side faces, as angles from +X `[deg]`
     /// (see [`face_directions_deg`]); the palm approaching at such an angle lies flat on the face.
     pub face_directions_deg: Vec<f64>,
@@ -65,18 +71,12 @@ impl Domain {
             .iter()
             .map(|a| slice(mesh, &Plane::vertical(a.to_radians())).bridged(hand.finger_width_mm()))
             .collect();
+        let slice_z_range_mm: Vec<[f64; 2]> = slices.iter().map(|s| z_range(&s.contours)).collect();
         let mut lo = f64::NEG_INFINITY;
         let mut hi = f64::INFINITY;
-        for s in &slices {
-            let (a, b) = s
-                .contours
-                .iter()
-                .flat_map(|c| c.points.iter())
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
-                    (a.min(p.y), b.max(p.y))
-                });
-            lo = lo.max(a);
-            hi = hi.min(b);
+        for [a, b] in &slice_z_range_mm {
+            lo = lo.max(*a);
+            hi = hi.min(*b);
         }
         let effective = [lo + shrink_mm, hi - shrink_mm];
         let h = params.height_step_mm;
@@ -86,8 +86,19 @@ impl Domain {
             let n = ((effective[1] - effective[0]) / h + 1e-9).floor() as usize + 1;
             elevations = (0..n).map(|i| effective[0] + i as f64 * h).collect();
         }
+        let crossings = elevations
+            .iter()
+            .map(|&z| {
+                slices
+                    .iter()
+                    .map(|s| outermost_crossings(&s.contours, z))
+                    .collect()
+            })
+            .collect();
         Domain {
             slices,
+            slice_z_range_mm,
+            crossings,
             angles_deg,
             effective,
             elevations,
@@ -102,6 +113,18 @@ impl Domain {
     pub fn touches(&self, k: usize, z: f64) -> Option<(Touch, Touch)> {
         outermost_crossings(&self.slices[k].contours, z)
     }
+}
+
+/// The lowest and highest elevation of `contours`' points, `[lo, hi]` `[mm]` (`[∞, −∞]` when
+/// there are none).
+pub fn z_range(contours: &[Contour]) -> [f64; 2] {
+    let (lo, hi) = contours
+        .iter()
+        .flat_map(|c| c.points.iter())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.y), b.max(p.y))
+        });
+    [lo, hi]
 }
 
 /// The crossings of the line at height `z` with the smallest and largest horizontal coordinate.

@@ -22,7 +22,7 @@ use super::geom2::ConvexPolygon;
 use super::kinematics::{inward_normal, phalanx1_direction};
 use super::palm::{PalmPlacement, PENETRATION_TOL_MM};
 use super::{Relaxation, RuleSet};
-use crate::hand::{Hand, Side};
+use crate::hand::Hand;
 use crate::mesh::Mesh;
 use crate::slice::{slice, Slice};
 use nalgebra::{Point2, Rotation2, Vector2};
@@ -99,10 +99,7 @@ pub fn place_finger(
 ) -> Result<FingerPlacement, FingerRejection> {
     let f = &hand.finger_list[k];
     let o = hand.fingers.offset_mm;
-    let mirror = match f.side {
-        Side::Left => 1.0,
-        Side::Right => -1.0,
-    };
+    let mirror = f.side.sign();
     let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
         let s = slice(mesh, &palm.finger_plane(f.height_mm + dz)).bridged(2.0 * o);
         place_als(&s, hand, mirror)
@@ -372,4 +369,51 @@ fn circle_crossings(a: Point2<f64>, b: Point2<f64>, c: Point2<f64>, r: f64) -> V
         .filter(|t| (0.0..=1.0).contains(t))
         .map(|t| a + d * t)
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::palm::place_palm;
+
+    use crate::hand::thesis_for_tests as thesis_hand;
+
+    #[test]
+    fn fingers_wrap_the_d40_cylinder_at_the_thesis_angles() {
+        // Thesis 5.2: θ1 72.2°, θ2 90° on the D40 cylinder, within the 3° a scenario's `[expect]`
+        // allows by default. This mesh (144 facets) gives 72.11° and 91.81°, phalanx 2 touching
+        // with its tip; every finger and each of its three ALS alike (the wall is straight).
+        let hand = thesis_hand();
+        let mesh = crate::objects::cylinder(40.0, 124.0);
+        let palm = place_palm(&mesh, &hand, 80.0, 0.0, 0.2).unwrap();
+        for k in 0..hand.finger_list.len() {
+            let f = place_finger(&mesh, &hand, &palm, k, [5.0, 5.0], RuleSet::Thesis).unwrap();
+            assert_eq!(f.name, hand.finger_list[k].name);
+            assert!(f.relaxations.is_empty());
+            for als in [f.top, f.centre, f.bottom] {
+                let (t1, t2) = (als.theta1_deg, als.theta2_deg);
+                assert!(
+                    (t1 - 72.2).abs() < 3.0 && (t2 - 90.0).abs() < 3.0,
+                    "finger {k}: ({t1:.3}, {t2:.3}), thesis (72.2, 90)"
+                );
+                assert!(
+                    (t1 - 72.11).abs() < 0.01 && (t2 - 91.81).abs() < 0.01,
+                    "finger {k}: ({t1:.3}, {t2:.3}), expected (72.11, 91.81)"
+                );
+                assert!(als.is_tip_contact, "finger {k}");
+                assert_eq!(als.gap_mm, 0.0, "finger {k}");
+            }
+        }
+    }
+
+    #[test]
+    fn a_finger_rejects_what_it_cannot_wrap() {
+        // A D10 rod is thinner than the smallest graspable diameter (17.4 mm): phalanx 1 would
+        // have to close beyond joint 1's 45° to reach it.
+        let hand = thesis_hand();
+        let rod = crate::objects::cylinder(10.0, 124.0);
+        let palm = place_palm(&rod, &hand, 80.0, 0.0, 0.2).unwrap();
+        let r = place_finger(&rod, &hand, &palm, 0, [5.0, 5.0], RuleSet::Thesis);
+        assert_eq!(r, Err(FingerRejection::Theta1OutOfRange));
+    }
 }

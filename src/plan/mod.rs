@@ -19,15 +19,16 @@ pub mod geom2;
 pub mod kinematics;
 pub mod palm;
 pub mod palm_grade;
+pub mod params;
 pub mod search;
 
 pub use curvature::{CurvatureParams, SideGrade};
 pub use domain::{Domain, Touch};
 pub use palm_grade::{GradedDomain, Grades};
+pub use params::PlannerParams;
 
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::scenario::PlannerParams;
 use std::collections::BTreeMap;
 use std::time::Instant;
 

@@ -72,14 +72,23 @@ pub fn place_palm(
     approach_rad: f64,
     pitch_range_rad: f64,
 ) -> Result<PalmPlacement, PalmRejection> {
-    place_palm_with(mesh, hand, z1, approach_rad, pitch_range_rad, false)
+    let vslice = vertical_slice(mesh, hand, approach_rad);
+    place_palm_on(&vslice, hand, z1, approach_rad, pitch_range_rad, false)
 }
 
-/// [`place_palm`]; with `back_off`, a palm outline that takes in part of the object in the
-/// vertical plane is moved back along its normal until it only touches (the extended rules'
-/// [`super::Relaxation::PalmBackedOff`]) instead of being rejected.
-pub fn place_palm_with(
-    mesh: &Mesh,
+/// The vertical slice the palm is placed in at approach angle `approach_rad`, bridged to the
+/// finger width: it depends on the angle only, so a search cuts it once per angle and hands it
+/// to [`place_palm_on`] for every elevation.
+pub fn vertical_slice(mesh: &Mesh, hand: &Hand, approach_rad: f64) -> Slice {
+    slice(mesh, &Plane::vertical(approach_rad)).bridged(hand.finger_width_mm())
+}
+
+/// [`place_palm`] in `vslice`, the [`vertical_slice`] at `approach_rad`; with `back_off`, a
+/// palm outline that takes in part of the object in the vertical plane is moved back along its
+/// normal until it only touches (the extended rules' [`super::Relaxation::PalmBackedOff`])
+/// instead of being rejected.
+pub fn place_palm_on(
+    vslice: &Slice,
     hand: &Hand,
     z1: f64,
     approach_rad: f64,
@@ -87,7 +96,6 @@ pub fn place_palm_with(
     back_off: bool,
 ) -> Result<PalmPlacement, PalmRejection> {
     let plane = Plane::vertical(approach_rad);
-    let vslice = slice(mesh, &plane).bridged(hand.finger_width_mm());
     let h1 = hand.finger_list[0].height_mm;
     let (h_lo, h_hi) = hand.finger_height_span();
     let m = hand.palm.margin_mm;
@@ -177,17 +185,18 @@ pub fn place_palm_with(
     let mut centre = p1 - up * h1;
     let mut backed_off_mm = 0.0;
     if back_off {
-        let depth = penetration_depth(&vslice, centre, up, back, [h_lo - m, h_hi + m]);
+        let depth = penetration_depth(vslice, centre, up, back, hand.palm_z_range_mm());
         if depth > PENETRATION_TOL_MM {
             centre += back * depth;
             backed_off_mm = depth;
         }
     }
+    let [p_lo, p_hi] = hand.palm_z_range_mm();
     let outline = ConvexPolygon::new(vec![
-        centre + up * (h_lo - m),
-        centre + up * (h_hi + m),
-        centre + up * (h_hi + m) + back * hand.palm.offset_mm,
-        centre + up * (h_lo - m) + back * hand.palm.offset_mm,
+        centre + up * p_lo,
+        centre + up * p_hi,
+        centre + up * p_hi + back * hand.palm.offset_mm,
+        centre + up * p_lo + back * hand.palm.offset_mm,
     ]);
     for c in &vslice.contours {
         for i in 0..c.segment_count() {
@@ -211,7 +220,7 @@ pub fn place_palm_with(
         origin: plane.to_3d(&centre),
         axes: [x_p, y_p, z_p],
         contacts,
-        slice: vslice,
+        slice: vslice.clone(),
         backed_off_mm,
     })
 }
@@ -265,4 +274,104 @@ pub fn penetration_depth(
         }
     }
     depth
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::slice::Contour;
+    use std::f64::consts::FRAC_PI_2;
+
+    use crate::hand::thesis_for_tests as thesis_hand;
+
+    #[test]
+    fn the_palm_lies_flat_on_a_cylinder_from_any_side() {
+        // The D40 cylinder has a vertex every 2.5°, so at these angles the wall is 20 mm out.
+        let hand = thesis_hand();
+        let mesh = crate::objects::cylinder(40.0, 124.0);
+        let table = [
+            (0.0, [20.0, 0.0]),
+            (FRAC_PI_2, [0.0, 20.0]),
+            (-FRAC_PI_2, [0.0, -20.0]),
+        ];
+        for (approach, [x, y]) in table {
+            let p = place_palm(&mesh, &hand, 80.0, approach, 10f64.to_radians()).unwrap();
+            assert_eq!(p.pitch_rad, 0.0, "{approach}");
+            assert!(
+                (p.origin - Point3::new(x, y, 55.0)).norm() < 1e-9,
+                "{approach}: {}",
+                p.origin
+            );
+            let u = Vector3::new(approach.cos(), approach.sin(), 0.0);
+            assert!((p.axes[0] - u).norm() < 1e-12, "{approach}");
+            assert!((p.axes[2] - Vector3::z()).norm() < 1e-12, "{approach}");
+            assert!(
+                (p.axes[1] - Vector3::z().cross(&u)).norm() < 1e-12,
+                "{approach}"
+            );
+            assert_eq!(p.backed_off_mm, 0.0);
+        }
+    }
+
+    #[test]
+    fn the_palm_pitches_onto_a_cone_and_rejects_what_it_cannot_reach() {
+        let hand = thesis_hand();
+        // A cup: 56 mm across at the bottom, 80 at the top, 110 tall; its wall leans out by
+        // atan(12 / 110) = 6.2° (thesis 5.3: the palm pitches −7° with its own geometry).
+        let cup = crate::objects::frustum(56.0, 80.0, 110.0);
+        let lean = (12.0f64 / 110.0).atan();
+        let p = place_palm(&cup, &hand, 80.0, 0.0, 10f64.to_radians()).unwrap();
+        assert!(
+            (p.pitch_rad + lean).abs() < 1e-3,
+            "pitch {}",
+            p.pitch_rad.to_degrees()
+        );
+        assert_eq!(p.contacts.len(), 2);
+        // (elevation, pitch range, rejection): above the object; a pitch range too small for
+        // the wall's lean.
+        let table = [
+            (400.0, 0.2, PalmRejection::NoContact),
+            (80.0, 1f64.to_radians(), PalmRejection::PitchOutOfRange),
+        ];
+        for (z1, range, rejection) in table {
+            assert_eq!(
+                place_palm(&cup, &hand, z1, 0.0, range),
+                Err(rejection),
+                "{z1} {range}"
+            );
+        }
+    }
+
+    #[test]
+    fn penetration_depth_measures_past_the_contact_line_within_the_band() {
+        // A 13 × 10 mm rectangle reaching 3 mm past the line x = 0, from y = −5 to 5.
+        let rect = Contour::from_polyline(
+            vec![
+                Point2::new(-10.0, -5.0),
+                Point2::new(3.0, -5.0),
+                Point2::new(3.0, 5.0),
+                Point2::new(-10.0, 5.0),
+            ],
+            true,
+        );
+        let s = Slice {
+            plane: Plane::horizontal(0.0),
+            contours: vec![rect],
+            outermost: Some(0),
+        };
+        let (up, back) = (Vector2::y(), Vector2::x());
+        let table = [
+            (Point2::origin(), [-1.0, 1.0], 3.0),
+            (Point2::new(1.0, 0.0), [-1.0, 1.0], 2.0),
+            (Point2::new(5.0, 0.0), [-20.0, 20.0], -2.0),
+            (Point2::origin(), [10.0, 20.0], f64::NEG_INFINITY),
+        ];
+        for (origin, band, depth) in table {
+            assert_eq!(
+                penetration_depth(&s, origin, up, back, band),
+                depth,
+                "{origin} {band:?}"
+            );
+        }
+    }
 }

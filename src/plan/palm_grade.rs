@@ -16,10 +16,10 @@
 
 use super::diameter::DiameterGrades;
 use super::kinematics::GraspableRange;
+use super::PlannerParams;
 use super::RuleSet;
 use super::{Domain, Grade};
 use crate::hand::Hand;
-use crate::scenario::PlannerParams;
 
 /// Per-index grade vectors (index i at position i − 1), `None` where ungraspable.
 #[derive(Debug, Clone, PartialEq)]
@@ -248,4 +248,112 @@ fn explain(
     format!(
         "no palm position has all its fingers on graspable elevations ({bad} of {n} ungraspable: {thin} too thin, {thick} too thick, {sharp} by curvature)"
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::plan::kinematics::graspable_range;
+
+    use crate::hand::thesis_for_tests as thesis_hand;
+
+    /// Stage 3 on the D40 × 124 cylinder's domain (45 indexed elevations, 2.5 mm apart; the
+    /// fingers 10 indices apart) with the given curvature and diameter grades per index.
+    fn ranked(
+        curvature: impl Fn(usize) -> Grade,
+        diameter: impl Fn(usize) -> Grade,
+    ) -> GradedDomain {
+        let hand = thesis_hand();
+        let params = PlannerParams::default();
+        let domain = Domain::build(&crate::objects::cylinder(40.0, 124.0), &params, &hand);
+        let n = domain.elevations.len();
+        assert_eq!(n, 45);
+        let diameter = DiameterGrades {
+            diameters_mm: vec![40.0; n],
+            grades: (1..=n).map(diameter).collect(),
+        };
+        let curvature = (1..=n).map(curvature).collect();
+        rank(
+            domain,
+            curvature,
+            diameter,
+            graspable_range(&hand),
+            &params,
+            &hand,
+        )
+    }
+
+    #[test]
+    fn palm_positions_are_sorted_and_blocked() {
+        type Case = (
+            &'static str,
+            fn(usize) -> Grade,
+            fn(usize) -> Grade,
+            Vec<usize>,
+        );
+        let table: [Case; 4] = [
+            // Equal grades: every position with all three fingers inside, the higher first.
+            (
+                "uniform",
+                |_| Some(1.0),
+                |_| Some(1.0),
+                (21..=45).rev().collect(),
+            ),
+            // Index 30 ungraspable: Finger_1 from 30 to 45 would put a finger on it or across it.
+            (
+                "one hole",
+                |i| (i != 30).then_some(1.0),
+                |_| Some(1.0),
+                (21..=29).rev().collect(),
+            ),
+            // Thinner lower down grades better: the lowest position first.
+            (
+                "graded",
+                |_| Some(1.0),
+                |i| Some(1.0 / i as f64),
+                (21..=45).collect(),
+            ),
+            // Ungraspable at 20 and 40: no span between them exceeds the fingers' 50 mm.
+            (
+                "no span",
+                |i| (i != 20 && i != 40).then_some(1.0),
+                |_| Some(1.0),
+                vec![],
+            ),
+        ];
+        for (name, curvature, diameter, expected) in table {
+            let g = ranked(curvature, diameter);
+            assert_eq!(g.sorted_indices, expected, "{name}");
+            assert_eq!(g.finger_offsets, vec![0, 10, 20], "{name}");
+            assert_eq!(
+                g.reason.is_some(),
+                expected.is_empty(),
+                "{name}: {:?}",
+                g.reason
+            );
+        }
+    }
+
+    #[test]
+    fn grades_combine_with_the_significance_factor_and_palm_grades_average_the_fingers() {
+        let g = ranked(|_| Some(1.0), |i| Some(i as f64 / 100.0));
+        let sf = PlannerParams::default().sf_c;
+        for i in [1, 21, 45] {
+            let combined = sf + (1.0 - sf) * i as f64 / 100.0;
+            let got = g.grades.combined[i - 1].unwrap();
+            assert!(
+                (got - combined).abs() < 1e-12,
+                "index {i}: {got}, expected {combined}"
+            );
+        }
+        // Finger_1 at 30: the fingers on 30, 20 and 10.
+        let mean = [30.0, 20.0, 10.0]
+            .iter()
+            .map(|i| sf + (1.0 - sf) * i / 100.0)
+            .sum::<f64>()
+            / 3.0;
+        let got = g.grades.palm[29].unwrap();
+        assert!((got - mean).abs() < 1e-12, "{got}, expected {mean}");
+        assert_eq!(g.grades.palm[19], None);
+    }
 }

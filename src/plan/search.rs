@@ -5,12 +5,14 @@
 
 use super::finger::{place_finger, FingerPlacement, FingerRejection};
 use super::palm::{
-    penetration_depth, place_palm_with, PalmPlacement, PalmRejection, PENETRATION_TOL_MM,
+    penetration_depth, place_palm_on, vertical_slice, PalmPlacement, PalmRejection,
+    PENETRATION_TOL_MM,
 };
+use super::PlannerParams;
 use super::{GradedDomain, Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::scenario::PlannerParams;
+use crate::slice::Slice;
 use std::collections::BTreeMap;
 
 /// A kinematically feasible enveloping grasp: the thesis's Grasp Parameter Set.
@@ -141,11 +143,21 @@ pub fn search_with(
         params.joint_deviation_theta2_deg,
     ];
     let angles = approach_angles_deg(graded, params);
+    // The palm's vertical slice depends on the approach angle only: cut once per angle, when
+    // the search first needs it.
+    let mut vslices: Vec<Option<Slice>> = vec![None; angles.len()];
     for &index in &graded.sorted_indices {
         let z1 = graded.domain.elevations[index - 1];
-        for &approach_deg in &angles {
+        for (&approach_deg, vslice) in angles.iter().zip(&mut vslices) {
             tried += 1;
-            match try_candidate(mesh, hand, z1, approach_deg, params, deviation, rules) {
+            let vslice =
+                vslice.get_or_insert_with(|| vertical_slice(mesh, hand, approach_deg.to_radians()));
+            let candidate = Candidate {
+                z1,
+                approach_deg,
+                vslice,
+            };
+            match try_candidate(mesh, hand, &candidate, params, deviation, rules) {
                 Ok((palm, fingers)) => {
                     let mut relaxations: Vec<Relaxation> = fingers
                         .iter()
@@ -184,21 +196,28 @@ pub fn search_with(
     (tried, rejections)
 }
 
+/// One candidate of the search: Finger_1's elevation and the approach angle, with the palm's
+/// vertical slice at that angle.
+struct Candidate<'a> {
+    z1: f64,
+    approach_deg: f64,
+    vslice: &'a Slice,
+}
+
 fn try_candidate(
     mesh: &Mesh,
     hand: &Hand,
-    z1: f64,
-    approach_deg: f64,
+    candidate: &Candidate,
     params: &PlannerParams,
     deviation: [f64; 2],
     rules: RuleSet,
 ) -> Result<(PalmPlacement, Vec<FingerPlacement>), Rejection> {
     let extended = rules == RuleSet::Extended;
-    let mut palm = place_palm_with(
-        mesh,
+    let mut palm = place_palm_on(
+        candidate.vslice,
         hand,
-        z1,
-        approach_deg.to_radians(),
+        candidate.z1,
+        candidate.approach_deg.to_radians(),
         params.pitch_range_deg.to_radians(),
         extended,
     )

@@ -27,6 +27,7 @@
 
 pub mod contacts;
 pub mod convert;
+pub mod params;
 pub mod protocol;
 pub mod scene;
 

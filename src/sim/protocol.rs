@@ -336,9 +336,9 @@ fn summarise(
 /// The palm, phalanx 1 and 2 of each finger, then the object (aligned frame, metres).
 fn poses(scene: &Scene) -> Vec<super::BodyPose> {
     let mut handles = vec![scene.palm];
-    for &(b1, b2, _, _) in &scene.fingers {
-        handles.push(b1);
-        handles.push(b2);
+    for f in &scene.fingers {
+        handles.push(f.phalanx1);
+        handles.push(f.phalanx2);
     }
     handles.push(scene.object);
     handles
@@ -637,9 +637,10 @@ fn joint_errors(scene: &Scene) -> Vec<[f64; 2]> {
     scene
         .fingers
         .iter()
-        .map(|&(b1, b2, t1, t2)| {
-            let r1 = *bodies[b1].rotation();
-            let r2 = *bodies[b2].rotation();
+        .map(|f| {
+            let [t1, t2] = f.planned_bend_rad;
+            let r1 = *bodies[f.phalanx1].rotation();
+            let r2 = *bodies[f.phalanx2].rotation();
             let bend = |parent: Rotation, child: Rotation| {
                 convert::unit_quaternion(parent.inverse() * child).angle()
             };

@@ -1,10 +1,10 @@
 //! Building the rapier scene: palm, phalanges, joints with motors, and the object.
 
 use super::convert;
-use crate::hand::{Hand, Side};
+use super::params::SimParams;
+use crate::hand::{palm_rotation, BodyPose, Hand, HandBox};
 use crate::mesh::Mesh;
-use crate::scenario::SimParams;
-use nalgebra::{Point3, Rotation3, UnitQuaternion, Vector3};
+use nalgebra::{Point3, Vector3};
 use rapier3d::parry::transformation::vhacd::VHACDParameters;
 use rapier3d::prelude::*;
 
@@ -95,13 +95,8 @@ pub struct Scene {
     pub object_collider: ColliderHandle,
     /// Every hand collider.
     pub hand_colliders: Vec<ColliderHandle>,
-    /// Phalanx bodies per finger and the bend each joint should reach `[rad]`: (body1, body2,
-    /// planned bend 1, planned bend 2).
-    pub fingers: Vec<(RigidBodyHandle, RigidBodyHandle, f64, f64)>,
-    /// Joint 2 of each finger and its motor target once released `[rad]` (held open until then).
-    pub joint2: Vec<(MultibodyJointHandle, f32)>,
-    /// Joint 1 of each finger.
-    pub joint1: Vec<MultibodyJointHandle>,
+    /// The fingers, in the hand's order.
+    pub fingers: Vec<SimFinger>,
     /// Motor stiffness and damping.
     motor_gains: (f32, f32),
     /// Torque that holds a locked joint 1 `[N·m]`.
@@ -111,6 +106,23 @@ pub struct Scene {
     pub reach_m: f64,
     /// Radius about the object's centre of mass of a sphere that holds the object `[m]`.
     pub object_radius_m: f64,
+}
+
+/// One finger of the scene: its phalanx bodies, its joints and what they aim at.
+#[derive(Debug, Clone, Copy)]
+pub struct SimFinger {
+    /// Phalanx 1's body.
+    pub phalanx1: RigidBodyHandle,
+    /// Phalanx 2's body.
+    pub phalanx2: RigidBodyHandle,
+    /// The planned bend of joint 1 and joint 2 `[rad]`.
+    pub planned_bend_rad: [f64; 2],
+    /// Joint 1 (palm to phalanx 1).
+    pub joint1: MultibodyJointHandle,
+    /// Joint 2 (phalanx 1 to phalanx 2), held open until released.
+    pub joint2: MultibodyJointHandle,
+    /// Joint 2's motor target once released `[rad]`.
+    pub joint2_target: f32,
 }
 
 /// A copy of `w` that continues bit for bit as `w` would: every part of rapier's state, with
@@ -142,8 +154,6 @@ impl Scene {
             world: copy_world(&self.world),
             hand_colliders: self.hand_colliders.clone(),
             fingers: self.fingers.clone(),
-            joint2: self.joint2.clone(),
-            joint1: self.joint1.clone(),
             ..*self
         }
     }
@@ -161,8 +171,8 @@ impl Scene {
     /// closes. Without the lock, joint 2's reaction torque lifts phalanx 1 off the object.
     pub fn release_joint2(&mut self) {
         let (k, d) = self.motor_gains;
-        for &h in &self.joint1 {
-            if let Some((mb, id)) = self.world.multibody_joints.get_mut(h) {
+        for f in &self.fingers {
+            if let Some((mb, id)) = self.world.multibody_joints.get_mut(f.joint1) {
                 if let Some(link) = mb.link_mut(id) {
                     let angle = link.joint.coords()[3];
                     link.joint
@@ -172,23 +182,20 @@ impl Scene {
                 }
             }
         }
-        for &(h, target) in &self.joint2 {
-            if let Some((mb, id)) = self.world.multibody_joints.get_mut(h) {
+        for f in &self.fingers {
+            if let Some((mb, id)) = self.world.multibody_joints.get_mut(f.joint2) {
                 if let Some(link) = mb.link_mut(id) {
                     link.joint
                         .data
-                        .set_motor_position(JointAxis::AngX, target, k, d);
+                        .set_motor_position(JointAxis::AngX, f.joint2_target, k, d);
                 }
             }
         }
     }
 }
 
-/// Bend from straight of a joint at interior angle `theta_deg` `[rad]`: the joint value used
-/// by the rapier scene and by the MJCF and URDF exports alike.
-pub fn bend(theta_deg: f64) -> f64 {
-    (180.0 - theta_deg).to_radians()
-}
+/// The joint value of an interior angle (see [`crate::hand::bend`]).
+pub use crate::hand::bend;
 
 /// What one physics check is about: the hand, where it is and how it is planned to close, the
 /// object and its physical properties, and the protocol's parameters.
@@ -218,101 +225,10 @@ impl Case<'_> {
     }
 }
 
-/// A box of the hand, in its body's frame `[mm]`: half extents and centre.
-#[derive(Debug, Clone, Copy)]
-struct HandBox {
-    half: Vector3<f64>,
-    centre: Vector3<f64>,
-}
-
-impl HandBox {
-    fn shape(&self) -> SharedShape {
-        let h = convert::vector_m(&self.half);
-        SharedShape::cuboid(h.x, h.y, h.z)
-    }
-}
-
-/// The palm box in the palm's frame: `offset_mm` deep behind the contact surface (palm x points
-/// away from the object), as wide as the palm, and as tall as the fingers' span plus the margin.
-fn palm_box(hand: &Hand) -> HandBox {
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
-    let (z_lo, z_hi) = (h_lo - m, h_hi + m);
-    HandBox {
-        half: Vector3::new(
-            hand.palm.offset_mm / 2.0,
-            hand.palm.half_width_mm,
-            (z_hi - z_lo) / 2.0,
-        ),
-        centre: Vector3::new(hand.palm.offset_mm / 2.0, 0.0, (z_hi + z_lo) / 2.0),
-    }
-}
-
-/// The boxes of phalanx 1 and of phalanx 2 (its contact part, then its thinned tip if it has
-/// one), each in its phalanx's frame, for a finger on side `s` (±1).
-fn phalanx_boxes(hand: &Hand, s: f64) -> (HandBox, Vec<HandBox>) {
-    let o = hand.fingers.offset_mm;
-    let (l1, l2) = (hand.phalanx_1.length_mm, hand.phalanx_2.length_mm);
-    let l2_contact = l2 - hand.phalanx_2.unusable_distal_mm;
-    let p1 = HandBox {
-        half: Vector3::new(o, l1 / 2.0, o),
-        centre: Vector3::new(0.0, s * l1 / 2.0, 0.0),
-    };
-    let mut p2 = vec![HandBox {
-        half: Vector3::new(o, l2_contact / 2.0, o),
-        centre: Vector3::new(0.0, s * l2_contact / 2.0, 0.0),
-    }];
-    if l2 > l2_contact + 1e-9 {
-        // The thinned tip (thesis Fig. 3.8): its contact side recedes to the tip thickness.
-        let t = hand.fingers.tip_thickness_mm;
-        p2.push(HandBox {
-            half: Vector3::new(t / 2.0, (l2 - l2_contact) / 2.0, o),
-            centre: Vector3::new(o - t / 2.0, s * (l2 + l2_contact) / 2.0, 0.0),
-        });
-    }
-    (p1, p2)
-}
-
-/// The side of a finger as a sign: +1 on the left, −1 on the right.
-fn side_sign(side: Side) -> f64 {
-    match side {
-        Side::Left => 1.0,
-        Side::Right => -1.0,
-    }
-}
-
-/// The palm's rotation from its axes (aligned frame).
-fn palm_rotation(pose: &SimHand) -> UnitQuaternion<f64> {
-    let [x, y, z] = pose.axes;
-    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(
-        nalgebra::Matrix3::from_columns(&[x, y, z]),
-    ))
-}
-
-/// Frames of a finger's phalanx 1 and 2 (joint position `[mm]` and rotation, aligned frame)
-/// with the palm at `origin`, turned `r_palm`, and the joints bent `b1`, `b2` `[rad]`. A
-/// phalanx's frame is its parent's turned by side × bend about the palm's z: the revolute
-/// joint's angle about (0, 0, side) is then the bend itself.
-fn finger_frames(
-    hand: &Hand,
-    finger: &crate::hand::Finger,
-    origin: &Point3<f64>,
-    r_palm: &UnitQuaternion<f64>,
-    b1: f64,
-    b2: f64,
-) -> [(Point3<f64>, UnitQuaternion<f64>); 2] {
-    let s = side_sign(finger.side);
-    let turn = |b: f64| UnitQuaternion::from_axis_angle(&Vector3::z_axis(), s * b);
-    let anchor1 = Vector3::new(
-        hand.joints.setback_mm,
-        s * hand.joints.lateral_mm,
-        finger.height_mm,
-    );
-    let r1 = r_palm * turn(b1);
-    let j1 = origin + r_palm * anchor1;
-    let r2 = r1 * turn(b2);
-    let j2 = j1 + r1 * Vector3::new(0.0, s * hand.phalanx_1.length_mm, 0.0);
-    [(j1, r1), (j2, r2)]
+/// The collision shape of a hand box `[m]`.
+fn box_shape(b: &HandBox) -> SharedShape {
+    let h = convert::vector_m(&b.half_extents);
+    SharedShape::cuboid(h.x, h.y, h.z)
 }
 
 /// Where the check starts (docs/SIM.md, "Starting clear"): the palm at the planned pose, backed
@@ -346,19 +262,20 @@ pub struct Start {
 const START_TOLERANCE_MM: f64 = 0.1;
 
 /// Depth of the deepest overlap of `boxes` (posed by `frame`) with the object `[mm]`, 0 if none.
-fn overlap_mm(
-    object: &SharedShape,
-    frame: &(Point3<f64>, UnitQuaternion<f64>),
-    boxes: &[HandBox],
-) -> f64 {
+fn overlap_mm(object: &SharedShape, frame: &BodyPose, boxes: &[HandBox]) -> f64 {
     let at_origin = Pose::IDENTITY;
     boxes
         .iter()
         .map(|b| {
             let c = frame.0 + frame.1 * b.centre;
             let pose = convert::pose(&c, &frame.1);
-            match rapier3d::parry::query::contact(&pose, &*b.shape().0, &at_origin, &*object.0, 0.0)
-            {
+            match rapier3d::parry::query::contact(
+                &pose,
+                &*box_shape(b).0,
+                &at_origin,
+                &*object.0,
+                0.0,
+            ) {
                 Ok(Some(contact)) => (-f64::from(contact.dist) / convert::M_PER_MM).max(0.0),
                 _ => 0.0,
             }
@@ -375,8 +292,8 @@ pub fn start(case: &Case) -> Start {
         params,
         ..
     } = *case;
-    let r_palm = palm_rotation(pose);
-    let palm = [palm_box(hand)];
+    let r_palm = palm_rotation(&pose.axes);
+    let palm = [hand.palm_box()];
     let limits1 = [
         bend(hand.joints.theta1_range_deg[1]),
         bend(hand.joints.theta1_range_deg[0]),
@@ -413,11 +330,11 @@ pub fn start(case: &Case) -> Start {
     let mut open_bend = Vec::new();
     let mut open_margin = Vec::new();
     for (f, [t1, t2]) in hand.finger_list.iter().zip(&pose.theta_deg) {
-        let (p1, p2) = phalanx_boxes(hand, side_sign(f.side));
+        let (p1, p2) = hand.phalanx_boxes(f.side);
         let at = |m: f64| {
             let b1 = (bend(*t1) - m.to_radians()).max(limits1[0]);
             let b2 = (bend(*t2) - m.to_radians()).max(limits2[0]);
-            let [f1, f2] = finger_frames(hand, f, &origin, &r_palm, b1, b2);
+            let [f1, f2] = hand.finger_poses(f, &(origin, r_palm), [b1, b2]);
             let d = overlap_mm(&object.shape, &f1, &[p1]).max(overlap_mm(&object.shape, &f2, &p2));
             ([b1, b2], d)
         };
@@ -453,6 +370,10 @@ pub fn start(case: &Case) -> Start {
 }
 
 /// Builds the scene with the fingers open and gravity off.
+///
+/// # Panics
+/// If rapier refuses a finger's joint (it does only for a joint that would close a kinematic
+/// loop, which a hand of open chains never has).
 pub fn build(case: &Case) -> Scene {
     let Case {
         hand,
@@ -462,6 +383,69 @@ pub fn build(case: &Case) -> Scene {
         friction,
         params,
     } = *case;
+    let mut world = new_world(params);
+    let r_palm = palm_rotation(&pose.axes);
+    let start = start(case);
+    // The palm never moves during the check: a fixed body. (A kinematic body here made rapier
+    // refresh the palm's contacts irregularly: the object, pressed against the palm, sank into it
+    // for about five steps and was thrown back in one, a 0.16 mm sawtooth that ratcheted it along
+    // the fingers by 0.03 mm per period, docs/SIM.md.)
+    let palm = world
+        .bodies
+        .insert(RigidBodyBuilder::fixed().pose(convert::pose(&start.origin_mm, &r_palm)));
+    let mut hand_colliders = vec![world.colliders.insert_with_parent(
+        hand_collider(&hand.palm_box(), friction),
+        palm,
+        &mut world.bodies,
+    )];
+    let fingers: Vec<SimFinger> = hand
+        .finger_list
+        .iter()
+        .zip(&pose.theta_deg)
+        .zip(&start.open_bend_rad)
+        .map(|((f, theta), open)| {
+            let at = FingerAt {
+                finger: f,
+                theta_deg: *theta,
+                open_bend_rad: *open,
+                palm_pose: (start.origin_mm, r_palm),
+            };
+            insert_finger(&mut world, &mut hand_colliders, case, palm, &at)
+        })
+        .collect();
+    for (f, open) in fingers.iter().zip(&start.open_bend_rad) {
+        set_open(&mut world, f, *open);
+    }
+
+    let object_body = world
+        .bodies
+        .insert(RigidBodyBuilder::dynamic().can_sleep(false));
+    let object_collider = world.colliders.insert_with_parent(
+        ColliderBuilder::new(object.shape.clone())
+            .mass(mass_kg as f32)
+            .friction(friction as f32),
+        object_body,
+        &mut world.bodies,
+    );
+    Scene {
+        world,
+        palm,
+        object: object_body,
+        object_collider,
+        hand_colliders,
+        fingers,
+        lock_torque: params.joint1_lock_torque_nm as f32,
+        motor_gains: (
+            params.motor_stiffness_nm_per_rad as f32,
+            params.motor_damping_nms_per_rad as f32,
+        ),
+        reach_m: reach_mm(hand) * convert::M_PER_MM,
+        object_radius_m: object_radius_m(object),
+    }
+}
+
+/// An empty world, gravity off, with the integration parameters of the check.
+fn new_world(params: &SimParams) -> PhysicsWorld {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::ZERO;
     let ip = &mut world.integration_parameters;
@@ -494,187 +478,159 @@ pub fn build(case: &Case) -> Scene {
     let hz = params.contact_stiffness_hz as f32;
     ip.contact_softness = SpringCoefficients::new(hz, 10.0);
     ip.static_contact_softness = SpringCoefficients::new(hz, 10.0);
+    world
+}
 
-    let r_palm = palm_rotation(pose);
-    let start = start(case);
-    // The palm never moves during the check: a fixed body. (A kinematic body here made rapier
-    // refresh the palm's contacts irregularly: the object, pressed against the palm, sank into it
-    // for about five steps and was thrown back in one, a 0.16 mm sawtooth that ratcheted it along
-    // the fingers by 0.03 mm per period, docs/SIM.md.)
-    let palm = world
-        .bodies
-        .insert(RigidBodyBuilder::fixed().pose(convert::pose(&start.origin_mm, &r_palm)));
-    let mm = |v: f64| (v * convert::M_PER_MM) as f32;
-    let collider = |b: &HandBox| {
-        ColliderBuilder::new(b.shape())
-            .translation(convert::vector_m(&b.centre))
-            .friction(friction as f32)
-    };
-    let mut hand_colliders = vec![world.colliders.insert_with_parent(
-        collider(&palm_box(hand)),
-        palm,
-        &mut world.bodies,
-    )];
+/// The collider of a hand box, in its body's frame.
+fn hand_collider(b: &HandBox, friction: f64) -> ColliderBuilder {
+    ColliderBuilder::new(box_shape(b))
+        .translation(convert::vector_m(&b.centre))
+        .friction(friction as f32)
+}
 
-    let l1 = hand.phalanx_1.length_mm;
+/// A finger to insert: its planned angles `[deg]`, the bends it starts at `[rad]` and the
+/// palm's pose.
+struct FingerAt<'a> {
+    finger: &'a crate::hand::Finger,
+    theta_deg: [f64; 2],
+    open_bend_rad: [f64; 2],
+    palm_pose: BodyPose,
+}
+
+/// Inserts one finger's phalanx bodies, their colliders (pushed onto `hand_colliders`) and its
+/// two motored joints; the phalanges are placed open (see [`Start`]), so contact is made by
+/// closing along the planned path.
+fn insert_finger(
+    world: &mut PhysicsWorld,
+    hand_colliders: &mut Vec<ColliderHandle>,
+    case: &Case,
+    palm: RigidBodyHandle,
+    at: &FingerAt,
+) -> SimFinger {
+    let Case {
+        hand,
+        friction,
+        params,
+        ..
+    } = *case;
+    let f = at.finger;
+    let [t1, t2] = at.theta_deg;
+    let [open1, open2] = at.open_bend_rad;
     let density = params.finger_density_kg_m3 as f32;
-    let limits1 = [
-        bend(hand.joints.theta1_range_deg[1]) as f32,
-        bend(hand.joints.theta1_range_deg[0]) as f32,
-    ];
-    let limits2 = [
-        bend(hand.joints.theta2_range_deg[1]) as f32,
-        bend(hand.joints.theta2_range_deg[0]) as f32,
-    ];
-    let squeeze = params.squeeze_deg.to_radians();
-    let squeeze2 = params.squeeze2_deg.to_radians();
+    let limits = |range: [f64; 2]| [bend(range[1]) as f32, bend(range[0]) as f32];
+    let limits1 = limits(hand.joints.theta1_range_deg);
+    let limits2 = limits(hand.joints.theta2_range_deg);
     let motor = |target: f64, limits: [f32; 2]| (target as f32).clamp(limits[0], limits[1]);
-    let mut fingers = Vec::new();
-    let mut opening = Vec::new();
-    let mut joint2_handles = Vec::new();
-    let mut joint1_handles = Vec::new();
-    for ((f, [t1, t2]), [open1, open2]) in hand
-        .finger_list
-        .iter()
-        .zip(&pose.theta_deg)
-        .zip(&start.open_bend_rad)
-    {
-        let s = side_sign(f.side);
-        let (p1, p2) = phalanx_boxes(hand, s);
-        // Start open (see [`Start`]), so contact is made by closing along the planned path.
-        let [(j1, r1), (j2, r2)] =
-            finger_frames(hand, f, &start.origin_mm, &r_palm, *open1, *open2);
-        let b1 = world.bodies.insert(
-            RigidBodyBuilder::dynamic()
-                .pose(convert::pose(&j1, &r1))
-                .can_sleep(false),
-        );
-        hand_colliders.push(world.colliders.insert_with_parent(
-            collider(&p1).density(density),
-            b1,
-            &mut world.bodies,
-        ));
-        let axis = Vector::new(0.0, 0.0, s as f32);
-        let anchor1_mm = Vector3::new(
-            hand.joints.setback_mm,
-            s * hand.joints.lateral_mm,
-            f.height_mm,
-        );
-        let joint1 = RevoluteJointBuilder::new(axis)
-            .local_anchor1(convert::vector_m(&anchor1_mm))
+    let revolute = |anchor: &Vector3<f64>, limits: [f32; 2], target: f32| {
+        RevoluteJointBuilder::new(Vector::new(0.0, 0.0, f.side.sign() as f32))
+            .local_anchor1(convert::vector_m(anchor))
             .local_anchor2(Vector::ZERO)
-            .limits(limits1)
+            .limits(limits)
             .motor_model(MotorModel::ForceBased)
             .motor_position(
-                motor(bend(*t1) + squeeze, limits1),
+                target,
                 params.motor_stiffness_nm_per_rad as f32,
                 params.motor_damping_nms_per_rad as f32,
             )
             .motor_max_force(params.torque_limit_nm as f32)
-            .contacts_enabled(false);
-        if let Some(h) = world.multibody_joints.insert(palm, b1, joint1, true) {
-            joint1_handles.push(h);
-        }
-
-        let b2 = world.bodies.insert(
-            RigidBodyBuilder::dynamic()
-                .pose(convert::pose(&j2, &r2))
-                .can_sleep(false),
-        );
-        for b in &p2 {
+            .contacts_enabled(false)
+    };
+    let (p1, p2) = hand.phalanx_boxes(f.side);
+    let [(j1, r1), (j2, r2)] = hand.finger_poses(f, &at.palm_pose, [open1, open2]);
+    let mut phalanx = |world: &mut PhysicsWorld, pose: Pose, boxes: &[HandBox]| {
+        let body = world
+            .bodies
+            .insert(RigidBodyBuilder::dynamic().pose(pose).can_sleep(false));
+        for b in boxes {
             hand_colliders.push(world.colliders.insert_with_parent(
-                collider(b).density(density),
-                b2,
+                hand_collider(b, friction).density(density),
+                body,
                 &mut world.bodies,
             ));
         }
-        // Joint 2 is held at its open angle until released (see `Scene::release_joint2`).
-        let joint2 = RevoluteJointBuilder::new(axis)
-            .local_anchor1(Vector::new(0.0, s as f32 * mm(l1), 0.0))
-            .local_anchor2(Vector::ZERO)
-            .limits(limits2)
-            .motor_model(MotorModel::ForceBased)
-            .motor_position(
-                *open2 as f32,
-                params.motor_stiffness_nm_per_rad as f32,
-                params.motor_damping_nms_per_rad as f32,
-            )
-            .motor_max_force(params.torque_limit_nm as f32)
-            .contacts_enabled(false);
-        if let Some(h) = world.multibody_joints.insert(b1, b2, joint2, true) {
-            joint2_handles.push((h, motor(bend(*t2) + squeeze2, limits2)));
-        }
-        fingers.push((b1, b2, bend(*t1), bend(*t2)));
-        opening.push((b1, *open1, b2, *open2));
-    }
-    // A multibody places its links from its joint coordinates, which start at zero (every
-    // phalanx straight): set them to the open pose and move the bodies there.
-    for (b1, open1, b2, open2) in opening {
-        let Some(link) = world.multibody_joints.rigid_body_link(b1).copied() else {
-            continue;
-        };
-        let Some(mb) = world.multibody_joints.get_multibody_mut(link.multibody) else {
-            continue;
-        };
-        let mut disp = vec![0.0; mb.ndofs()];
-        for (body, angle) in [(b1, open1), (b2, open2)] {
-            if let Some(l) = mb.links().find(|l| l.rigid_body_handle() == body) {
-                disp[l.assembly_id()] = angle as f32;
-            }
-        }
-        // rapier gives every multibody angular dof a default viscous damping of 0.1 N·m·s/rad
-        // (`MultibodyJoint::default_damping`). The hand has none (the motors carry their own
-        // damping) and neither has the MJCF export: at a 0.07 N·m torque limit it capped the
-        // closing speed near 0.7 rad/s, so phalanx 2 had only just touched when gravity came on.
-        mb.damping_mut().fill(0.0);
-        mb.apply_displacements(&disp);
-        mb.forward_kinematics(&world.bodies, true);
-        mb.update_rigid_bodies(&mut world.bodies, true);
-    }
-
-    let object_body = world
-        .bodies
-        .insert(RigidBodyBuilder::dynamic().can_sleep(false));
-    let object_collider = world.colliders.insert_with_parent(
-        ColliderBuilder::new(object.shape.clone())
-            .mass(mass_kg as f32)
-            .friction(friction as f32),
-        object_body,
-        &mut world.bodies,
+        body
+    };
+    let squeeze = params.squeeze_deg.to_radians();
+    let squeeze2 = params.squeeze2_deg.to_radians();
+    // Body, colliders, joint, in this order for each phalanx: rapier's state (and so the run)
+    // depends on the order of insertion.
+    let b1 = phalanx(world, convert::pose(&j1, &r1), &[p1]);
+    let joint1 = revolute(
+        &hand.joint1_anchor_mm(f),
+        limits1,
+        motor(bend(t1) + squeeze, limits1),
     );
-    // Reach: the palm box's farthest corner, or a finger's joint 1 plus phalanx 1 plus the
-    // farthest point of phalanx 2 (or its tip) from joint 2, whichever is larger; the finger
-    // boxes are 2 × offset thick and wide.
-    let pb = palm_box(hand);
-    let mut reach_mm = (pb.centre.abs() + pb.half).norm();
-    let (o, l2) = (hand.fingers.offset_mm, hand.phalanx_2.length_mm);
+    let joint1 = world
+        .multibody_joints
+        .insert(palm, b1, joint1, true)
+        .expect("joint 1 closes no loop");
+    let b2 = phalanx(world, convert::pose(&j2, &r2), &p2);
+    // Joint 2 is held at its open angle until released (see `Scene::release_joint2`).
+    let joint2 = revolute(&hand.joint2_anchor_mm(f.side), limits2, open2 as f32);
+    let joint2 = world
+        .multibody_joints
+        .insert(b1, b2, joint2, true)
+        .expect("joint 2 closes no loop");
+    SimFinger {
+        phalanx1: b1,
+        phalanx2: b2,
+        planned_bend_rad: [bend(t1), bend(t2)],
+        joint1,
+        joint2,
+        joint2_target: motor(bend(t2) + squeeze2, limits2),
+    }
+}
+
+/// A multibody places its links from its joint coordinates, which start at zero (every
+/// phalanx straight): sets them to the open bends and moves the finger's bodies there.
+fn set_open(world: &mut PhysicsWorld, f: &SimFinger, [open1, open2]: [f64; 2]) {
+    let Some(link) = world.multibody_joints.rigid_body_link(f.phalanx1).copied() else {
+        return;
+    };
+    let Some(mb) = world.multibody_joints.get_multibody_mut(link.multibody) else {
+        return;
+    };
+    let mut disp = vec![0.0; mb.ndofs()];
+    for (body, angle) in [(f.phalanx1, open1), (f.phalanx2, open2)] {
+        if let Some(l) = mb.links().find(|l| l.rigid_body_handle() == body) {
+            disp[l.assembly_id()] = angle as f32;
+        }
+    }
+    // rapier gives every multibody angular dof a default viscous damping of 0.1 N·m·s/rad
+    // (`MultibodyJoint::default_damping`). The hand has none (the motors carry their own
+    // damping) and neither has the MJCF export: at a 0.07 N·m torque limit it capped the
+    // closing speed near 0.7 rad/s, so phalanx 2 had only just touched when gravity came on.
+    mb.damping_mut().fill(0.0);
+    mb.apply_displacements(&disp);
+    mb.forward_kinematics(&world.bodies, true);
+    mb.update_rigid_bodies(&mut world.bodies, true);
+}
+
+/// Radius about the palm origin of a sphere that holds every hand collider at any joint angle
+/// `[mm]`: the palm box's farthest corner, or a finger's joint 1 plus phalanx 1 plus the
+/// farthest point of phalanx 2 (or its tip) from joint 2, whichever is larger; the finger boxes
+/// are 2 × offset thick and wide.
+fn reach_mm(hand: &Hand) -> f64 {
+    let pb = hand.palm_box();
+    let mut reach_mm = (pb.centre.abs() + pb.half_extents).norm();
+    let (o, l1, l2) = (
+        hand.fingers.offset_mm,
+        hand.phalanx_1.length_mm,
+        hand.phalanx_2.length_mm,
+    );
     for f in &hand.finger_list {
         let anchor = Vector3::new(hand.joints.setback_mm, hand.joints.lateral_mm, f.height_mm);
         let finger = anchor.norm() + l1 + (l2 * l2 + 2.0 * o * o).sqrt();
         reach_mm = reach_mm.max(finger);
     }
-    let object_radius_m = {
-        let sphere = object.shape.compute_local_bounding_sphere();
-        let com = object.shape.mass_properties(1.0).local_com;
-        f64::from(sphere.radius() + (sphere.center() - com).length())
-    };
-    Scene {
-        world,
-        palm,
-        object: object_body,
-        object_collider,
-        hand_colliders,
-        fingers,
-        joint2: joint2_handles,
-        joint1: joint1_handles,
-        lock_torque: params.joint1_lock_torque_nm as f32,
-        motor_gains: (
-            params.motor_stiffness_nm_per_rad as f32,
-            params.motor_damping_nms_per_rad as f32,
-        ),
-        reach_m: reach_mm * convert::M_PER_MM,
-        object_radius_m,
-    }
+    reach_mm
+}
+
+/// Radius about the object's centre of mass of a sphere that holds the object `[m]`.
+fn object_radius_m(object: &ObjectShape) -> f64 {
+    let sphere = object.shape.compute_local_bounding_sphere();
+    let com = object.shape.mass_properties(1.0).local_com;
+    f64::from(sphere.radius() + (sphere.center() - com).length())
 }
 
 /// The object's centre of mass `[m]` and inertia tensor about it `[kg·m²]`, aligned frame, as the
@@ -751,8 +707,8 @@ mod tests {
         assert!(
             overlap_mm(
                 &object.shape,
-                &(s.origin_mm, palm_rotation(&pose)),
-                &[palm_box(&hand)]
+                &(s.origin_mm, palm_rotation(&pose.axes)),
+                &[hand.palm_box()]
             ) <= START_TOLERANCE_MM
         );
     }

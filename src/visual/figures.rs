@@ -3,7 +3,7 @@
 //! 4.12–4.16 (a finger's slice with palm, joints, phalanx search domains and the placed ALS).
 
 use super::svg::Plot;
-use crate::hand::{Hand, Side};
+use crate::hand::Hand;
 use crate::mesh::Mesh;
 use crate::plan::kinematics::{inward_normal, phalanx1_direction};
 use crate::plan::search::Grasp;
@@ -150,13 +150,12 @@ pub fn palm(g: &Grasp, hand: &Hand) -> String {
         o3.x * g.palm.approach_rad.cos() + o3.y * g.palm.approach_rad.sin(),
         o3.z,
     );
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
+    let [z_lo, z_hi] = hand.palm_z_range_mm();
     let corners = [
-        c + up * (h_lo - m),
-        c + up * (h_hi + m),
-        c + up * (h_hi + m) + back * hand.palm.offset_mm,
-        c + up * (h_lo - m) + back * hand.palm.offset_mm,
+        c + up * z_lo,
+        c + up * z_hi,
+        c + up * z_hi + back * hand.palm.offset_mm,
+        c + up * z_lo + back * hand.palm.offset_mm,
     ];
     let pts: Vec<(f64, f64)> = corners.iter().map(|q| (q.x, q.y)).collect();
     p.fill(&pts, PALM, 0.25, "palm-outline");
@@ -217,10 +216,7 @@ pub fn finger_planes(g: &Grasp, hand: &Hand) -> String {
 /// drawn mirrored, as the planner handles them.
 pub fn finger(g: &Grasp, hand: &Hand, mesh: &Mesh, k: usize) -> String {
     let f = &hand.finger_list[k];
-    let mirror = match f.side {
-        Side::Left => 1.0,
-        Side::Right => -1.0,
-    };
+    let mirror = f.side.sign();
     let s = slice(mesh, &g.palm.finger_plane(f.height_mm));
     let (x, y) = bounds(&s);
     let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);

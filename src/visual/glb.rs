@@ -2,8 +2,9 @@
 //! under a root node that turns grasp-sim's Z-up frame into glTF's Y-up. The JSON is built with
 //! serde_json and packed with the `gltf` crate's GLB writer; tests read it back with its reader.
 
-use crate::hand::{Hand, Side};
+use crate::hand::{bend, palm_rotation, Hand};
 use crate::mesh::Mesh;
+use crate::sim::convert::M_PER_MM;
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 
 /// One body: a triangle mesh in its own frame and its pose.
@@ -47,9 +48,9 @@ pub fn object_body(mesh: &Mesh, translation: Vector3<f64>, rotation: UnitQuatern
             .iter()
             .map(|v| {
                 [
-                    (v.x * 1e-3) as f32,
-                    (v.y * 1e-3) as f32,
-                    (v.z * 1e-3) as f32,
+                    (v.x * M_PER_MM) as f32,
+                    (v.y * M_PER_MM) as f32,
+                    (v.z * M_PER_MM) as f32,
                 ]
             })
             .collect(),
@@ -63,25 +64,21 @@ pub fn object_body(mesh: &Mesh, translation: Vector3<f64>, rotation: UnitQuatern
 /// The hand's bodies in their local frames (as in the rapier scene) with the given poses, in
 /// the order palm, then phalanx 1 and 2 of each finger.
 pub fn hand_bodies(hand: &Hand, poses: &[(Vector3<f64>, UnitQuaternion<f64>)]) -> Vec<Body> {
-    let mm = 1e-3;
+    let mm = M_PER_MM;
     let o = hand.fingers.offset_mm * mm;
-    let (h_lo, h_hi) = hand.finger_height_span();
-    let m = hand.palm.margin_mm;
+    let [z_lo, z_hi] = hand.palm_z_range_mm();
     let mut bodies = Vec::new();
     let (p, i) = cuboid(
-        [0.0, -hand.palm.half_width_mm * mm, (h_lo - m) * mm],
+        [0.0, -hand.palm.half_width_mm * mm, z_lo * mm],
         [
             hand.palm.offset_mm * mm,
             hand.palm.half_width_mm * mm,
-            (h_hi + m) * mm,
+            z_hi * mm,
         ],
     );
     bodies.push(("palm".to_string(), p, i, [0.2, 0.4, 0.8, 1.0]));
     for f in &hand.finger_list {
-        let s = match f.side {
-            Side::Left => 1.0,
-            Side::Right => -1.0,
-        };
+        let s = f.side.sign();
         for (j, len) in [(1, hand.phalanx_1.length_mm), (2, hand.phalanx_2.length_mm)] {
             let y = s * len * mm;
             let (p, i) = cuboid([-o, y.min(0.0), -o], [o, y.max(0.0), o]);
@@ -115,31 +112,11 @@ pub fn planned_poses(
     axes: &[Vector3<f64>; 3],
     theta_deg: &[[f64; 2]],
 ) -> Vec<(Vector3<f64>, UnitQuaternion<f64>)> {
-    let r_palm = UnitQuaternion::from_rotation_matrix(&nalgebra::Rotation3::from_matrix_unchecked(
-        nalgebra::Matrix3::from_columns(axes),
-    ));
-    let mut out = vec![(origin_mm.coords * 1e-3, r_palm)];
-    for (f, [t1, t2]) in hand.finger_list.iter().zip(theta_deg) {
-        let s = match f.side {
-            Side::Left => 1.0,
-            Side::Right => -1.0,
-        };
-        let turn = |t: f64| {
-            UnitQuaternion::from_axis_angle(&Vector3::z_axis(), s * (180.0 - t).to_radians())
-        };
-        let anchor = Vector3::new(
-            hand.joints.setback_mm,
-            s * hand.joints.lateral_mm,
-            f.height_mm,
-        );
-        let r1 = r_palm * turn(*t1);
-        let j1 = origin_mm.coords + r_palm * anchor;
-        let r2 = r1 * turn(*t2);
-        let j2 = j1 + r1 * Vector3::new(0.0, s * hand.phalanx_1.length_mm, 0.0);
-        out.push((j1 * 1e-3, r1));
-        out.push((j2 * 1e-3, r2));
-    }
-    out
+    let bends: Vec<[f64; 2]> = theta_deg.iter().map(|t| t.map(bend)).collect();
+    hand.body_poses(&(*origin_mm, palm_rotation(axes)), &bends)
+        .into_iter()
+        .map(|(p, r)| (p.coords * M_PER_MM, r))
+        .collect()
 }
 
 /// The scene as GLB bytes.

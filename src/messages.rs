@@ -1,0 +1,132 @@
+//! Messages shared by the parsers of scenario and hand files: I/O errors in a few stable words,
+//! TOML errors as one line with its line number, and "did you mean" suggestions for mistyped
+//! keys. (Its own module so that `hand` and `scenario` need not import each other.)
+
+/// `[("section.field", value), ...]` for the named fields of `$s`: each key is the field's own
+/// name, as serde reads it from the file, so a message cannot name a key the file does not have.
+macro_rules! keyed {
+    ($section:literal, $s:expr; $($field:ident),+ $(,)?) => {
+        [$((concat!($section, ".", stringify!($field)), $s.$field)),+]
+    };
+}
+pub(crate) use keyed;
+
+/// A short, stable description of an I/O error.
+pub(crate) fn io_message(e: &std::io::Error) -> String {
+    match e.kind() {
+        std::io::ErrorKind::NotFound => "no such file".to_string(),
+        std::io::ErrorKind::PermissionDenied => "permission denied".to_string(),
+        std::io::ErrorKind::InvalidData => "not UTF-8 text".to_string(),
+        _ => e.to_string(),
+    }
+}
+
+/// The top-level sections of a scenario, for naming a missing one.
+const SECTIONS: [&str; 5] = ["object", "hand", "planner", "sim", "expect"];
+
+/// One line from a TOML error: `line N: `the line`: message`. A missing section is named
+/// as such rather than pinned on line 1.
+pub(crate) fn toml_message(e: &toml::de::Error, text: &str) -> String {
+    let message = with_suggestion(&e.message().replace('\n', " "));
+    if let Some(field) = message
+        .strip_prefix("missing field `")
+        .and_then(|m| m.strip_suffix('`'))
+    {
+        let at_top = e.span().is_none_or(|s| s.start == 0);
+        if at_top && SECTIONS.contains(&field) {
+            return format!("missing section `[{field}]`");
+        }
+    }
+    match e.span() {
+        Some(span) => {
+            let start = span.start.min(text.len());
+            let line_no = text[..start].matches('\n').count() + 1;
+            let line = text.lines().nth(line_no - 1).unwrap_or("").trim();
+            if line.is_empty() {
+                format!("line {line_no}: {message}")
+            } else {
+                format!("line {line_no} (`{line}`): {message}")
+            }
+        }
+        None => message,
+    }
+}
+
+/// `message` with "; did you mean `key`?" appended when it is serde's "unknown field `x`,
+/// expected one of `a`, `b`, ..." (or "expected `a`") and one known key is close to `x`.
+pub(crate) fn with_suggestion(message: &str) -> String {
+    let Some(rest) = message.strip_prefix("unknown field `") else {
+        return message.to_string();
+    };
+    let Some((unknown, expected)) = rest.split_once('`') else {
+        return message.to_string();
+    };
+    let known: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
+    match did_you_mean(unknown, known) {
+        Some(k) => format!("{message}; did you mean `{k}`?"),
+        None => message.to_string(),
+    }
+}
+
+/// The known key nearest to `unknown` by edit distance (case-insensitive), when it is close
+/// enough to be a typo: at most a third of the longer name's characters differ (at least 1,
+/// at most 3). The first of equally near keys wins, so the answer is deterministic.
+pub(crate) fn did_you_mean<'a>(
+    unknown: &str,
+    known: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
+    let u = unknown.to_lowercase();
+    let mut best: Option<(usize, &'a str)> = None;
+    for k in known {
+        let d = edit_distance(&u, &k.to_lowercase());
+        let limit = (u.chars().count().max(k.chars().count()) / 3).clamp(1, 3);
+        if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, k));
+        }
+    }
+    best.map(|(_, k)| k)
+}
+
+/// Levenshtein distance (insertions, deletions, substitutions), with a swap of two adjacent
+/// characters counted as one edit (Damerau, optimal string alignment): `lenght` → `length` is 1.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let cost = usize::from(a[i - 1] != b[j - 1]);
+            let mut v = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                v = v.min(d[i - 2][j - 2] + 1);
+            }
+            d[i][j] = v;
+        }
+    }
+    d[a.len()][b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{did_you_mean, edit_distance};
+
+    #[test]
+    fn near_keys_are_suggested_and_far_ones_not() {
+        assert_eq!(edit_distance("lenght", "length"), 1);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("planer", "planner"), 1);
+        let keys = ["mesh", "units", "density_kg_m3", "mass_kg", "friction"];
+        assert_eq!(did_you_mean("densty_kg_m3", keys), Some("density_kg_m3"));
+        assert_eq!(did_you_mean("Units", keys), Some("units"));
+        assert_eq!(did_you_mean("colour", keys), None);
+        assert_eq!(did_you_mean("", keys), None);
+    }
+}

@@ -1,0 +1,127 @@
+//! The planner's parameters (thesis chapter 3), as a scenario's `[planner]` table gives them,
+//! and their validation against the hand. Units in the names: millimetres and degrees.
+
+use crate::hand::Hand;
+use crate::messages::keyed;
+use serde::Deserialize;
+
+/// Planner parameters (thesis chapter 3); defaults reproduce the thesis.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct PlannerParams {
+    /// HeightStep between indexed elevations `[mm]`; must divide the finger gap (3.4.2).
+    pub height_step_mm: f64,
+    /// AngularStep between vertical slices and approach angles `[deg]`; must divide 360.
+    pub angular_step_deg: f64,
+    /// Curvature significance factor Sf_c; Sf_t = 1 − Sf_c (eq. 3.4).
+    pub sf_c: f64,
+    /// Vertical Deviation Range: slopes within ± this count as vertical `[deg]` (3.4.3.1).
+    pub vertical_deviation_deg: f64,
+    /// Segments counted before and after a touch point for the angular trend (3.4.3.1).
+    pub curvature_segments: usize,
+    /// Magnify_Factor: the thesis's largest graspable diameter is this × the smallest (eq. 3.3).
+    pub magnify_factor: f64,
+    /// Joint Angular Deviation for joint 1 between a finger's ALS `[deg]` (Table 3.2).
+    pub joint_deviation_theta1_deg: f64,
+    /// Joint Angular Deviation for joint 2 `[deg]` (Table 3.2).
+    pub joint_deviation_theta2_deg: f64,
+    /// Largest palm pitch tried either way when placing the palm `[deg]` (3.5.2).
+    pub pitch_range_deg: f64,
+}
+
+impl Default for PlannerParams {
+    fn default() -> Self {
+        PlannerParams {
+            height_step_mm: 2.5,
+            angular_step_deg: 10.0,
+            sf_c: 0.6,
+            vertical_deviation_deg: 12.0,
+            curvature_segments: 3,
+            magnify_factor: 9.0,
+            joint_deviation_theta1_deg: 5.0,
+            joint_deviation_theta2_deg: 5.0,
+            pitch_range_deg: 20.0,
+        }
+    }
+}
+
+impl PlannerParams {
+    /// Checks the parameters against the hand and the friction: the key and the problem of the
+    /// first one out of range (a scenario reports it with its file, the tuner skips the setting).
+    ///
+    /// # Errors
+    /// `(key, problem)`.
+    pub fn validate(&self, hand: &Hand, friction: f64) -> Result<(), (&'static str, String)> {
+        let p = self;
+        let step = p.height_step_mm;
+        if !(step.is_finite() && step > 0.0) {
+            return Err((
+                "planner.height_step_mm",
+                format!("must be positive, got {step}"),
+            ));
+        }
+        let ratio = hand.fingers.gap_mm / step;
+        if (ratio - ratio.round()).abs() > 1e-9 * ratio.max(1.0) {
+            return Err((
+                "planner.height_step_mm",
+                format!(
+                    "must divide the finger gap of {} mm evenly (thesis 3.4.2), got {step}",
+                    hand.fingers.gap_mm
+                ),
+            ));
+        }
+        // Every finger must sit on an indexed elevation when Finger_1 does (thesis 3.4.4.2).
+        let top = hand.finger_list[0].height_mm;
+        for f in &hand.finger_list[1..] {
+            let k = (top - f.height_mm) / step;
+            if (k - k.round()).abs() > 1e-9 * k.abs().max(1.0) {
+                return Err((
+                    "planner.height_step_mm",
+                    format!(
+                        "must divide the height difference of finger_1 and {} ({} mm), got {step}",
+                        f.name,
+                        top - f.height_mm
+                    ),
+                ));
+            }
+        }
+        let a = p.angular_step_deg;
+        let turns = 360.0 / a;
+        if !(a.is_finite() && a > 0.0 && a <= 360.0 && (turns - turns.round()).abs() < 1e-9) {
+            return Err((
+                "planner.angular_step_deg",
+                format!("must divide 360 evenly (thesis 3.5), got {a}"),
+            ));
+        }
+        if !(0.0..=1.0).contains(&p.sf_c) {
+            return Err(("planner.sf_c", format!("must be in [0, 1], got {}", p.sf_c)));
+        }
+        let friction_cone_deg = friction.atan().to_degrees();
+        if !(p.vertical_deviation_deg >= 0.0 && p.vertical_deviation_deg < friction_cone_deg) {
+            return Err((
+                "planner.vertical_deviation_deg",
+                format!(
+                    "must be in [0, {friction_cone_deg:.1}) (below the friction cone of mu = {}), got {}",
+                    friction, p.vertical_deviation_deg
+                ),
+            ));
+        }
+        if p.curvature_segments == 0 {
+            return Err((
+                "planner.curvature_segments",
+                "must be at least 1".to_string(),
+            ));
+        }
+        for (key, v) in keyed!("planner", p;
+            magnify_factor,
+            joint_deviation_theta1_deg,
+            joint_deviation_theta2_deg,
+            pitch_range_deg,
+        ) {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err((key, format!("must be zero or positive, got {v}")));
+            }
+        }
+        Ok(())
+    }
+}
