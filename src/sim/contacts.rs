@@ -37,15 +37,11 @@ pub fn grip_contacts(scene: &Scene) -> Vec<GripContact> {
         if body == scene.palm {
             return Some((None, 0));
         }
-        scene
-            .fingers
-            .iter()
-            .enumerate()
-            .find_map(|(i, &(b1, b2, _, _))| {
-                (body == b1)
-                    .then_some((Some(i), 1))
-                    .or((body == b2).then_some((Some(i), 2)))
-            })
+        scene.fingers.iter().enumerate().find_map(|(i, f)| {
+            (body == f.phalanx1)
+                .then_some((Some(i), 1))
+                .or((body == f.phalanx2).then_some((Some(i), 2)))
+        })
     };
     let mut out = Vec::new();
     for pair in world.narrow_phase.contact_pairs_with(scene.object_collider) {
