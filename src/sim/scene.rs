@@ -677,38 +677,37 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_palm_inside_the_collider_starts_backed_off() {
-        let hand = thesis_hand();
-        let object = box_shape();
-        let params = SimParams::default();
-        // Flush on the face: nothing to do.
-        let pose = hand_at(-20.0, [120.0, 120.0]);
-        let case = Case {
+    /// Where the thesis hand at `pose` starts on the box, with the default parameters.
+    fn start_on_box(pose: &SimHand) -> Start {
+        let (hand, object, params) = (thesis_hand(), box_shape(), SimParams::default());
+        start(&Case {
             hand: &hand,
-            pose: &pose,
+            pose,
             object: &object,
             mass_kg: 0.1,
             friction: 0.5,
             params: &params,
-        };
-        let s = start(&case);
+        })
+    }
+
+    #[test]
+    fn a_palm_inside_the_collider_starts_backed_off() {
+        // Flush on the face: nothing to do.
+        let pose = hand_at(-20.0, [120.0, 120.0]);
+        let s = start_on_box(&pose);
         assert_eq!(s.palm_backoff_mm, 0.0);
         assert_eq!(s.origin_mm, pose.origin_mm);
         // 3 mm inside: backed off by the depth plus the tolerance, along palm x.
         let pose = hand_at(-17.0, [120.0, 120.0]);
-        let s = start(&Case {
-            pose: &pose,
-            ..case
-        });
+        let s = start_on_box(&pose);
         assert!((s.palm_backoff_mm - 3.1).abs() < 1e-3, "{s:?}");
         assert!((s.origin_mm.x + 20.1).abs() < 1e-3, "{s:?}");
         assert_eq!((s.origin_mm.y, s.origin_mm.z), (0.0, 40.0));
         assert!(
             overlap_mm(
-                &object.shape,
+                &box_shape().shape,
                 &(s.origin_mm, palm_rotation(&pose.axes)),
-                &[hand.palm_box()]
+                &[thesis_hand().palm_box()]
             ) <= START_TOLERANCE_MM
         );
     }
@@ -717,18 +716,7 @@ mod tests {
     fn a_finger_that_cannot_start_clear_is_reported() {
         // A 100 mm wide face: the fingers' planes (36.7 mm either side of the palm's centre) cut
         // the box, and even fully open (45° bend) phalanx 1 starts inside it.
-        let hand = thesis_hand();
-        let object = box_shape();
-        let params = SimParams::default();
-        let pose = hand_at(-20.0, [120.0, 120.0]);
-        let s = start(&Case {
-            hand: &hand,
-            pose: &pose,
-            object: &object,
-            mass_kg: 0.1,
-            friction: 0.5,
-            params: &params,
-        });
+        let s = start_on_box(&hand_at(-20.0, [120.0, 120.0]));
         assert!(s.penetration_mm > 10.0, "{s:?}");
         assert_eq!(s.open_margin_deg, vec![20.0; 3]);
     }
