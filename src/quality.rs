@@ -660,6 +660,37 @@ mod tests {
         assert!(!q.force_closure);
     }
 
+    /// The quality of contacts `c` with the object and the grasp turned by `rot` and moved by
+    /// `shift` together.
+    fn evaluate_moved(
+        c: &[Contact],
+        params: &QualityParams,
+        rot: nalgebra::UnitQuaternion<f64>,
+        shift: Vector3<f64>,
+    ) -> Quality {
+        let moved: Vec<Contact> = c
+            .iter()
+            .map(|k| Contact {
+                point_mm: (rot * Point3::from(k.point_mm) + shift).into(),
+                normal: (rot * Vector3::from(k.normal)).into(),
+                ..k.clone()
+            })
+            .collect();
+        evaluate(
+            "planned",
+            moved,
+            &QualityParams {
+                centroid_mm: rot * params.centroid_mm + shift,
+                ..*params
+            },
+        )
+    }
+
+    /// Relative difference of `b` from `a`.
+    fn rel(a: f64, b: f64) -> f64 {
+        (a - b).abs() / a.abs().max(1e-12)
+    }
+
     #[test]
     fn epsilon_is_invariant_under_moving_object_and_grasp_together() {
         // A translation leaves every wrench as it is: equal to round-off, L-infinity too.
@@ -667,22 +698,7 @@ mod tests {
         let params = sphere_params(0.4);
         let q0 = evaluate("planned", c.clone(), &params);
         let shift = Vector3::new(120.0, -35.0, 7.5);
-        let moved: Vec<Contact> = c
-            .iter()
-            .map(|k| Contact {
-                point_mm: (Point3::from(k.point_mm) + shift).into(),
-                ..k.clone()
-            })
-            .collect();
-        let q1 = evaluate(
-            "planned",
-            moved,
-            &QualityParams {
-                centroid_mm: params.centroid_mm + shift,
-                ..params
-            },
-        );
-        let rel = |a: f64, b: f64| (a - b).abs() / a.abs().max(1e-12);
+        let q1 = evaluate_moved(&c, &params, nalgebra::UnitQuaternion::identity(), shift);
         assert!(
             rel(q0.epsilon, q1.epsilon) < 1e-9,
             "{} vs {}",
@@ -711,24 +727,7 @@ mod tests {
         };
         let q0 = evaluate("planned", c.clone(), &params);
         let rot = nalgebra::UnitQuaternion::from_euler_angles(0.3, -1.2, 2.5);
-        let shift = Vector3::new(120.0, -35.0, 7.5);
-        let moved: Vec<Contact> = c
-            .iter()
-            .map(|k| Contact {
-                point_mm: (rot * Point3::from(k.point_mm) + shift).into(),
-                normal: (rot * Vector3::from(k.normal)).into(),
-                ..k.clone()
-            })
-            .collect();
-        let q1 = evaluate(
-            "planned",
-            moved,
-            &QualityParams {
-                centroid_mm: rot * params.centroid_mm + shift,
-                ..params
-            },
-        );
-        let rel = |a: f64, b: f64| (a - b).abs() / a.abs().max(1e-12);
+        let q1 = evaluate_moved(&c, &params, rot, Vector3::new(120.0, -35.0, 7.5));
         assert!(
             rel(q0.epsilon, q1.epsilon) < 5e-3,
             "{} vs {}",
