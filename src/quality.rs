@@ -379,14 +379,16 @@ pub fn planned_contacts(
             (0.0, &placed.centre),
             (-o, &placed.bottom),
         ] {
-            let Some(contacts) = als.contacts else {
-                continue;
-            };
             let plane = palm.finger_plane(f.height_mm + dz);
-            for (k, (p, n)) in contacts.iter().enumerate() {
+            for (k, (p, n)) in als
+                .contacts
+                .iter()
+                .enumerate()
+                .filter_map(|(k, c)| Some((k, (*c)?)))
+            {
                 let n3 = plane.u * n.x + plane.v * n.y;
                 out.push(Contact {
-                    point_mm: plane.to_3d(p).into(),
+                    point_mm: plane.to_3d(&p).into(),
                     normal: n3.into(),
                     finger: placed.name.clone(),
                     phalanx: k as u8 + 1,

@@ -124,7 +124,7 @@ pub fn select(
     let collect = p.collect.max(1);
     let mut aligned_cache: Vec<Option<AlignedObject>> = vec![None; GraspAxis::SEARCH_ORDER.len()];
     for rules in [RuleSet::Thesis, RuleSet::Extended] {
-        if rules == RuleSet::Extended && !wants_extended(&sel, p) {
+        if rules == RuleSet::Extended && (!p.planner.extended_rules || !wants_extended(&sel, p)) {
             break;
         }
         for (k, axis) in GraspAxis::SEARCH_ORDER.iter().enumerate() {

@@ -41,9 +41,10 @@ pub struct AlsAngles {
     pub gap_mm: f64,
     /// Where phalanx 1 and phalanx 2 touch, in the finger slice plane's 2D coordinates
     /// `[mm]`, each with the unit direction in which the phalanx pushes (its contact surface's
-    /// inward normal); `None` for an ALS reported with its finger's angles because it met
-    /// nothing (extended rules).
-    pub contacts: Option<[(Point2<f64>, Vector2<f64>); 2]>,
+    /// inward normal), phalanx 1 then phalanx 2; `None` for a phalanx that touches nothing: both
+    /// for an ALS reported with its finger's angles because it met nothing, phalanx 1 for an ALS
+    /// placed by [`place_als_distal`] (extended rules).
+    pub contacts: [Option<(Point2<f64>, Vector2<f64>)>; 2],
 }
 
 /// A positioned finger: its three ALS.
@@ -84,7 +85,9 @@ pub enum FingerRejection {
 
 /// Positions finger `k` of `hand` on a placed palm: all three ALS and their agreement.
 ///
-/// Under [`RuleSet::Extended`], an ALS that meets nothing is allowed while another touches
+/// Under [`RuleSet::Extended`], an ALS whose phalanx 1 meets nothing closes until phalanx 2
+/// touches ([`place_als_distal`], [`Relaxation::DistalContactOnly`]; if that fails too, the ALS
+/// counts as meeting nothing), an ALS that meets nothing is allowed while another touches
 /// ([`Relaxation::AlsOffObject`]), and the finger stops where its first ALS touches: its most
 /// open θ1 and θ2 over the ALS that touch, with a deviation beyond the Joint Angular Deviation
 /// recorded ([`Relaxation::JointDeviationRecorded`]) instead of rejected. An ALS off the object
@@ -102,7 +105,12 @@ pub fn place_finger(
     let mirror = f.side.sign();
     let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
         let s = slice(mesh, &palm.finger_plane(f.height_mm + dz)).bridged(2.0 * o);
-        place_als(&s, hand, mirror)
+        match place_als(&s, hand, mirror) {
+            Err(e) if rules == RuleSet::Extended && e != FingerRejection::PalmPenetration => {
+                place_als_distal(&s, hand, mirror).map_err(|_| e)
+            }
+            placed => placed,
+        }
     };
     if rules == RuleSet::Extended {
         return place_finger_extended(f.name.clone(), [als(0.0), als(o), als(-o)], deviation_deg);
@@ -147,6 +155,9 @@ fn place_finger_extended(
         }
     }
     let touching: Vec<&AlsAngles> = als.iter().filter_map(|r| r.as_ref().ok()).collect();
+    if touching.iter().any(|a| a.contacts[0].is_none()) {
+        relaxations.push(Relaxation::DistalContactOnly);
+    }
     let first = touching
         .iter()
         .copied()
@@ -158,7 +169,7 @@ fn place_finger_extended(
         .fold(f64::NEG_INFINITY, f64::max);
     let finger = AlsAngles {
         theta2_deg: theta2,
-        contacts: als[0].as_ref().ok().and_then(|a| a.contacts),
+        contacts: als[0].as_ref().map_or([None, None], |a| a.contacts),
         ..*first
     };
     if touching.iter().any(|a| {
@@ -172,7 +183,7 @@ fn place_finger_extended(
     let pick = |r: &Result<AlsAngles, FingerRejection>| match r {
         Ok(a) => *a,
         Err(_) => AlsAngles {
-            contacts: None,
+            contacts: [None, None],
             ..finger
         },
     };
@@ -185,85 +196,87 @@ fn place_finger_extended(
     })
 }
 
-/// Places one ALS on its finger slice plane. `mirror` is +1 for a left finger (joint at +y) and
-/// −1 for a right one (the contour is mirrored so the finger is handled as a left one).
-pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, FingerRejection> {
-    let o = hand.fingers.offset_mm;
-    let segments: Vec<(Point2<f64>, Point2<f64>)> = s
-        .contours
-        .iter()
-        .flat_map(|c| {
-            (0..c.segment_count()).map(move |i| {
-                let (a, b) = c.segment(i);
-                (
-                    Point2::new(a.x, mirror * a.y),
-                    Point2::new(b.x, mirror * b.y),
-                )
+/// One finger slice plane, ready for the phalanges: the contour's segments in the palm's 2D
+/// frame (mirrored for a right finger) and the Gap Space.
+struct FingerPlane {
+    segments: Vec<(Point2<f64>, Point2<f64>)>,
+    gap_mm: f64,
+    mirror: f64,
+}
+
+impl FingerPlane {
+    /// The plane's segments, with the palm's outline checked (step 1).
+    fn new(s: &Slice, hand: &Hand, mirror: f64) -> Result<FingerPlane, FingerRejection> {
+        let segments: Vec<(Point2<f64>, Point2<f64>)> = s
+            .contours
+            .iter()
+            .flat_map(|c| {
+                (0..c.segment_count()).map(move |i| {
+                    let (a, b) = c.segment(i);
+                    (
+                        Point2::new(a.x, mirror * a.y),
+                        Point2::new(b.x, mirror * b.y),
+                    )
+                })
             })
-        })
-        .collect();
-
-    // Gap Space and the palm's outline in this plane.
-    let hw = hand.palm.half_width_mm;
-    let palm = ConvexPolygon::new(vec![
-        Point2::new(0.0, -hw),
-        Point2::new(hand.palm.offset_mm, -hw),
-        Point2::new(hand.palm.offset_mm, hw),
-        Point2::new(0.0, hw),
-    ]);
-    if segments
-        .iter()
-        .any(|(a, b)| palm.is_penetrated_by(*a, *b, PENETRATION_TOL_MM))
-    {
-        return Err(FingerRejection::PalmPenetration);
-    }
-    let gap_mm = -segments
-        .iter()
-        .flat_map(|(a, _)| [*a])
-        .filter(|p| p.y.abs() <= hw)
-        .map(|p| p.x)
-        .fold(f64::NEG_INFINITY, f64::max);
-
-    // Phalanx 1.
-    let p1 = &hand.phalanx_1;
-    let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
-    let usable1 = (
-        p1.unusable_proximal_mm,
-        p1.length_mm - p1.unusable_distal_mm,
-    );
-    let reach1 = usable1.1.hypot(o);
-    let straight1 = phalanx1_direction(PI);
-    let domain1: Vec<Point2<f64>> = segments
-        .iter()
-        .map(|(a, _)| *a)
-        .filter(|p| (p - j1).norm() <= reach1)
-        .collect();
-    let (bend1, along1) = first_contact(&domain1, j1, straight1, usable1, o)
-        .ok_or(FingerRejection::Phalanx1NoContact)?;
-    let theta1 = 180.0 - bend1.to_degrees();
-    let [lo1, hi1] = hand.joints.theta1_range_deg;
-    if !(lo1..=hi1).contains(&theta1) {
-        return Err(FingerRejection::Theta1OutOfRange);
-    }
-    let d1 = Rotation2::new(bend1) * straight1;
-    let body1 = ConvexPolygon::strip(j1, d1, p1.length_mm, -o, o);
-    if segments
-        .iter()
-        .any(|(a, b)| body1.is_penetrated_by(*a, *b, PENETRATION_TOL_MM))
-    {
-        return Err(FingerRejection::Phalanx1Penetration);
+            .collect();
+        let hw = hand.palm.half_width_mm;
+        let palm = ConvexPolygon::new(vec![
+            Point2::new(0.0, -hw),
+            Point2::new(hand.palm.offset_mm, -hw),
+            Point2::new(hand.palm.offset_mm, hw),
+            Point2::new(0.0, hw),
+        ]);
+        let plane = FingerPlane {
+            gap_mm: -segments
+                .iter()
+                .map(|(a, _)| *a)
+                .filter(|p| p.y.abs() <= hw)
+                .map(|p| p.x)
+                .fold(f64::NEG_INFINITY, f64::max),
+            segments,
+            mirror,
+        };
+        if plane.hits(&palm) {
+            return Err(FingerRejection::PalmPenetration);
+        }
+        Ok(plane)
     }
 
-    // Phalanx 2, with segments cut at its domain's border.
+    /// True if the object takes in part of `poly`.
+    fn hits(&self, poly: &ConvexPolygon) -> bool {
+        self.segments
+            .iter()
+            .any(|(a, b)| poly.is_penetrated_by(*a, *b, PENETRATION_TOL_MM))
+    }
+
+    /// A contact on a contact line in the palm's frame, mirrored back to the plane's.
+    fn unmirror(&self, p: Point2<f64>, n: Vector2<f64>) -> (Point2<f64>, Vector2<f64>) {
+        (
+            Point2::new(p.x, self.mirror * p.y),
+            Vector2::new(n.x, self.mirror * n.y),
+        )
+    }
+}
+
+/// Phalanx 2 closing about joint 2 at `j2`, phalanx 1 pointing along `d1` (step 3): its
+/// contact's θ2 `[deg]`, the contact point and its inward normal, and whether it is a tip
+/// contact.
+fn place_phalanx2(
+    plane: &FingerPlane,
+    hand: &Hand,
+    j2: Point2<f64>,
+    d1: Vector2<f64>,
+) -> Result<(f64, Point2<f64>, Vector2<f64>, bool), FingerRejection> {
+    let o = hand.fingers.offset_mm;
     let p2 = &hand.phalanx_2;
-    let j2 = j1 + d1 * p1.length_mm;
     let usable2 = (
         p2.unusable_proximal_mm,
         p2.length_mm - p2.unusable_distal_mm,
     );
     let reach2 = usable2.1.hypot(o);
     let mut domain2: Vec<Point2<f64>> = Vec::new();
-    for (a, b) in &segments {
+    for (a, b) in &plane.segments {
         if (a - j2).norm() <= reach2 {
             domain2.push(*a);
         }
@@ -287,33 +300,105 @@ pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, Finge
         j2 + e * p2.length_mm + n_e * tip_front,
         j2 + e * usable2.1 + n_e * o,
     ]);
-    let hits = |poly: &ConvexPolygon| {
-        segments
-            .iter()
-            .any(|(a, b)| poly.is_penetrated_by(*a, *b, PENETRATION_TOL_MM))
-    };
-    if hits(&body2) || (p2.length_mm > usable2.1 && hits(&tip)) {
+    if plane.hits(&body2) || (p2.length_mm > usable2.1 && plane.hits(&tip)) {
         return Err(FingerRejection::Phalanx2Penetration);
     }
     let is_tip_contact = along2 >= usable2.1 - 1e-6;
+    Ok((theta2, j2 + e * along2 + n_e * o, n_e, is_tip_contact))
+}
+
+/// Places one ALS on its finger slice plane. `mirror` is +1 for a left finger (joint at +y) and
+/// −1 for a right one (the contour is mirrored so the finger is handled as a left one).
+pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, FingerRejection> {
+    let plane = FingerPlane::new(s, hand, mirror)?;
+    let o = hand.fingers.offset_mm;
+
+    // Phalanx 1.
+    let p1 = &hand.phalanx_1;
+    let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
+    let usable1 = (
+        p1.unusable_proximal_mm,
+        p1.length_mm - p1.unusable_distal_mm,
+    );
+    let reach1 = usable1.1.hypot(o);
+    let straight1 = phalanx1_direction(PI);
+    let domain1: Vec<Point2<f64>> = plane
+        .segments
+        .iter()
+        .map(|(a, _)| *a)
+        .filter(|p| (p - j1).norm() <= reach1)
+        .collect();
+    let (bend1, along1) = first_contact(&domain1, j1, straight1, usable1, o)
+        .ok_or(FingerRejection::Phalanx1NoContact)?;
+    let theta1 = 180.0 - bend1.to_degrees();
+    let [lo1, hi1] = hand.joints.theta1_range_deg;
+    if !(lo1..=hi1).contains(&theta1) {
+        return Err(FingerRejection::Theta1OutOfRange);
+    }
+    let d1 = Rotation2::new(bend1) * straight1;
+    if plane.hits(&ConvexPolygon::strip(j1, d1, p1.length_mm, -o, o)) {
+        return Err(FingerRejection::Phalanx1Penetration);
+    }
+
+    // Phalanx 2, with segments cut at its domain's border.
+    let (theta2, c2, n2, is_tip_contact) =
+        place_phalanx2(&plane, hand, j1 + d1 * p1.length_mm, d1)?;
     // The contacts on the contact lines, a finger offset inside the centrelines, mirrored back.
     let n_d1 = inward_normal(&d1);
-    let unmirror = |p: Point2<f64>, n: Vector2<f64>| {
-        (
-            Point2::new(p.x, mirror * p.y),
-            Vector2::new(n.x, mirror * n.y),
-        )
-    };
     Ok(AlsAngles {
         theta1_deg: theta1,
         theta2_deg: theta2,
         is_tip_contact,
-        gap_mm,
-        contacts: Some([
-            unmirror(j1 + d1 * along1 + n_d1 * o, n_d1),
-            unmirror(j2 + e * along2 + n_e * o, n_e),
-        ]),
+        gap_mm: plane.gap_mm,
+        contacts: [
+            Some(plane.unmirror(j1 + d1 * along1 + n_d1 * o, n_d1)),
+            Some(plane.unmirror(c2, n2)),
+        ],
     })
+}
+
+/// Joint 1's step while a finger whose phalanx 1 meets nothing closes `[deg]`.
+const DISTAL_STEP_DEG: f64 = 0.25;
+
+/// An ALS whose phalanx 1 meets nothing (the extended rules'
+/// [`Relaxation::DistalContactOnly`]): joint 1 closes from its most open angle in
+/// [`DISTAL_STEP_DEG`] steps and, at each, phalanx 2 closes from straight; the ALS stops at the
+/// first joint-1 angle at which phalanx 2 meets the object within joint 2's range (a contact
+/// beyond the range is passed over, closing on). Phalanx 1's body meeting the object first, or
+/// phalanx 2's body or tip inside it at its contact, is a rejection. This is a thin object pinched by the fingertips with the palm on its narrow face
+/// (a book held by its spine): phalanx 1 reaches past it and only phalanx 2 can come back to it.
+pub fn place_als_distal(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, FingerRejection> {
+    let plane = FingerPlane::new(s, hand, mirror)?;
+    let o = hand.fingers.offset_mm;
+    let p1 = &hand.phalanx_1;
+    let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
+    let [lo1, hi1] = hand.joints.theta1_range_deg;
+    let steps = ((hi1 - lo1) / DISTAL_STEP_DEG).floor() as usize;
+    let mut last = FingerRejection::Phalanx2NoContact;
+    for k in 0..=steps {
+        let theta1 = hi1 - k as f64 * DISTAL_STEP_DEG;
+        let d1 = phalanx1_direction(theta1.to_radians());
+        if plane.hits(&ConvexPolygon::strip(j1, d1, p1.length_mm, -o, o)) {
+            return Err(FingerRejection::Phalanx1Penetration);
+        }
+        match place_phalanx2(&plane, hand, j1 + d1 * p1.length_mm, d1) {
+            Ok((theta2, c2, n2, is_tip_contact)) => {
+                return Ok(AlsAngles {
+                    theta1_deg: theta1,
+                    theta2_deg: theta2,
+                    is_tip_contact,
+                    gap_mm: plane.gap_mm,
+                    contacts: [None, Some(plane.unmirror(c2, n2))],
+                })
+            }
+            Err(FingerRejection::Theta2OutOfRange) => {
+                last = FingerRejection::Theta2OutOfRange;
+            }
+            Err(FingerRejection::Phalanx2NoContact) => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Err(last)
 }
 
 /// The smallest bend from `straight` (radians, counter-clockwise, in [0, π]) at which the
@@ -403,6 +488,45 @@ mod tests {
                 assert!(als.is_tip_contact, "finger {k}");
                 assert_eq!(als.gap_mm, 0.0, "finger {k}");
             }
+        }
+    }
+
+    #[test]
+    fn a_thin_box_is_pinched_by_phalanx_2_where_its_reach_first_meets_the_face() {
+        // The palm on the 30 mm face of a 100 x 30 mm box (x in [-100, 0], |y| <= 15 in the
+        // palm's frame). The thesis's phalanx 1 meets a vertex of the broad face first, with its
+        // body already through the box's corner: rejected. Closing joint 1 from 135°, joint 2 sits at y = 36.7 - 61 cos θ1, and the
+        // end of phalanx 2's contact line reaches hypot(20, 7) = 21.19 mm from it: the face
+        // y = 15 comes within reach at cos θ1 = (36.7 - 15 - 21.19) / 61, θ1 = 89.52°, so the
+        // first 0.25° step there is 89.5°: joint 2 at (−55.20, 36.17), and the end of phalanx
+        // 2's contact line meets the face 0.96 mm further out, at x = −56.16, with phalanx 2
+        // bent 67.6° from phalanx 1 (θ2 = 112.4°).
+        let hand = thesis_hand();
+        let prism = crate::objects::prism(100.0, 30.0, 124.0);
+        let s = slice(
+            &prism,
+            &crate::slice::Plane {
+                origin: nalgebra::Point3::new(50.0, 0.0, 62.0),
+                u: nalgebra::Vector3::x(),
+                v: nalgebra::Vector3::y(),
+            },
+        );
+        assert_eq!(
+            place_als(&s, &hand, 1.0),
+            Err(FingerRejection::Phalanx1Penetration)
+        );
+        for mirror in [1.0, -1.0] {
+            let a = place_als_distal(&s, &hand, mirror).unwrap();
+            assert_eq!(a.theta1_deg, 89.5);
+            assert!((a.theta2_deg - 112.4).abs() < 0.05, "{a:?}");
+            assert!(a.is_tip_contact);
+            assert!(a.contacts[0].is_none());
+            let (p, n) = a.contacts[1].unwrap();
+            assert!((p.y - mirror * 15.0).abs() < 1e-9, "{p:?}");
+            assert!((p.x + 56.16).abs() < 0.01, "{p:?}");
+            // The push is phalanx 2's inward normal (the planner's convention for a contact):
+            // partly towards the other face.
+            assert!(n.y * mirror < -0.3, "{n:?}");
         }
     }
 

@@ -73,6 +73,11 @@ pub enum Relaxation {
     /// The ALS of a finger disagree beyond the Joint Angular Deviation: the finger stops where its
     /// first ALS touches (its most open angles), and the deviation is recorded, not rejected.
     JointDeviationRecorded,
+    /// Phalanx 1 of an ALS meets nothing: joint 1 closes on until phalanx 2 meets the object
+    /// ([`finger::place_als_distal`]): a thin object (a book, a flat box) held by the fingertips
+    /// with the palm on its narrow face, where the 61 mm phalanx 1 reaches past the object and
+    /// only phalanx 2 comes back to it.
+    DistalContactOnly,
 }
 
 /// Runs stages 1–3 on an aligned object: the reduced, graded, sorted search domain.

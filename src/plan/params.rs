@@ -27,6 +27,10 @@ pub struct PlannerParams {
     pub joint_deviation_theta2_deg: f64,
     /// Largest palm pitch tried either way when placing the palm `[deg]` (3.5.2).
     pub pitch_range_deg: f64,
+    /// Try the rules beyond the thesis ([`super::RuleSet::Extended`]) when the thesis's find
+    /// nothing (or, with the physics check, nothing that holds); `false`: the thesis's rules
+    /// only, as the thesis plans.
+    pub extended_rules: bool,
 }
 
 impl Default for PlannerParams {
@@ -41,6 +45,7 @@ impl Default for PlannerParams {
             joint_deviation_theta1_deg: 5.0,
             joint_deviation_theta2_deg: 5.0,
             pitch_range_deg: 20.0,
+            extended_rules: true,
         }
     }
 }

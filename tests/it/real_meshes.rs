@@ -124,6 +124,17 @@ pub fn mesh(soup: &[Tri]) -> Mesh {
 /// Writes `soup` as a binary STL and a scenario for it (no `[expect]`: `outcome = "hold"` is
 /// given only so that scenario parsing works on every branch) and runs it.
 pub fn run_soup(soup: &[Tri], sim: bool) -> RunReport {
+    run_soup_with(
+        soup,
+        &RunOptions {
+            no_sim: !sim,
+            ..RunOptions::default()
+        },
+    )
+}
+
+/// [`run_soup`] with the given options.
+pub fn run_soup_with(soup: &[Tri], options: &RunOptions) -> RunReport {
     let dir = tempfile::tempdir().unwrap();
     let stl = dir.path().join("object.stl");
     std::fs::write(&stl, mesh(soup).to_binary_stl()).unwrap();
@@ -138,14 +149,7 @@ pub fn run_soup(soup: &[Tri], sim: bool) -> RunReport {
     )
     .unwrap();
     let scenario = Scenario::load(&s).unwrap();
-    run(
-        &scenario,
-        &RunOptions {
-            no_sim: !sim,
-            ..RunOptions::default()
-        },
-    )
-    .unwrap()
+    run(&scenario, options).unwrap()
 }
 
 fn rotate_z(soup: &[Tri], deg: f64) -> Vec<Tri> {
@@ -424,6 +428,64 @@ fn a_bar_with_bosses_is_held_with_the_palm_backed_off() {
         g.relaxations
     );
     assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim.translation_mm);
+}
+
+#[test]
+fn a_flat_box_is_pinched_by_the_fingertips_with_the_palm_on_its_narrow_face() {
+    // A 100 x 30 x 150 mm box (a cereal box). With the palm on a broad face, the joints 36.7 mm
+    // either side of the palm's centre put phalanx 1 into the 100 mm face, and on the 30 mm
+    // face the 61 mm phalanx 1 reaches past the box, so no phalanx 1 touches it under any rule
+    // but the last: joint 1 closes on until phalanx 2 meets the broad faces.
+    let soup = cuboid([0.0, 0.0, 75.0], [100.0, 30.0, 150.0]);
+    let r = run_soup(&soup, true);
+    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
+    let g = r.plan.grasp.as_ref().expect("the box gets a grasp");
+    assert_eq!(g.rules, RuleSet::Extended);
+    assert!(
+        g.relaxations.contains(&Relaxation::DistalContactOnly),
+        "{:?}",
+        g.relaxations
+    );
+    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim.translation_mm);
+
+    // The planned contacts: every finger touches with phalanx 2 only, on the broad faces, the
+    // thumb opposite the other two, 30 mm apart across the box (a phalanx's push is its own
+    // normal, tilted from the face's at a tip contact).
+    let planned = run_soup_with(
+        &soup,
+        &RunOptions {
+            no_sim: true,
+            quality: true,
+            ..RunOptions::default()
+        },
+    );
+    let q = planned.quality.as_ref().expect("quality asked for");
+    let fingers: Vec<_> = q.contacts.iter().filter(|c| c.finger != "palm").collect();
+    assert!(fingers.len() >= 3, "{:?}", q.contacts);
+    assert!(fingers.iter().all(|c| c.phalanx == 2), "{fingers:?}");
+    let thumb = fingers
+        .iter()
+        .find(|c| c.finger == "finger_2")
+        .expect("the thumb touches");
+    // Across the box: the aligned frame's x or y, whichever the thumb's contact lies 15 mm out
+    // along (the box is centred on its centroid).
+    let p = Vector3::from(thumb.point_mm);
+    let across = if (p.x.abs() - 15.0).abs() < 0.5 {
+        Vector3::x() * p.x.signum()
+    } else {
+        Vector3::y() * p.y.signum()
+    };
+    assert!((p.dot(&across) - 15.0).abs() < 0.5, "{thumb:?}");
+    for c in &fingers {
+        let q = Vector3::from(c.point_mm);
+        let side = if c.finger == "finger_2" { 1.0 } else { -1.0 };
+        assert!(
+            (q.dot(&across) - side * 15.0).abs() < 0.5,
+            "{c:?}: not on the broad face"
+        );
+        // Each pushes into the box, towards the other side.
+        assert!(Vector3::from(c.normal).dot(&across) * side < -0.2, "{c:?}");
+    }
 }
 
 #[test]

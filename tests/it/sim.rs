@@ -393,9 +393,11 @@ fn penetration_after_closing_is_reported_and_bounded() {
 #[test]
 fn the_hand_starts_clear_of_the_collider() {
     // The golf club's convex decomposition bulges past the mesh the planner used: at the
-    // planned palm pose the palm starts inside one part, and with every joint 20° open finger 1
-    // starts 11 mm inside the club's head (MuJoCo then threw the club 3 m). The check backs the
-    // palm off and opens fingers 1 and 3 further, so everything starts clear.
+    // planned palm pose the palm starts inside one part, and with every joint 20° open a finger
+    // starts inside the club's head (at commit e4d7c31's grasp, finger 1 by 11 mm: MuJoCo then
+    // threw the club 3 m; today's first candidate, a fingertip pinch, has the thumb inside). The
+    // check backs the palm off and opens the fingers that need it further, so everything
+    // starts clear, and leaves the others at the default 20°.
     let out = crate::succeed(crate::grasp_sim().args([
         "--json",
         "--max-checked",
@@ -406,7 +408,7 @@ fn the_hand_starts_clear_of_the_collider() {
     let start = &v["sim"]["start"];
     assert_eq!(start["penetration_mm"], 0.0, "{start}");
     let backoff = start["palm_backoff_mm"].as_f64().unwrap();
-    assert!(backoff > 0.3 && backoff < 2.0, "{start}");
+    assert!(backoff > 0.1 && backoff < 2.0, "{start}");
     let margins: Vec<f64> = start["open_margin_deg"]
         .as_array()
         .unwrap()
@@ -414,6 +416,6 @@ fn the_hand_starts_clear_of_the_collider() {
         .map(|m| m.as_f64().unwrap())
         .collect();
     assert_eq!(margins.len(), 3);
-    assert!(margins[0] > 20.0 && margins[2] > 20.0, "{start}");
-    assert_eq!(margins[1], 20.0, "{start}");
+    assert!(margins.iter().any(|&m| m > 20.0), "{start}");
+    assert!(margins.contains(&20.0), "{start}");
 }
