@@ -174,7 +174,7 @@ fn study_grasp(p: &Planned, k: usize, six: bool) -> Row {
         axis: axis.aligned.axis.name(),
         rules: match axis.rules {
             plan::RuleSet::Thesis => "thesis".to_string(),
-            plan::RuleSet::Extended => "extended".to_string(),
+            plan::RuleSet::Extended | plan::RuleSet::Pinch => "extended".to_string(),
         },
         grade,
         eps_sim: q_sim.epsilon,

@@ -27,9 +27,10 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent
 REAL = ROOT / "assets" / "real"
 BEGIN = "<!-- BEGIN GENERATED: scripts/real_objects_eval.py -->"
 END = "<!-- END GENERATED -->"
-# A run that takes longer than this is reported as a timeout (one object of the set, a book of
-# 33 shells, plans for minutes: see docs/REAL_OBJECTS.md).
-TIMEOUT_S = 300
+# A run that takes longer than this is reported as a timeout. One object of the set, a book of
+# 33 shells, plans for about 4 minutes on a loaded 2-core machine (every axis under the thesis's
+# and the extended rules before the fingertip pinch finds it: see docs/REAL_OBJECTS.md).
+TIMEOUT_S = 600
 
 
 def scenario_text(path, gravity, sim=()):

@@ -481,6 +481,7 @@ fn axis_report(a: &select::AxisPlan) -> report::AxisReport {
         axis: [v.x, v.y, v.z],
         axis_name: a.aligned.axis.name(),
         rules: a.rules,
+        pinch: a.rules == plan::RuleSet::Pinch,
         indexed_elevations: a.graded.domain.elevations.len(),
         sorted_indices: a.graded.sorted_indices.len(),
         candidates_tried: a.candidates_tried,

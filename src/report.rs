@@ -269,6 +269,10 @@ pub struct AxisReport {
     pub axis_name: String,
     /// `thesis` or `extended`.
     pub rules: crate::plan::RuleSet,
+    /// True for the extended rules' last pass, with the fingertip pinch
+    /// (`distal_contact_only`); absent otherwise.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub pinch: bool,
     /// Indexed elevations about this axis.
     pub indexed_elevations: usize,
     /// Candidate palm elevations after stage 3.

@@ -6,7 +6,8 @@
 //! search order. The thesis's rules on the thesis's axis come first, so a thesis object gets the
 //! thesis's grasp; the other axes follow ([`GraspAxis::SEARCH_ORDER`] says why in that order);
 //! the extended rules ([`RuleSet::Extended`]) only when the thesis's rules found no grasp on any
-//! axis, or, with the physics check, when none of their grasps held and checks remain.
+//! axis, or, with the physics check, when none of their grasps held and checks remain; the
+//! fingertip pinch ([`RuleSet::Pinch`]) last, on the same terms after the extended rules.
 //!
 //! Without the physics check the first feasible grasp is the answer, as in the thesis
 //! (`--candidates N` collects N). With it, candidates are checked one by one until one holds or
@@ -123,8 +124,8 @@ pub fn select(
     };
     let collect = p.collect.max(1);
     let mut aligned_cache: Vec<Option<AlignedObject>> = vec![None; GraspAxis::SEARCH_ORDER.len()];
-    for rules in [RuleSet::Thesis, RuleSet::Extended] {
-        if rules == RuleSet::Extended && (!p.planner.extended_rules || !wants_extended(&sel, p)) {
+    for rules in [RuleSet::Thesis, RuleSet::Extended, RuleSet::Pinch] {
+        if rules.is_extended() && (!p.planner.extended_rules || !wants_extended(&sel, p)) {
             break;
         }
         for (k, axis) in GraspAxis::SEARCH_ORDER.iter().enumerate() {
@@ -147,7 +148,7 @@ pub fn select(
                 Some(cache) => {
                     let key = (
                         *axis,
-                        rules,
+                        rules.domain_rules(),
                         p.planner.angular_step_deg.to_bits(),
                         p.planner.height_step_mm.to_bits(),
                     );
@@ -155,7 +156,12 @@ pub fn select(
                         .borrow_mut()
                         .entry(key)
                         .or_insert_with(|| {
-                            plan::stage1_with(&aligned.mesh, p.hand, p.planner, rules)
+                            plan::stage1_with(
+                                &aligned.mesh,
+                                p.hand,
+                                p.planner,
+                                rules.domain_rules(),
+                            )
                         })
                         .clone();
                     plan::grade_built_with(domain, p.hand, p.planner, p.friction, rules, &mut t)

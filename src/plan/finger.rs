@@ -85,9 +85,10 @@ pub enum FingerRejection {
 
 /// Positions finger `k` of `hand` on a placed palm: all three ALS and their agreement.
 ///
-/// Under [`RuleSet::Extended`], an ALS whose phalanx 1 meets nothing closes until phalanx 2
-/// touches ([`place_als_distal`], [`Relaxation::DistalContactOnly`]; if that fails too, the ALS
-/// counts as meeting nothing), an ALS that meets nothing is allowed while another touches
+/// Under [`RuleSet::Pinch`], an ALS the thesis's placement rejects (but for the palm) closes
+/// until phalanx 2 touches ([`place_als_distal`], [`Relaxation::DistalContactOnly`]; if that
+/// fails too, the first rejection stands). Under either extended rule set, an ALS that meets
+/// nothing is allowed while another touches
 /// ([`Relaxation::AlsOffObject`]), and the finger stops where its first ALS touches: its most
 /// open θ1 and θ2 over the ALS that touch, with a deviation beyond the Joint Angular Deviation
 /// recorded ([`Relaxation::JointDeviationRecorded`]) instead of rejected. An ALS off the object
@@ -106,14 +107,27 @@ pub fn place_finger(
     let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
         let s = slice(mesh, &palm.finger_plane(f.height_mm + dz)).bridged(2.0 * o);
         match place_als(&s, hand, mirror) {
-            Err(e) if rules == RuleSet::Extended && e != FingerRejection::PalmPenetration => {
+            Err(e) if rules == RuleSet::Pinch && e != FingerRejection::PalmPenetration => {
                 place_als_distal(&s, hand, mirror).map_err(|_| e)
             }
             placed => placed,
         }
     };
-    if rules == RuleSet::Extended {
-        return place_finger_extended(f.name.clone(), [als(0.0), als(o), als(-o)], deviation_deg);
+    if rules.is_extended() {
+        // Centre, top, bottom, each placed only while the others leave the finger possible
+        // (a slice of a many-shell mesh is costly).
+        let mut placed = Vec::with_capacity(3);
+        for dz in [0.0, o, -o] {
+            let r = als(dz);
+            if let Err(e) = r {
+                if !is_off_object(e) {
+                    return Err(e);
+                }
+            }
+            placed.push(r);
+        }
+        let [centre, top, bottom]: [_; 3] = placed.try_into().expect("three ALS");
+        return place_finger_extended(f.name.clone(), [centre, top, bottom], deviation_deg);
     }
     let centre = als(0.0)?;
     let top = als(o)?;
@@ -134,22 +148,25 @@ pub fn place_finger(
     })
 }
 
+/// True for the rejections that mean an ALS meets nothing: allowed under the extended rules
+/// while another ALS of the finger touches.
+fn is_off_object(r: FingerRejection) -> bool {
+    matches!(
+        r,
+        FingerRejection::Phalanx1NoContact | FingerRejection::Phalanx2NoContact
+    )
+}
+
 /// The extended rules' finger (see [`place_finger`]); `als` is centre, top, bottom.
 fn place_finger_extended(
     name: String,
     als: [Result<AlsAngles, FingerRejection>; 3],
     deviation_deg: [f64; 2],
 ) -> Result<FingerPlacement, FingerRejection> {
-    let is_off = |r: &FingerRejection| {
-        matches!(
-            r,
-            FingerRejection::Phalanx1NoContact | FingerRejection::Phalanx2NoContact
-        )
-    };
     let mut relaxations = Vec::new();
     for r in &als {
         match r {
-            Err(e) if !is_off(e) => return Err(*e),
+            Err(e) if !is_off_object(*e) => return Err(*e),
             Err(_) => relaxations.push(Relaxation::AlsOffObject),
             Ok(_) => {}
         }

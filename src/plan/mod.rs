@@ -44,6 +44,28 @@ pub enum RuleSet {
     /// The thesis's rules with the relaxations of [`Relaxation`], tried only when the thesis's
     /// rules find no grasp on any axis (or none that holds in the physics check).
     Extended,
+    /// The extended rules with the fingertip pinch as well ([`Relaxation::DistalContactOnly`]),
+    /// tried last: only when the extended rules find no grasp on any axis (or none that holds).
+    /// A pinch holds by phalanx 2's tips alone, so a wrap is preferred wherever one exists.
+    /// Reported as `extended` (its grasps list `distal_contact_only`).
+    #[serde(rename = "extended")]
+    Pinch,
+}
+
+impl RuleSet {
+    /// True for the rule sets beyond the thesis.
+    pub fn is_extended(self) -> bool {
+        self != RuleSet::Thesis
+    }
+
+    /// The rule set whose stage-1 domain and grades this one uses (the pinch changes only
+    /// how a finger is placed).
+    pub fn domain_rules(self) -> RuleSet {
+        match self {
+            RuleSet::Pinch => RuleSet::Extended,
+            r => r,
+        }
+    }
 }
 
 /// A rule of the thesis relaxed under [`RuleSet::Extended`], and why it may be.
@@ -116,7 +138,7 @@ pub fn stage1_with(mesh: &Mesh, hand: &Hand, params: &PlannerParams, rules: Rule
         RuleSet::Thesis => hand.fingers.offset_mm,
         // An outer finger's centreline may lie beyond the object's end by up to the finger
         // offset less EXTENDED_MIN_OVERLAP_MM: its inner edge still overlaps the object.
-        RuleSet::Extended => EXTENDED_MIN_OVERLAP_MM - hand.fingers.offset_mm,
+        RuleSet::Extended | RuleSet::Pinch => EXTENDED_MIN_OVERLAP_MM - hand.fingers.offset_mm,
     };
     Domain::build_with(mesh, params, hand, shrink)
 }
@@ -144,7 +166,7 @@ pub fn grade_built_with(
 ) -> GradedDomain {
     let t = Instant::now();
     let mut cparams = CurvatureParams::from_planner(params, hand, friction);
-    if rules == RuleSet::Extended {
+    if rules.is_extended() {
         cparams.ungraspable_grade = Some(EXTENDED_CURVATURE_FLOOR);
     }
     let (curvature, floored) = curvature::grade_elevations_marked(&domain, &cparams);

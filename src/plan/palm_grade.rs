@@ -129,7 +129,7 @@ pub fn rank_with(
     let finger_span_mm = (spread - low) as f64 * step;
 
     let mut palm: Vec<Grade> = vec![None; n];
-    if rules == RuleSet::Extended {
+    if rules.is_extended() {
         let o = hand.fingers.offset_mm;
         let inner_range = [domain.span_mm[0] + o, domain.span_mm[1] - o];
         for (i0, slot) in palm.iter_mut().enumerate() {

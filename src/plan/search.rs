@@ -171,7 +171,7 @@ pub fn search_with(
                     if palm.backed_off_mm > 0.0 {
                         relaxations.push(Relaxation::PalmBackedOff);
                     }
-                    if rules == RuleSet::Extended && uses_outer_elevation(graded, index, hand) {
+                    if rules.is_extended() && uses_outer_elevation(graded, index, hand) {
                         relaxations.push(Relaxation::OuterFingerBeyondElevation);
                     }
                     relaxations.sort();
@@ -212,7 +212,7 @@ fn try_candidate(
     deviation: [f64; 2],
     rules: RuleSet,
 ) -> Result<(PalmPlacement, Vec<FingerPlacement>), Rejection> {
-    let extended = rules == RuleSet::Extended;
+    let extended = rules.is_extended();
     let mut palm = place_palm_on(
         candidate.vslice,
         hand,

@@ -440,7 +440,7 @@ fn a_flat_box_is_pinched_by_the_fingertips_with_the_palm_on_its_narrow_face() {
     let r = run_soup(&soup, true);
     assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
     let g = r.plan.grasp.as_ref().expect("the box gets a grasp");
-    assert_eq!(g.rules, RuleSet::Extended);
+    assert_eq!(g.rules, RuleSet::Pinch);
     assert!(
         g.relaxations.contains(&Relaxation::DistalContactOnly),
         "{:?}",

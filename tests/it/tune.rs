@@ -25,9 +25,10 @@ fn sweeps_parse_and_grids_multiply() {
 #[test]
 fn settings_that_must_rank_differently_do_and_geometry_is_built_once() {
     // The cup needs about 6° of palm pitch to lie on its taper: with no pitch allowed the
-    // thesis's rules find nothing, and the rules beyond them only a fingertip pinch across its
-    // rim (`distal_contact_only`), which holds at 3.2 times the cup's mass against 56 for the
-    // wrap that 10° allows. The D40 cylinder needs no pitch and holds 64 times either way.
+    // thesis's rules find nothing, nor do the extended rules' wraps, and the last pass only a
+    // fingertip pinch across its rim (`distal_contact_only`), which holds at 3.2 times the
+    // cup's mass against 56 for the wrap that 10° allows. The D40 cylinder needs no pitch and
+    // holds 64 times either way.
     let root = crate::root();
     let items = expand(&[
         root.join("scenarios/cup.toml"),
@@ -57,11 +58,11 @@ fn settings_that_must_rank_differently_do_and_geometry_is_built_once() {
     );
     // Loading, alignment and the vertical slices are done once per object and per axis and
     // rule set planned, not per setting: neither swept parameter changes the AngularStep or the
-    // HeightStep. The cup without pitch is planned on all 6 axes under the thesis's rules and on
-    // 2 under the extended ones (the second finds the pinch), with pitch and D40 on the thesis's
-    // axis only: 8 + 1 stage-1 domains for 4 settings.
+    // HeightStep. The cup without pitch is planned on all 6 axes under the thesis's rules and
+    // the extended ones, then with the pinch on the extended rules' domains (shared), with pitch
+    // and D40 on the thesis's axis only: 12 + 1 stage-1 domains for 4 settings.
     assert_eq!(r.counters.objects_loaded, 2);
-    assert_eq!(r.counters.domains_built, 9);
+    assert_eq!(r.counters.domains_built, 13);
     assert_eq!(r.counters.plans, 8);
     // A grasp found by several settings is simulated once.
     assert!(r.counters.sim_reused > 0, "{:?}", r.counters);
