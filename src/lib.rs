@@ -39,7 +39,7 @@ use report::{
     ExpectReport, GradesReport, IndexScale, ObjectReport, PlanReport, PoseReport, RunReport,
     SimReport,
 };
-use scenario::{MassSpec, Outcome, Scenario};
+use scenario::{Outcome, Scenario};
 use std::collections::BTreeMap;
 use std::time::Instant;
 
@@ -113,10 +113,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
     timings.insert("align".to_string(), ms(t1));
 
     let volume = aligned.original.volume_mm3;
-    let mass_kg = match scenario.object.mass {
-        MassSpec::Mass(m) => m,
-        MassSpec::Density(d) => d * volume * 1e-9,
-    };
+    let mass_kg = scenario.object.mass.mass_kg(volume);
     let axis = aligned.principal_axis_original();
     let c = aligned.original.centroid;
     let q = aligned.to_aligned.rotation;

@@ -84,6 +84,19 @@ pub struct ObjectSpec {
     pub friction: f64,
 }
 
+impl ObjectSpec {
+    /// The object `mesh` with the defaults a scenario's `[object]` table gets for what it
+    /// leaves out: millimetres, [`DEFAULT_DENSITY_KG_M3`], [`DEFAULT_FRICTION`].
+    pub fn with_defaults(mesh: PathBuf) -> ObjectSpec {
+        ObjectSpec {
+            mesh,
+            units: LengthUnit::default(),
+            mass: MassSpec::Density(DEFAULT_DENSITY_KG_M3),
+            friction: DEFAULT_FRICTION,
+        }
+    }
+}
+
 /// The object's mass, from a density or given outright.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum MassSpec {
@@ -91,6 +104,16 @@ pub enum MassSpec {
     Density(f64),
     /// Total mass `[kg]`.
     Mass(f64),
+}
+
+impl MassSpec {
+    /// The mass `[kg]` of an object of `volume_mm3` `[mm³]`.
+    pub fn mass_kg(self, volume_mm3: f64) -> f64 {
+        match self {
+            MassSpec::Mass(m) => m,
+            MassSpec::Density(d) => d * volume_mm3 * 1e-9,
+        }
+    }
 }
 
 /// Expected outcome of a scenario.
@@ -184,8 +207,11 @@ struct RawObject {
 }
 
 fn default_friction() -> f64 {
-    0.3
+    DEFAULT_FRICTION
 }
+
+/// Coulomb friction between hand and object when the scenario gives none (the thesis's).
+pub const DEFAULT_FRICTION: f64 = 0.3;
 
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]

@@ -13,7 +13,7 @@
 use crate::batch::{scenario_for, Item};
 use crate::mesh::{load_mesh, AlignedObject};
 use crate::plan::{self, Domain};
-use crate::scenario::{validate_planner, MassSpec, PlannerParams, Scenario};
+use crate::scenario::{validate_planner, PlannerParams, Scenario};
 use crate::sim::{self, ObjectShape, SimHand, Verdict};
 use crate::Error;
 use rayon::prelude::*;
@@ -295,10 +295,7 @@ pub fn tune_with_progress(
         let aligned = crate::mesh::align_with(&loaded.mesh, &props, crate::mesh::GraspAxis::THESIS);
         let volume = aligned.original.volume_mm3;
         let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
-        let mass_kg = match scenario.object.mass {
-            MassSpec::Mass(m) => m,
-            MassSpec::Density(d) => d * volume * 1e-9,
-        };
+        let mass_kg = scenario.object.mass.mass_kg(volume);
         prepared.push(Prepared {
             scenario,
             mesh: loaded.mesh,

@@ -21,7 +21,7 @@ pub use isolate::{Interrupted, Worker};
 pub use record::{input_hash, Key, Record};
 
 use crate::hand::Hand;
-use crate::scenario::{MassSpec, ObjectSpec, PlannerParams, Scenario, ScenarioError, SimParams};
+use crate::scenario::{ObjectSpec, PlannerParams, Scenario, ScenarioError, SimParams};
 use crate::{run, Error, RunOptions};
 use rayon::prelude::*;
 use record::BatchInfo;
@@ -158,12 +158,7 @@ pub fn default_template() -> Scenario {
     Scenario {
         path: PathBuf::from("<built-in template>"),
         name: String::new(),
-        object: ObjectSpec {
-            mesh: PathBuf::new(),
-            units: Default::default(),
-            mass: MassSpec::Density(crate::scenario::DEFAULT_DENSITY_KG_M3),
-            friction: 0.3,
-        },
+        object: ObjectSpec::with_defaults(PathBuf::new()),
         hand,
         hand_file: PathBuf::from("<built-in thesis hand>"),
         planner: PlannerParams::default(),
