@@ -22,7 +22,6 @@ use grasp_sim::quality;
 use grasp_sim::scenario::{GravityMode, PlannerParams, Protocol, SimParams};
 use grasp_sim::sim::{check, check_with_payload, Case, ObjectShape, SimHand};
 use grasp_sim::slice::{slice, Plane};
-use std::collections::BTreeMap;
 use std::hint::black_box;
 use std::path::Path;
 
@@ -57,7 +56,7 @@ fn bench_plan(c: &mut Criterion) {
         g.bench_function(name, |b| {
             b.iter(|| {
                 let a = align(black_box(&mesh));
-                let mut t = BTreeMap::new();
+                let mut t = grasp_sim::report::StageTimings::default();
                 plan(&a.mesh, &hand, &params, 0.3, 1, &mut t)
             })
         });
@@ -87,7 +86,7 @@ fn bench_plan(c: &mut Criterion) {
                  -> grasp_sim::sim::SimOutcome {
                     unreachable!("no physics check")
                 };
-                let mut t = BTreeMap::new();
+                let mut t = grasp_sim::report::StageTimings::default();
                 grasp_sim::select::select(
                     &mesh,
                     &props,
@@ -115,7 +114,7 @@ fn bench_plan(c: &mut Criterion) {
             ..PlannerParams::default()
         };
         g.bench_with_input(BenchmarkId::new("angular_step_deg", step), &p, |b, p| {
-            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut BTreeMap::new()))
+            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut grasp_sim::report::StageTimings::default()))
         });
     }
     for step in [1.25, 2.5, 5.0] {
@@ -124,7 +123,7 @@ fn bench_plan(c: &mut Criterion) {
             ..PlannerParams::default()
         };
         g.bench_with_input(BenchmarkId::new("height_step_mm", step), &p, |b, p| {
-            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut BTreeMap::new()))
+            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut grasp_sim::report::StageTimings::default()))
         });
     }
     g.finish();
@@ -147,7 +146,7 @@ fn bench_sim(c: &mut Criterion) {
         &PlannerParams::default(),
         0.3,
         1,
-        &mut BTreeMap::new(),
+        &mut grasp_sim::report::StageTimings::default(),
     );
     let g0 = &found.grasps[0];
     let pose = SimHand::from_grasp(g0);
@@ -199,7 +198,7 @@ fn bench_quality(c: &mut Criterion) {
             &PlannerParams::default(),
             0.3,
             1,
-            &mut BTreeMap::new(),
+            &mut grasp_sim::report::StageTimings::default(),
         );
         let grasp = &found.grasps[0];
         let pose = SimHand::from_grasp(grasp);

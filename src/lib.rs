@@ -103,14 +103,14 @@ impl Default for RunOptions {
 /// # Errors
 /// [`Error`] for a bad mesh file.
 pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error> {
-    let mut timings = BTreeMap::new();
+    let mut timings = report::StageTimings::default();
     let t0 = Instant::now();
     let loaded = mesh::load_mesh(&scenario.object.mesh, scenario.object.units)?;
-    timings.insert("load".to_string(), ms(t0));
+    timings.load = ms(t0);
     let t1 = Instant::now();
     let props = mesh::mass_properties(&loaded.mesh);
     let aligned = mesh::align_with(&loaded.mesh, &props, mesh::GraspAxis::THESIS);
-    timings.insert("align".to_string(), ms(t1));
+    timings.align = ms(t1);
 
     let volume = aligned.original.volume_mm3;
     let mass_kg = scenario.object.mass.mass_kg(volume);

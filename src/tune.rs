@@ -18,7 +18,7 @@ use crate::sim::{self, ObjectShape, SimHand, Verdict};
 use crate::Error;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 
 /// The parameters the tuner can sweep.
 pub const PARAMETERS: [&str; 8] = [
@@ -435,7 +435,7 @@ fn run_object(
                     Domain::build(&p.aligned.mesh, &params, hand)
                 })
                 .clone();
-            let mut t = BTreeMap::new();
+            let mut t = crate::report::StageTimings::default();
             let graded = plan::grade_built(domain, hand, &params, friction, &mut t);
             let pose = crate::override_pose(&p.aligned.mesh, hand, &graded, s, angles);
             let outcome = pose.ok().map(|pose| {
@@ -478,7 +478,7 @@ fn run_object(
                 ..o.3.clone()
             }
         };
-        let mut t = BTreeMap::new();
+        let mut t = crate::report::StageTimings::default();
         let selection = crate::select::select(
             &p.mesh,
             &p.props,

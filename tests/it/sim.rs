@@ -235,7 +235,7 @@ fn d40_case<R>(
         &grasp_sim::scenario::PlannerParams::default(),
         0.3,
         1,
-        &mut std::collections::BTreeMap::new(),
+        &mut grasp_sim::report::StageTimings::default(),
     );
     let pose = SimHand::from_grasp(&found.grasps[0]);
     let volume = grasp_sim::mesh::mass_properties(&aligned.mesh).volume_mm3;
