@@ -4,6 +4,7 @@
 //! have not run are reported as such (`"status": "not_run"`, `"verdict": "not_run"`), never with
 //! invented numbers.
 
+use crate::scenario::{Expect, Outcome};
 use serde::Serialize;
 
 /// Everything one scenario run produced.
@@ -443,6 +444,107 @@ impl ExpectReport {
     pub fn is_given(&self) -> bool {
         self.outcome != "none"
     }
+
+    /// Judges `[expect]`: the planning part (status and reference values), then, when the
+    /// physics check ran, its verdict against the expected outcome. A scenario that fixes the
+    /// joint angles (`override_angles`) is judged on the verdict alone.
+    pub fn judge(expect: &Expect, plan: &PlanReport, sim: &SimReport) -> ExpectReport {
+        let outcome = expect.outcome.as_str().to_string();
+        if sim.grasp_source.as_deref() == Some("override_angles") {
+            return ExpectReport {
+                met: Some(sim.verdict == outcome),
+                details: format!("sim-only (override_angles): verdict {}", sim.verdict),
+                outcome,
+            };
+        }
+        let (met, details) = match (expect.outcome, &plan.grasp) {
+            (Outcome::Ungraspable, None) => (true, "planner: ungraspable, as expected".to_string()),
+            (Outcome::Ungraspable, Some(_)) => (
+                false,
+                "planner found a feasible grasp; expected ungraspable".to_string(),
+            ),
+            (_, None) => (false, format!("planner: {}; expected a grasp", plan.status)),
+            (_, Some(g)) => {
+                let misses = planning_misses(expect, g);
+                if !misses.is_empty() {
+                    (
+                        false,
+                        format!("planning part not met: {}", misses.join("; ")),
+                    )
+                } else if sim.verdict == "not_run" {
+                    (
+                        true,
+                        "planning part met (feasible, reference values within tolerance); \
+                         physics check not run"
+                            .to_string(),
+                    )
+                } else if sim.verdict == outcome {
+                    (
+                        true,
+                        format!("planning part met; physics check: {}", sim.verdict),
+                    )
+                } else {
+                    (
+                        false,
+                        format!("physics check: {}, expected {outcome}", sim.verdict),
+                    )
+                }
+            }
+        };
+        ExpectReport {
+            outcome,
+            met: Some(met),
+            details,
+        }
+    }
+}
+
+/// The reference values of `expect` that the grasp misses, each in words.
+fn planning_misses(expect: &Expect, g: &GraspReport) -> Vec<String> {
+    let mut misses = Vec::new();
+    if let Some(a) = expect.approach_angle_deg {
+        if (g.approach_angle_deg - a).abs() > 1e-9 {
+            misses.push(format!(
+                "approach {} deg (expected {a})",
+                g.approach_angle_deg
+            ));
+        }
+    }
+    if let Some(p) = expect.palm_pitch_deg {
+        if (g.palm_pitch_deg - p).abs() > expect.pitch_tolerance_deg {
+            misses.push(format!(
+                "pitch {:.1} deg (expected {p} +- {})",
+                g.palm_pitch_deg, expect.pitch_tolerance_deg
+            ));
+        }
+    }
+    if let Some(i) = expect.elevation_index {
+        if (g.elevation_index as i64 - i).abs() > expect.index_tolerance {
+            misses.push(format!(
+                "index {} (expected {i} +- {})",
+                g.elevation_index, expect.index_tolerance
+            ));
+        }
+    }
+    if let Some(t) = &expect.theta_deg {
+        let tol2 = expect
+            .theta2_tolerance_deg
+            .unwrap_or(expect.theta_tolerance_deg);
+        for (f, [t1, t2]) in g.fingers.iter().zip(t) {
+            for (got, want, which, tol) in [
+                (f.theta1_deg, *t1, "theta1", expect.theta_tolerance_deg),
+                (f.theta2_deg, *t2, "theta2", tol2),
+            ] {
+                if (got - want).abs() > tol {
+                    misses.push(format!(
+                        "{} {which} {got:.1} (expected {want} +- {tol})",
+                        f.name
+                    ));
+                }
+            }
+        }
+    }
+    misses
 }
 
 impl RunReport {

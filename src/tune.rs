@@ -11,7 +11,9 @@
 //! produce is simulated once (its physics does not depend on how it was found).
 
 use crate::batch::{scenario_for, Item};
-use crate::mesh::{load_mesh, AlignedObject};
+use crate::mesh::AlignedObject;
+use crate::prepared::PreparedObject;
+use crate::report::StageTimings;
 use crate::plan::{self, Domain};
 use crate::scenario::{validate_planner, PlannerParams, Scenario};
 use crate::sim::{self, ObjectShape, SimHand, Verdict};
@@ -184,34 +186,13 @@ pub struct TuneResult {
 
 struct Prepared {
     scenario: Scenario,
-    /// The mesh as loaded (original frame), for planning on every axis.
-    mesh: crate::mesh::Mesh,
-    props: crate::mesh::MassProperties,
-    aligned: AlignedObject,
-    shape: ObjectShape,
-    mass_kg: f64,
+    object: PreparedObject,
 }
 
 /// Simulated grasps by (axis, fingerprint): verdict, translation, payload margin of a hold, and
 /// the outcome.
 type SimCache =
     HashMap<(crate::mesh::GraspAxis, Vec<u64>), (Verdict, f64, Option<f64>, sim::SimOutcome)>;
-
-/// The object's collider about `a`'s axis (the thesis axis's is prepared; others made once).
-fn shape_for(
-    p: &Prepared,
-    a: &AlignedObject,
-    shapes: &std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>>,
-) -> ObjectShape {
-    if a.axis == p.aligned.axis {
-        return p.shape.clone();
-    }
-    shapes
-        .borrow_mut()
-        .entry(a.axis)
-        .or_insert_with(|| ObjectShape::from_mesh(&a.mesh, p.props.volume_mm3))
-        .clone()
-}
 
 /// The physics check of a pose (and its payload margin when it holds), cached by `key`.
 fn simulate(
@@ -226,14 +207,7 @@ fn simulate(
         counters.sim_reused += 1;
         return o.clone();
     }
-    let case = sim::Case {
-        hand: &p.scenario.hand,
-        pose,
-        object: shape,
-        mass_kg: p.mass_kg,
-        friction: p.scenario.object.friction,
-        params: &p.scenario.sim,
-    };
+    let case = p.object.case(&p.scenario, pose, shape);
     let out = sim::check(&case);
     counters.sim_runs += 1;
     let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
@@ -290,20 +264,8 @@ pub fn tune_with_progress(
     let mut prepared = Vec::new();
     for item in items {
         let scenario = scenario_for(item, template)?;
-        let loaded = load_mesh(&scenario.object.mesh, scenario.object.units)?;
-        let props = crate::mesh::mass_properties(&loaded.mesh);
-        let aligned = crate::mesh::align_with(&loaded.mesh, &props, crate::mesh::GraspAxis::THESIS);
-        let volume = aligned.original.volume_mm3;
-        let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
-        let mass_kg = scenario.object.mass.mass_kg(volume);
-        prepared.push(Prepared {
-            scenario,
-            mesh: loaded.mesh,
-            props,
-            aligned,
-            shape,
-            mass_kg,
-        });
+        let object = PreparedObject::load(&scenario.object, &mut StageTimings::default())?;
+        prepared.push(Prepared { scenario, object });
     }
     let work = || -> Vec<PerObject> {
         prepared
@@ -395,8 +357,6 @@ fn run_object(
     let mut domains: HashMap<(u64, u64), Domain> = HashMap::new();
     let mut sims: SimCache = HashMap::new();
     let select_domains: crate::select::DomainCache = Default::default();
-    let shapes: std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>> =
-        Default::default();
     let hand = &p.scenario.hand;
     let friction = p.scenario.object.friction;
     let mut results = Vec::with_capacity(settings.len());
@@ -432,15 +392,17 @@ fn run_object(
                 .entry(key)
                 .or_insert_with(|| {
                     counters.domains_built += 1;
-                    Domain::build(&p.aligned.mesh, &params, hand)
+                    Domain::build(&p.object.aligned.mesh, &params, hand)
                 })
                 .clone();
-            let mut t = crate::report::StageTimings::default();
+            let mut t = StageTimings::default();
             let graded = plan::grade_built(domain, hand, &params, friction, &mut t);
-            let pose = crate::override_pose(&p.aligned.mesh, hand, &graded, s, angles);
+            let aligned = &p.object.aligned;
+            let pose = SimHand::from_override(&aligned.mesh, hand, &graded, s, angles);
             let outcome = pose.ok().map(|pose| {
                 let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
-                simulate(p, &pose, &p.shape, key, &mut sims, &mut counters)
+                let shape = p.object.shape(aligned);
+                simulate(p, &pose, &shape, key, &mut sims, &mut counters)
             });
             results.push(ObjectResult {
                 scenario: name,
@@ -462,7 +424,7 @@ fn run_object(
         let counters_cell = std::cell::RefCell::new(std::mem::take(&mut counters));
         let check = |a: &AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
             let pose = SimHand::from_grasp(g);
-            let shape = shape_for(p, a, &shapes);
+            let shape = p.object.shape(a);
             let key = (a.axis, fingerprint(&pose));
             let o = simulate(
                 p,
@@ -478,10 +440,10 @@ fn run_object(
                 ..o.3.clone()
             }
         };
-        let mut t = crate::report::StageTimings::default();
+        let mut t = StageTimings::default();
         let selection = crate::select::select(
-            &p.mesh,
-            &p.props,
+            p.object.mesh(),
+            &p.object.props,
             &crate::select::SelectParams {
                 hand,
                 planner: &params,

@@ -19,7 +19,46 @@ pub struct SimHand {
     pub theta_deg: Vec<[f64; 2]>,
 }
 
+/// Why a scenario's `[sim] override_angles` cannot be checked.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OverrideError {
+    /// The graded domain has no indexed elevation to put the palm on.
+    #[error("override_angles: the object has no indexed elevation")]
+    NoElevation,
+    /// The palm could not be placed at the chosen elevation.
+    #[error("override_angles: palm placement failed: {0:?}")]
+    PalmPlacement(crate::plan::palm::PalmRejection),
+}
+
 impl SimHand {
+    /// The hand pose for a scenario whose joint angles are fixed by `[sim] override_angles`:
+    /// the palm at approach 0 and pitch 0 on indexed elevation `override_index` (default: the
+    /// middle one) of the graded domain.
+    ///
+    /// # Errors
+    /// [`OverrideError`]: why the grasp cannot be checked.
+    pub fn from_override(
+        mesh: &Mesh,
+        hand: &Hand,
+        graded: &crate::plan::GradedDomain,
+        p: &SimParams,
+        angles: &[[f64; 2]],
+    ) -> Result<SimHand, OverrideError> {
+        let n = graded.domain.elevations.len();
+        if n == 0 {
+            return Err(OverrideError::NoElevation);
+        }
+        let index = p.override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
+        let z1 = graded.domain.elevations[index - 1];
+        let palm = crate::plan::palm::place_palm(mesh, hand, z1, 0.0, 0.0)
+            .map_err(OverrideError::PalmPlacement)?;
+        Ok(SimHand {
+            origin_mm: palm.origin,
+            axes: palm.axes,
+            theta_deg: angles.to_vec(),
+        })
+    }
+
     /// The palm pose and the centre ALS's joint angles of a planned grasp.
     pub fn from_grasp(g: &crate::plan::search::Grasp) -> SimHand {
         SimHand {
