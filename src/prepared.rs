@@ -5,9 +5,9 @@
 //! [`PreparedObject`], so loading, aligning, the mass formula and the collider are written once.
 
 use crate::mesh::{self, AlignedObject, GraspAxis, LoadedMesh, MassProperties, Mesh, MeshError};
+use crate::report::StageTimings;
 use crate::scenario::{ObjectSpec, Scenario};
 use crate::sim::{Case, ObjectShape, SimHand};
-use crate::report::StageTimings;
 use std::collections::BTreeMap;
 use std::sync::Mutex;
 use std::time::Instant;

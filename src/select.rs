@@ -17,8 +17,8 @@ use crate::hand::Hand;
 use crate::mesh::{align_with, AlignedObject, GraspAxis, MassProperties, Mesh};
 use crate::plan::search::{search_with, Grasp, Rejection};
 use crate::plan::{self, GradedDomain, RuleSet};
-use crate::scenario::PlannerParams;
 use crate::report::StageTimings;
+use crate::scenario::PlannerParams;
 use crate::sim::{SimOutcome, Verdict};
 use std::collections::BTreeMap;
 
