@@ -38,8 +38,8 @@ pub mod visual;
 
 use prepared::PreparedObject;
 use report::{
-    ExpectReport, GradesReport, IndexScale, ObjectReport, PlanReport, PoseReport, RunReport,
-    SimReport, StageTimings,
+    ExpectReport, GradesReport, GraspSource, IndexScale, ObjectReport, PlanReport, PlanStatus,
+    PoseReport, RunReport, SimReport, SimVerdict, StageTimings,
 };
 use scenario::Scenario;
 use std::collections::BTreeMap;
@@ -267,25 +267,17 @@ fn plan_report(
         })
         .collect();
     let chosen_report = selection.chosen.map(|i| all_grasps[i].clone());
-    let mut all_rejections: BTreeMap<String, usize> = BTreeMap::new();
-    for a in &selection.axes {
-        for (r, n) in &a.rejections {
-            *all_rejections
-                .entry(r.describe(&scenario.hand))
-                .or_insert(0) += n;
-        }
-    }
     let (status, reason) = if chosen_report.is_some() {
-        ("feasible", None)
+        (PlanStatus::Feasible, None)
     } else {
         (
-            "ungraspable",
+            PlanStatus::Ungraspable,
             Some(ungraspable_reason(selection, &scenario.hand)),
         )
     };
     let g = &graded.grades;
     PlanReport {
-        status: status.to_string(),
+        status,
         reason,
         effective_elevation_mm: graded.domain.effective,
         indexed_elevations: graded.domain.elevations.len(),
@@ -310,7 +302,7 @@ fn plan_report(
             palm: g.palm.clone(),
         },
         candidates_tried: selection.axes.iter().map(|a| a.candidates_tried).sum(),
-        rejections: all_rejections,
+        rejections: rejections(selection, &scenario.hand),
         grasp: chosen_report,
         grasps: if all_grasps.len() > 1 {
             all_grasps
@@ -329,13 +321,15 @@ fn plan_report(
     }
 }
 
-/// The `sim` report of a check that did not run, and why.
-fn not_run(reason: &str) -> SimReport {
-    SimReport {
-        verdict: "not_run".to_string(),
-        reason: Some(reason.to_string()),
-        ..SimReport::default()
+/// How often each constraint rejected a candidate, over every axis and rule set.
+fn rejections(selection: &select::Selection, hand: &hand::Hand) -> BTreeMap<String, usize> {
+    let mut all: BTreeMap<String, usize> = BTreeMap::new();
+    for a in &selection.axes {
+        for (r, n) in &a.rejections {
+            *all.entry(r.describe(hand)).or_insert(0) += n;
+        }
     }
+    all
 }
 
 /// Writes the URDF and MJCF exports asked for, and runs the physics check on the chosen grasp
@@ -352,18 +346,18 @@ fn run_sim(
         export::write_urdf(&dir.join(&scenario.name), &scenario.hand, &scenario.sim)?;
     }
     if options.no_sim && options.export_mjcf.is_none() {
-        return Ok((not_run("--no-sim"), None));
+        return Ok((SimReport::not_run("--no-sim"), None));
     }
     let p = &scenario.sim;
     let (pose, source, done) = match (&p.override_angles, grasp) {
         (Some(angles), _) => {
             match sim::SimHand::from_override(&aligned.mesh, &scenario.hand, graded, p, angles) {
-                Ok(pose) => (pose, "override_angles", None),
-                Err(e) => return Ok((not_run(&e.to_string()), None)),
+                Ok(pose) => (pose, GraspSource::OverrideAngles, None),
+                Err(e) => return Ok((SimReport::not_run(&e.to_string()), None)),
             }
         }
-        (None, Some((g, done))) => (sim::SimHand::from_grasp(g), "planner", done),
-        (None, None) => return Ok((not_run("no feasible grasp to check"), None)),
+        (None, Some((g, done))) => (sim::SimHand::from_grasp(g), GraspSource::Planner, done),
+        (None, None) => return Ok((SimReport::not_run("no feasible grasp to check"), None)),
     };
     let shape = object.shape(aligned);
     let case = object.case(scenario, &pose, &shape);
@@ -376,7 +370,7 @@ fn run_sim(
         export::write_mjcf(&dir.join(&scenario.name), &input)?;
     }
     if options.no_sim {
-        return Ok((not_run("--no-sim"), None));
+        return Ok((SimReport::not_run("--no-sim"), None));
     }
     // The candidate search already checked the chosen grasp: the same case, the same outcome.
     let (out, payload) = match done {
@@ -388,25 +382,36 @@ fn run_sim(
         None => sim::check_with_payload(&case, options.payload),
     };
     let poses = out.final_poses.clone();
-    let report = SimReport {
-        verdict: out.verdict.as_str().to_string(),
-        reason: None,
+    let report = checked_report(out, payload, &case, &shape, source, options);
+    Ok((report, Some(poses)))
+}
+
+/// The `sim` report of a check that ran on `case` (with the payload bracket when asked for).
+fn checked_report(
+    out: sim::SimOutcome,
+    payload: Option<(f64, Option<f64>)>,
+    case: &sim::Case,
+    shape: &sim::ObjectShape,
+    source: GraspSource,
+    options: &RunOptions,
+) -> SimReport {
+    SimReport {
+        verdict: SimVerdict::Ran(out.verdict),
         translation_mm: Some(out.translation_mm),
         rotation_deg: Some(out.rotation_deg),
         simulated_s: Some(out.simulated_s),
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
-        start: Some(sim::scene::start(&case)),
+        start: Some(sim::scene::start(case)),
         collider: Some(format!("{} ({} parts)", shape.kind, shape.parts)),
-        mass_kg: Some(object.mass_kg),
-        grasp_source: Some(source.to_string()),
+        mass_kg: Some(case.mass_kg),
+        grasp_source: Some(source),
         payload_margin: options
             .payload
             .then(|| payload.map_or(0.0, |(held, _)| held)),
         payload_fails_at: payload.and_then(|(_, failed)| failed),
         directions: out.directions,
-    };
-    Ok((report, Some(poses)))
+    }
 }
 
 fn pose_report(
@@ -510,7 +515,7 @@ fn grasp_report(
         rules: g.rules,
         relaxations: g.relaxations.clone(),
         check: check.map(|o| report::CandidateCheck {
-            verdict: o.verdict.as_str().to_string(),
+            verdict: o.verdict,
             translation_mm: o.translation_mm,
             rotation_deg: o.rotation_deg,
         }),

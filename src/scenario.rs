@@ -12,6 +12,7 @@ use crate::hand::{Hand, HandError};
 use crate::mesh::LengthUnit;
 pub use crate::plan::PlannerParams;
 pub use crate::sim::params::{GravityMode, Protocol, SimParams};
+use crate::sim::Verdict;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -138,6 +139,16 @@ impl Outcome {
             Outcome::Slip => "slip",
             Outcome::Drop => "drop",
             Outcome::Ungraspable => "ungraspable",
+        }
+    }
+
+    /// The physics check's verdict this outcome expects (`None` for `ungraspable`).
+    pub fn verdict(self) -> Option<Verdict> {
+        match self {
+            Outcome::Hold => Some(Verdict::Hold),
+            Outcome::Slip => Some(Verdict::Slip),
+            Outcome::Drop => Some(Verdict::Drop),
+            Outcome::Ungraspable => None,
         }
     }
 }

@@ -73,13 +73,39 @@ impl SimHand {
     }
 }
 
+/// How the object's collider was made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ColliderKind {
+    /// The convex hull of the mesh (the mesh is convex).
+    ConvexHull,
+    /// A convex decomposition (V-HACD) of the mesh.
+    ConvexDecomposition,
+}
+
+impl ColliderKind {
+    /// The name used in JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ColliderKind::ConvexHull => "convex_hull",
+            ColliderKind::ConvexDecomposition => "convex_decomposition",
+        }
+    }
+}
+
+impl std::fmt::Display for ColliderKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
 /// The object's collision shape, built once per object and shared by every run.
 #[derive(Clone)]
 pub struct ObjectShape {
     /// The shape in metres, aligned frame.
     pub shape: SharedShape,
-    /// How it was made: `convex_hull` or `convex_decomposition`.
-    pub kind: &'static str,
+    /// How it was made.
+    pub kind: ColliderKind,
     /// Number of convex parts.
     pub parts: usize,
     /// True if and only if the object is inertially a body of revolution about its principal
@@ -100,7 +126,7 @@ impl ObjectShape {
             if hull_mm3 <= volume_mm3 * 1.02 {
                 return ObjectShape {
                     shape: hull,
-                    kind: "convex_hull",
+                    kind: ColliderKind::ConvexHull,
                     parts: 1,
                     is_revolution,
                 };
@@ -115,7 +141,7 @@ impl ObjectShape {
         let parts = shape.as_compound().map_or(1, |c| c.shapes().len());
         ObjectShape {
             shape,
-            kind: "convex_decomposition",
+            kind: ColliderKind::ConvexDecomposition,
             parts,
             is_revolution,
         }
