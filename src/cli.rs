@@ -201,8 +201,8 @@ pub struct BatchArgs {
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
     /// Run only the K-th of N contiguous blocks of the inputs (e.g. a Slurm array task).
-    #[arg(long, value_name = "K/N")]
-    pub shard: Option<String>,
+    #[arg(long, value_name = "K/N", value_parser = grasp_sim::batch::parse_shard)]
+    pub shard: Option<grasp_sim::batch::Shard>,
     /// Plan only.
     #[arg(long)]
     pub no_sim: bool,

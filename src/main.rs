@@ -364,9 +364,8 @@ fn batch(args: &cli::BatchArgs) -> anyhow::Result<u8> {
         check_writable_file(path).context("--out")?;
     }
     let mut items = batch::expand(&args.inputs)?;
-    if let Some(s) = &args.shard {
-        let (k, n) = batch::parse_shard(s).map_err(|m| anyhow::anyhow!("--shard: {m}"))?;
-        items = batch::shard(&items, k, n);
+    if let Some(shard) = args.shard {
+        items = shard.of(&items);
     }
     let keys = batch::keys(&items, &template, &options);
     if !args.merge.is_empty() {
