@@ -129,11 +129,15 @@ pub enum Command {
         /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
         #[arg(required = true, value_name = "DIR | SCENARIO")]
         inputs: Vec<PathBuf>,
-        /// NAME=START:END:STEP, repeatable (sf_c, height_step_mm, angular_step_deg,
-        /// vertical_deviation_deg, joint_deviation_deg, joint_deviation_theta1_deg,
-        /// joint_deviation_theta2_deg, pitch_range_deg).
-        #[arg(long = "param", required = true, value_name = "NAME=START:END:STEP")]
-        params: Vec<String>,
+        // Help: NAME=START:END:STEP, repeatable, and the names of tune::TunedParam.
+        #[arg(
+            long = "param",
+            required = true,
+            value_name = "NAME=START:END:STEP",
+            value_parser = grasp_sim::tune::parse_sweep,
+            help = format!("NAME=START:END:STEP, repeatable ({})", grasp_sim::tune::TunedParam::names())
+        )]
+        params: Vec<grasp_sim::tune::Sweep>,
         /// Output folder.
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
