@@ -19,10 +19,10 @@ use grasp_sim::mesh::{align, mass_properties};
 use grasp_sim::objects;
 use grasp_sim::plan::plan;
 use grasp_sim::quality;
+use grasp_sim::report::StageTimings;
 use grasp_sim::scenario::{GravityMode, PlannerParams, Protocol, SimParams};
 use grasp_sim::sim::{check, check_with_payload, Case, ObjectShape, SimHand};
 use grasp_sim::slice::{slice, Plane};
-use std::collections::BTreeMap;
 use std::hint::black_box;
 use std::path::Path;
 
@@ -57,7 +57,7 @@ fn bench_plan(c: &mut Criterion) {
         g.bench_function(name, |b| {
             b.iter(|| {
                 let a = align(black_box(&mesh));
-                let mut t = BTreeMap::new();
+                let mut t = StageTimings::default();
                 plan(&a.mesh, &hand, &params, 0.3, 1, &mut t)
             })
         });
@@ -87,7 +87,7 @@ fn bench_plan(c: &mut Criterion) {
                  -> grasp_sim::sim::SimOutcome {
                     unreachable!("no physics check")
                 };
-                let mut t = BTreeMap::new();
+                let mut t = StageTimings::default();
                 grasp_sim::select::select(
                     &mesh,
                     &props,
@@ -115,7 +115,7 @@ fn bench_plan(c: &mut Criterion) {
             ..PlannerParams::default()
         };
         g.bench_with_input(BenchmarkId::new("angular_step_deg", step), &p, |b, p| {
-            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut BTreeMap::new()))
+            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut StageTimings::default()))
         });
     }
     for step in [1.25, 2.5, 5.0] {
@@ -124,7 +124,7 @@ fn bench_plan(c: &mut Criterion) {
             ..PlannerParams::default()
         };
         g.bench_with_input(BenchmarkId::new("height_step_mm", step), &p, |b, p| {
-            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut BTreeMap::new()))
+            b.iter(|| plan(&cup, &hand, p, 0.3, 1, &mut StageTimings::default()))
         });
     }
     g.finish();
@@ -147,7 +147,7 @@ fn bench_sim(c: &mut Criterion) {
         &PlannerParams::default(),
         0.3,
         1,
-        &mut BTreeMap::new(),
+        &mut StageTimings::default(),
     );
     let g0 = &found.grasps[0];
     let pose = SimHand::from_grasp(g0);
@@ -199,7 +199,7 @@ fn bench_quality(c: &mut Criterion) {
             &PlannerParams::default(),
             0.3,
             1,
-            &mut BTreeMap::new(),
+            &mut StageTimings::default(),
         );
         let grasp = &found.grasps[0];
         let pose = SimHand::from_grasp(grasp);

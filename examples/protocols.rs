@@ -109,7 +109,7 @@ fn main() {
         }
         let full = by(Protocol::Full);
         let fast = by(Protocol::Fast);
-        if full.verdict == "not_run" {
+        if full.verdict.verdict().is_none() {
             println!("| {} | not run | not run | | | | | | |", s.name);
             continue;
         }

@@ -28,7 +28,7 @@ use grasp_sim::scenario::{GravityMode, MassSpec, Scenario};
 use grasp_sim::{mesh, plan, quality, select, sim};
 use plotters::prelude::*;
 use rayon::prelude::*;
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -100,7 +100,7 @@ fn plan_one(path: &Path, collect: usize) -> Result<Planned, String> {
             check: &no_check,
             domains: None,
         },
-        &mut BTreeMap::new(),
+        &mut grasp_sim::report::StageTimings::default(),
     );
     if selection.candidates.is_empty() {
         return Err("no feasible grasp".to_string());

@@ -129,11 +129,15 @@ pub enum Command {
         /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
         #[arg(required = true, value_name = "DIR | SCENARIO")]
         inputs: Vec<PathBuf>,
-        /// NAME=START:END:STEP, repeatable (sf_c, height_step_mm, angular_step_deg,
-        /// vertical_deviation_deg, joint_deviation_deg, joint_deviation_theta1_deg,
-        /// joint_deviation_theta2_deg, pitch_range_deg).
-        #[arg(long = "param", required = true, value_name = "NAME=START:END:STEP")]
-        params: Vec<String>,
+        // Help: NAME=START:END:STEP, repeatable, and the names of tune::TunedParam.
+        #[arg(
+            long = "param",
+            required = true,
+            value_name = "NAME=START:END:STEP",
+            value_parser = grasp_sim::tune::parse_sweep,
+            help = format!("NAME=START:END:STEP, repeatable ({})", grasp_sim::tune::TunedParam::names())
+        )]
+        params: Vec<grasp_sim::tune::Sweep>,
         /// Output folder.
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
@@ -201,8 +205,8 @@ pub struct BatchArgs {
     #[arg(long, value_name = "N")]
     pub jobs: Option<usize>,
     /// Run only the K-th of N contiguous blocks of the inputs (e.g. a Slurm array task).
-    #[arg(long, value_name = "K/N")]
-    pub shard: Option<String>,
+    #[arg(long, value_name = "K/N", value_parser = grasp_sim::batch::parse_shard)]
+    pub shard: Option<grasp_sim::batch::Shard>,
     /// Plan only.
     #[arg(long)]
     pub no_sim: bool,

@@ -25,6 +25,7 @@ pub mod mesh;
 mod messages;
 pub mod objects;
 pub mod plan;
+pub mod prepared;
 pub mod quality;
 pub mod report;
 pub mod scenario;
@@ -35,13 +36,13 @@ pub mod summarize;
 pub mod tune;
 pub mod visual;
 
+use prepared::PreparedObject;
 use report::{
-    ExpectReport, GradesReport, IndexScale, ObjectReport, PlanReport, PoseReport, RunReport,
-    SimReport,
+    ExpectReport, GradesReport, GraspSource, IndexScale, ObjectReport, PlanReport, PlanStatus,
+    PoseReport, RunReport, SimReport, SimVerdict, StageTimings,
 };
-use scenario::{MassSpec, Outcome, Scenario};
+use scenario::Scenario;
 use std::collections::BTreeMap;
-use std::time::Instant;
 
 /// Any error that stops a scenario from running: bad input, never a grasp outcome.
 #[derive(Debug, thiserror::Error)]
@@ -98,95 +99,94 @@ impl Default for RunOptions {
     }
 }
 
-/// Loads, validates and aligns the scenario's object, and reports what exists of the pipeline.
+/// Runs a scenario: prepares its object, plans (choosing among candidates with the physics
+/// check when it runs), checks the chosen grasp, judges `[expect]` and writes what `options`
+/// ask for.
 ///
 /// # Errors
-/// [`Error`] for a bad mesh file.
+/// [`Error`] for a bad mesh file or an export that cannot be written.
 pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error> {
-    let mut timings = BTreeMap::new();
-    let t0 = Instant::now();
-    let loaded = mesh::load_mesh(&scenario.object.mesh, scenario.object.units)?;
-    timings.insert("load".to_string(), ms(t0));
-    let t1 = Instant::now();
-    let props = mesh::mass_properties(&loaded.mesh);
-    let aligned = mesh::align_with(&loaded.mesh, &props, mesh::GraspAxis::THESIS);
-    timings.insert("align".to_string(), ms(t1));
+    let mut timings = StageTimings::default();
+    let object = PreparedObject::load(&scenario.object, &mut timings)?;
+    let selection = select_grasps(scenario, options, &object, &mut timings);
+    let qualities = qualities(scenario, options, &selection);
+    let plan = plan_report(scenario, &selection, &qualities, timings);
+    let chosen = selection.chosen();
+    let (sim, sim_poses) = run_sim(
+        scenario,
+        options,
+        &object,
+        chosen.map_or(&object.aligned, |c| &selection.axes[c.axis_plan].aligned),
+        &selection.axes[0].graded,
+        chosen.map(|c| (&c.grasp, c.check.clone())),
+    )?;
+    let expect = match &scenario.expect {
+        Some(e) => ExpectReport::judge(e, &plan, &sim),
+        None => ExpectReport::none(),
+    };
+    let shown = selection.reported_axis();
+    let report = RunReport {
+        scenario: scenario.name.clone(),
+        object: object_report(scenario, &object),
+        warnings: warnings(scenario, &object, &shown.graded, plan.open_slices),
+        plan,
+        sim,
+        expect,
+        quality: selection.chosen.and_then(|i| qualities[i].clone()),
+    };
+    if let Some(dir) = &options.report {
+        visual::write_report(
+            &dir.join(&scenario.name),
+            &report,
+            &shown.graded,
+            chosen.map(|c| &c.grasp),
+            &shown.aligned.mesh,
+            &scenario.hand,
+            sim_poses.as_deref(),
+        )?;
+    }
+    Ok(report)
+}
 
-    let volume = aligned.original.volume_mm3;
-    let mass_kg = match scenario.object.mass {
-        MassSpec::Mass(m) => m,
-        MassSpec::Density(d) => d * volume * 1e-9,
-    };
-    let axis = aligned.principal_axis_original();
-    let c = aligned.original.centroid;
-    let q = aligned.to_aligned.rotation;
-    let tr = aligned.to_aligned.translation.vector;
-    let object = ObjectReport {
-        mesh: scenario.object.mesh.display().to_string(),
-        triangles: loaded.mesh.triangles.len(),
-        volume_mm3: volume,
-        principal_axis: [axis.x, axis.y, axis.z],
-        height_mm: aligned.height_mm,
-        centroid_mm: [c.x, c.y, c.z],
-        mass_kg,
-        degenerate_dropped: loaded.degenerate_dropped,
-        boundary_edges: loaded.topology.boundary_edges,
-        to_aligned: PoseReport {
-            position_mm: [tr.x, tr.y, tr.z],
-            quaternion_wxyz: [q.w, q.i, q.j, q.k],
-        },
-    };
-    let shapes: std::cell::RefCell<BTreeMap<mesh::GraspAxis, sim::ObjectShape>> =
-        Default::default();
-    let shape_for = |a: &mesh::AlignedObject| -> sim::ObjectShape {
-        shapes
-            .borrow_mut()
-            .entry(a.axis)
-            .or_insert_with(|| sim::ObjectShape::from_mesh(&a.mesh, volume))
-            .clone()
-    };
+/// Plans across axes and rule sets; with the physics check on the planner's grasps, checks
+/// candidates until one holds (at most `max_checked`).
+fn select_grasps(
+    scenario: &Scenario,
+    options: &RunOptions,
+    object: &PreparedObject,
+    timings: &mut StageTimings,
+) -> select::Selection {
     let check = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
-        let shape = shape_for(a);
+        let shape = object.shape(a);
         let pose = sim::SimHand::from_grasp(g);
-        sim::check(&sim::Case {
-            hand: &scenario.hand,
-            pose: &pose,
-            object: &shape,
-            mass_kg,
-            friction: scenario.object.friction,
-            params: &scenario.sim,
-        })
+        sim::check(&object.case(scenario, &pose, &shape))
     };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
     let checks_candidates = !options.no_sim && scenario.sim.override_angles.is_none();
-    let selection = select::select(
-        &loaded.mesh,
-        &props,
+    let max_checked = options.max_checked.unwrap_or(scenario.sim.max_checked);
+    select::select(
+        object.mesh(),
+        &object.props,
         &select::SelectParams {
             hand: &scenario.hand,
             planner: &scenario.planner,
             friction: scenario.object.friction,
             collect: options.candidates,
-            max_checked: checks_candidates.then_some(
-                options
-                    .max_checked
-                    .unwrap_or(scenario.sim.max_checked)
-                    .max(1),
-            ),
+            max_checked: checks_candidates.then_some(max_checked.max(1)),
             check: &check,
             domains: None,
         },
-        &mut timings,
-    );
-    let shown = selection.reported_axis();
-    let graded = &shown.graded;
-    let open_slices = graded
-        .domain
-        .slices
-        .iter()
-        .filter(|s| s.open_count() > 0)
-        .count();
-    let qualities: Vec<Option<quality::Quality>> = selection
+        timings,
+    )
+}
+
+/// The analytic quality of every candidate when `--quality` asks for it.
+fn qualities(
+    scenario: &Scenario,
+    options: &RunOptions,
+    selection: &select::Selection,
+) -> Vec<Option<quality::Quality>> {
+    selection
         .candidates
         .iter()
         .map(|c| {
@@ -196,11 +196,67 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
                 quality::of_grasp(&c.grasp, aligned, c.check.as_ref(), h, mu)
             })
         })
-        .collect();
+        .collect()
+}
+
+/// The `object` part of the report.
+fn object_report(scenario: &Scenario, object: &PreparedObject) -> ObjectReport {
+    let aligned = &object.aligned;
+    let axis = aligned.principal_axis_original();
+    let c = aligned.original.centroid;
+    let q = aligned.to_aligned.rotation;
+    let tr = aligned.to_aligned.translation.vector;
+    ObjectReport {
+        mesh: scenario.object.mesh.display().to_string(),
+        triangles: object.mesh().triangles.len(),
+        volume_mm3: object.volume_mm3(),
+        principal_axis: [axis.x, axis.y, axis.z],
+        height_mm: aligned.height_mm,
+        centroid_mm: [c.x, c.y, c.z],
+        mass_kg: object.mass_kg,
+        degenerate_dropped: object.loaded.degenerate_dropped,
+        boundary_edges: object.loaded.topology.boundary_edges,
+        to_aligned: PoseReport {
+            position_mm: [tr.x, tr.y, tr.z],
+            quaternion_wxyz: [q.w, q.i, q.j, q.k],
+        },
+    }
+}
+
+/// The input's warnings: the loader's, and open vertical slices of the axis reported.
+fn warnings(
+    scenario: &Scenario,
+    object: &PreparedObject,
+    graded: &plan::GradedDomain,
+    open_slices: usize,
+) -> Vec<String> {
+    object
+        .loaded
+        .warnings()
+        .into_iter()
+        .chain((open_slices > 0).then(|| {
+            format!(
+                "{open_slices} of {} vertical slices stay open after joining their ends: \
+                 the planner uses their pieces as they are",
+                graded.domain.slices.len()
+            )
+        }))
+        .map(|w| format!("{}: {w}", scenario.object.mesh.display()))
+        .collect()
+}
+
+/// The `plan` part of the report.
+fn plan_report(
+    scenario: &Scenario,
+    selection: &select::Selection,
+    qualities: &[Option<quality::Quality>],
+    timings: StageTimings,
+) -> PlanReport {
+    let graded = &selection.reported_axis().graded;
     let all_grasps: Vec<report::GraspReport> = selection
         .candidates
         .iter()
-        .zip(&qualities)
+        .zip(qualities)
         .map(|(c, q)| report::GraspReport {
             quality: q.as_ref().map(report::GraspQuality::of),
             ..grasp_report(
@@ -211,26 +267,17 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         })
         .collect();
     let chosen_report = selection.chosen.map(|i| all_grasps[i].clone());
-    let candidates_tried: usize = selection.axes.iter().map(|a| a.candidates_tried).sum();
-    let mut all_rejections: BTreeMap<String, usize> = BTreeMap::new();
-    for a in &selection.axes {
-        for (r, n) in &a.rejections {
-            *all_rejections
-                .entry(r.describe(&scenario.hand))
-                .or_insert(0) += n;
-        }
-    }
     let (status, reason) = if chosen_report.is_some() {
-        ("feasible", None)
+        (PlanStatus::Feasible, None)
     } else {
         (
-            "ungraspable",
-            Some(ungraspable_reason(&selection, &scenario.hand)),
+            PlanStatus::Ungraspable,
+            Some(ungraspable_reason(selection, &scenario.hand)),
         )
     };
     let g = &graded.grades;
-    let plan = PlanReport {
-        status: status.to_string(),
+    PlanReport {
+        status,
         reason,
         effective_elevation_mm: graded.domain.effective,
         indexed_elevations: graded.domain.elevations.len(),
@@ -254,8 +301,8 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             combined: g.combined.clone(),
             palm: g.palm.clone(),
         },
-        candidates_tried,
-        rejections: all_rejections,
+        candidates_tried: selection.axes.iter().map(|a| a.candidates_tried).sum(),
+        rejections: rejections(selection, &scenario.hand),
         grasp: chosen_report,
         grasps: if all_grasps.len() > 1 {
             all_grasps
@@ -263,114 +310,67 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             Vec::new()
         },
         candidates_checked: selection.checked(),
-        open_slices,
+        open_slices: graded
+            .domain
+            .slices
+            .iter()
+            .filter(|s| s.open_count() > 0)
+            .count(),
         axes: selection.axes.iter().map(axis_report).collect(),
         timings_ms: timings,
-    };
-    let chosen = selection.chosen();
-    let (sim, sim_poses) = run_sim(
-        scenario,
-        options,
-        match chosen {
-            Some(c) => &selection.axes[c.axis_plan].aligned,
-            None => &aligned,
-        },
-        &selection.axes[0].graded,
-        chosen.map(|c| (&c.grasp, c.check.clone())),
-        mass_kg,
-        &shape_for,
-    )?;
-    let expect = match &scenario.expect {
-        Some(e) => judge(e, &plan, &sim),
-        None => report::ExpectReport::none(),
-    };
-    let report = RunReport {
-        scenario: scenario.name.clone(),
-        object,
-        plan,
-        sim,
-        expect,
-        quality: selection.chosen.and_then(|i| qualities[i].clone()),
-        warnings: loaded
-            .warnings()
-            .into_iter()
-            .chain((open_slices > 0).then(|| {
-                format!(
-                    "{open_slices} of {} vertical slices stay open after joining their ends: \
-                     the planner uses their pieces as they are",
-                    graded.domain.slices.len()
-                )
-            }))
-            .map(|w| format!("{}: {w}", scenario.object.mesh.display()))
-            .collect(),
-    };
-    if let Some(dir) = &options.report {
-        visual::write_report(
-            &dir.join(&scenario.name),
-            &report,
-            graded,
-            chosen.map(|c| &c.grasp),
-            &shown.aligned.mesh,
-            &scenario.hand,
-            sim_poses.as_deref(),
-        )?;
     }
-    Ok(report)
 }
 
-/// Runs the physics check on the first grasp, or on `override_angles`.
+/// How often each constraint rejected a candidate, over every axis and rule set.
+fn rejections(selection: &select::Selection, hand: &hand::Hand) -> BTreeMap<String, usize> {
+    let mut all: BTreeMap<String, usize> = BTreeMap::new();
+    for a in &selection.axes {
+        for (r, n) in &a.rejections {
+            *all.entry(r.describe(hand)).or_insert(0) += n;
+        }
+    }
+    all
+}
+
+/// Writes the URDF and MJCF exports asked for, and runs the physics check on the chosen grasp
+/// or on `override_angles` (pose from the thesis axis's `graded` domain).
 fn run_sim(
     scenario: &Scenario,
     options: &RunOptions,
+    object: &PreparedObject,
     aligned: &mesh::AlignedObject,
     graded: &plan::GradedDomain,
     grasp: Option<(&plan::search::Grasp, Option<sim::SimOutcome>)>,
-    mass_kg: f64,
-    shape_for: &dyn Fn(&mesh::AlignedObject) -> sim::ObjectShape,
 ) -> Result<(SimReport, Option<Vec<sim::BodyPose>>), Error> {
-    let not_run = |reason: &str| SimReport {
-        verdict: "not_run".to_string(),
-        reason: Some(reason.to_string()),
-        ..SimReport::default()
-    };
     if let Some(dir) = &options.export_urdf {
         export::write_urdf(&dir.join(&scenario.name), &scenario.hand, &scenario.sim)?;
     }
     if options.no_sim && options.export_mjcf.is_none() {
-        return Ok((not_run("--no-sim"), None));
+        return Ok((SimReport::not_run("--no-sim"), None));
     }
     let p = &scenario.sim;
     let (pose, source, done) = match (&p.override_angles, grasp) {
         (Some(angles), _) => {
-            match override_pose(&aligned.mesh, &scenario.hand, graded, p, angles) {
-                Ok(pose) => (pose, "override_angles", None),
-                Err(reason) => return Ok((not_run(&reason), None)),
+            match sim::SimHand::from_override(&aligned.mesh, &scenario.hand, graded, p, angles) {
+                Ok(pose) => (pose, GraspSource::OverrideAngles, None),
+                Err(e) => return Ok((SimReport::not_run(&e.to_string()), None)),
             }
         }
-        (None, Some((g, done))) => (sim::SimHand::from_grasp(g), "planner", done),
-        (None, None) => return Ok((not_run("no feasible grasp to check"), None)),
+        (None, Some((g, done))) => (sim::SimHand::from_grasp(g), GraspSource::Planner, done),
+        (None, None) => return Ok((SimReport::not_run("no feasible grasp to check"), None)),
     };
-    let shape = shape_for(aligned);
-    let case = sim::Case {
-        hand: &scenario.hand,
-        pose: &pose,
-        object: &shape,
-        mass_kg,
-        friction: scenario.object.friction,
-        params: p,
-    };
+    let shape = object.shape(aligned);
+    let case = object.case(scenario, &pose, &shape);
     if let Some(dir) = &options.export_mjcf {
-        export::write_mjcf(
-            &dir.join(&scenario.name),
-            &export::ExportInput {
-                name: &scenario.name,
-                object: aligned,
-                case,
-            },
-        )?;
+        let input = export::ExportInput {
+            name: &scenario.name,
+            object: aligned,
+            case,
+        };
+        export::write_mjcf(&dir.join(&scenario.name), &input)?;
     }
     if options.no_sim {
-        return Ok((not_run("--no-sim"), None));
+        return Ok((SimReport::not_run("--no-sim"), None));
     }
     // The candidate search already checked the chosen grasp: the same case, the same outcome.
     let (out, payload) = match done {
@@ -382,52 +382,35 @@ fn run_sim(
         None => sim::check_with_payload(&case, options.payload),
     };
     let poses = out.final_poses.clone();
-    let report = SimReport {
-        verdict: out.verdict.as_str().to_string(),
-        reason: None,
+    let report = checked_report(out, payload, &case, &shape, source, options);
+    Ok((report, Some(poses)))
+}
+
+/// The `sim` report of a check that ran on `case` (with the payload bracket when asked for).
+fn checked_report(
+    out: sim::SimOutcome,
+    payload: Option<(f64, Option<f64>)>,
+    case: &sim::Case,
+    shape: &sim::ObjectShape,
+    source: GraspSource,
+    options: &RunOptions,
+) -> SimReport {
+    SimReport {
+        verdict: SimVerdict::Ran(out.verdict),
         translation_mm: Some(out.translation_mm),
         rotation_deg: Some(out.rotation_deg),
         simulated_s: Some(out.simulated_s),
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
-        start: Some(sim::scene::start(&case)),
+        start: Some(sim::scene::start(case)),
         collider: Some(format!("{} ({} parts)", shape.kind, shape.parts)),
-        mass_kg: Some(mass_kg),
-        grasp_source: Some(source.to_string()),
-        payload_margin: if options.payload {
-            Some(payload.map_or(0.0, |(held, _)| held))
-        } else {
-            None
-        },
+        mass_kg: Some(case.mass_kg),
+        grasp_source: Some(source),
+        payload_margin: options
+            .payload
+            .then(|| payload.map_or(0.0, |(held, _)| held)),
         payload_fails_at: payload.and_then(|(_, failed)| failed),
         directions: out.directions,
-    };
-    Ok((report, Some(poses)))
-}
-
-/// The hand pose for a scenario whose joint angles are fixed by `[sim] override_angles`: the
-/// palm at approach 0 and pitch 0 on indexed elevation `override_index` (default: the middle
-/// one) of the graded domain. `Err` gives the reason the grasp cannot be checked.
-pub(crate) fn override_pose(
-    mesh: &mesh::Mesh,
-    hand: &hand::Hand,
-    graded: &plan::palm_grade::GradedDomain,
-    p: &scenario::SimParams,
-    angles: &[[f64; 2]],
-) -> Result<sim::SimHand, String> {
-    let n = graded.domain.elevations.len();
-    if n == 0 {
-        return Err("override_angles: the object has no indexed elevation".to_string());
-    }
-    let index = p.override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
-    let z1 = graded.domain.elevations[index - 1];
-    match plan::palm::place_palm(mesh, hand, z1, 0.0, 0.0) {
-        Ok(palm) => Ok(sim::SimHand {
-            origin_mm: palm.origin,
-            axes: palm.axes,
-            theta_deg: angles.to_vec(),
-        }),
-        Err(e) => Err(format!("override_angles: palm placement failed: {e:?}")),
     }
 }
 
@@ -533,109 +516,10 @@ fn grasp_report(
         rules: g.rules,
         relaxations: g.relaxations.clone(),
         check: check.map(|o| report::CandidateCheck {
-            verdict: o.verdict.as_str().to_string(),
+            verdict: o.verdict,
             translation_mm: o.translation_mm,
             rotation_deg: o.rotation_deg,
         }),
         quality: None,
     }
-}
-
-/// Judges `[expect]`: the planning part (status and reference values), then, when the physics
-/// check ran, its verdict against the expected outcome.
-fn judge(expect: &scenario::Expect, plan: &PlanReport, sim: &SimReport) -> ExpectReport {
-    let outcome = expect.outcome.as_str().to_string();
-    if sim.grasp_source.as_deref() == Some("override_angles") {
-        let met = sim.verdict == outcome;
-        return ExpectReport {
-            outcome,
-            met: Some(met),
-            details: format!("sim-only (override_angles): verdict {}", sim.verdict),
-        };
-    }
-    let (met, details) = match (expect.outcome, &plan.grasp) {
-        (Outcome::Ungraspable, None) => (true, "planner: ungraspable, as expected".to_string()),
-        (Outcome::Ungraspable, Some(_)) => (
-            false,
-            "planner found a feasible grasp; expected ungraspable".to_string(),
-        ),
-        (_, None) => (false, format!("planner: {}; expected a grasp", plan.status)),
-        (_, Some(g)) => {
-            let mut misses = Vec::new();
-            if let Some(a) = expect.approach_angle_deg {
-                if (g.approach_angle_deg - a).abs() > 1e-9 {
-                    misses.push(format!(
-                        "approach {} deg (expected {a})",
-                        g.approach_angle_deg
-                    ));
-                }
-            }
-            if let Some(p) = expect.palm_pitch_deg {
-                if (g.palm_pitch_deg - p).abs() > expect.pitch_tolerance_deg {
-                    misses.push(format!(
-                        "pitch {:.1} deg (expected {p} +- {})",
-                        g.palm_pitch_deg, expect.pitch_tolerance_deg
-                    ));
-                }
-            }
-            if let Some(i) = expect.elevation_index {
-                if (g.elevation_index as i64 - i).abs() > expect.index_tolerance {
-                    misses.push(format!(
-                        "index {} (expected {i} +- {})",
-                        g.elevation_index, expect.index_tolerance
-                    ));
-                }
-            }
-            if let Some(t) = &expect.theta_deg {
-                let tol2 = expect
-                    .theta2_tolerance_deg
-                    .unwrap_or(expect.theta_tolerance_deg);
-                for (f, [t1, t2]) in g.fingers.iter().zip(t) {
-                    for (got, want, which, tol) in [
-                        (f.theta1_deg, *t1, "theta1", expect.theta_tolerance_deg),
-                        (f.theta2_deg, *t2, "theta2", tol2),
-                    ] {
-                        if (got - want).abs() > tol {
-                            misses.push(format!(
-                                "{} {which} {got:.1} (expected {want} +- {tol})",
-                                f.name
-                            ));
-                        }
-                    }
-                }
-            }
-            if !misses.is_empty() {
-                (
-                    false,
-                    format!("planning part not met: {}", misses.join("; ")),
-                )
-            } else if sim.verdict == "not_run" {
-                (
-                    true,
-                    "planning part met (feasible, reference values within tolerance); physics \
-                     check not run"
-                        .to_string(),
-                )
-            } else if sim.verdict == outcome {
-                (
-                    true,
-                    format!("planning part met; physics check: {}", sim.verdict),
-                )
-            } else {
-                (
-                    false,
-                    format!("physics check: {}, expected {outcome}", sim.verdict),
-                )
-            }
-        }
-    };
-    ExpectReport {
-        outcome,
-        met: Some(met),
-        details,
-    }
-}
-
-fn ms(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1000.0
 }

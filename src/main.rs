@@ -205,7 +205,7 @@ fn check_writable_file(file: &std::path::Path) -> anyhow::Result<()> {
 
 fn tune(
     inputs: &[std::path::PathBuf],
-    params: &[String],
+    sweeps: &[grasp_sim::tune::Sweep],
     out: &std::path::Path,
     candidates: usize,
     template: Option<&std::path::Path>,
@@ -213,10 +213,6 @@ fn tune(
 ) -> anyhow::Result<u8> {
     use grasp_sim::{batch, tune};
     use std::io::IsTerminal;
-    let sweeps = params
-        .iter()
-        .map(|p| tune::parse_sweep(p).map_err(|m| anyhow::anyhow!("--param {m}")))
-        .collect::<anyhow::Result<Vec<_>>>()?;
     let template = match template {
         Some(p) => Scenario::load(p)?,
         None => batch::default_template(),
@@ -226,7 +222,7 @@ fn tune(
     let jobs = jobs.unwrap_or_else(default_jobs).max(1);
     let t0 = std::time::Instant::now();
     // A progress bar over objects x settings, on a terminal only (as batch's).
-    let total = items.len() * tune::grid(&sweeps).len();
+    let total = items.len() * tune::grid(sweeps).len();
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(total as u64);
         b.set_style(
@@ -246,7 +242,7 @@ fn tune(
     let result = tune::tune_with_progress(
         &items,
         &template,
-        &sweeps,
+        sweeps,
         candidates.max(1),
         jobs,
         &progress,
@@ -262,7 +258,7 @@ fn tune(
         &out.join("tune.json"),
         grasp_sim::report::to_rounded_json_pretty(&result)?.as_bytes(),
     )?;
-    let plots = tune::plot(&result, out).map_err(|m| anyhow::anyhow!(m))?;
+    let plots = tune::plot(&result, out)?;
     print!("{}", tune::to_table(&result));
     let invalid = result
         .settings
@@ -364,9 +360,8 @@ fn batch(args: &cli::BatchArgs) -> anyhow::Result<u8> {
         check_writable_file(path).context("--out")?;
     }
     let mut items = batch::expand(&args.inputs)?;
-    if let Some(s) = &args.shard {
-        let (k, n) = batch::parse_shard(s).map_err(|m| anyhow::anyhow!("--shard: {m}"))?;
-        items = batch::shard(&items, k, n);
+    if let Some(shard) = args.shard {
+        items = shard.of(&items);
     }
     let keys = batch::keys(&items, &template, &options);
     if !args.merge.is_empty() {

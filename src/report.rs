@@ -1,9 +1,12 @@
 //! The run report: the JSON contract of DESIGN.md section 6 and the human summary.
 //!
-//! Field names are a contract that outside scripts read: add fields, never rename. Stages that
-//! have not run are reported as such (`"status": "not_run"`, `"verdict": "not_run"`), never with
-//! invented numbers.
+//! Field names are a contract that outside scripts read: add fields, never rename. A physics
+//! check that has not run is reported as such (`"verdict": "not_run"` and its `reason`), never
+//! with invented numbers. Outcomes are enums in Rust whose JSON names are the strings scripts
+//! read (`feasible`, `hold`, `not_run`, `override_angles`, ...).
 
+use crate::scenario::{Expect, Outcome};
+use crate::sim::Verdict;
 use serde::Serialize;
 
 /// Everything one scenario run produced.
@@ -64,8 +67,8 @@ pub struct PoseReport {
 /// The `plan` part of the report.
 #[derive(Debug, Clone, Serialize)]
 pub struct PlanReport {
-    /// `feasible`, `ungraspable`, or `not_run` while the positioning stages are not built.
-    pub status: String,
+    /// `feasible` or `ungraspable`.
+    pub status: PlanStatus,
     /// Why, when not feasible.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
@@ -109,7 +112,68 @@ pub struct PlanReport {
     /// Each principal axis and rule set the planner tried, in order.
     pub axes: Vec<AxisReport>,
     /// Per-stage wall times `[ms]`.
-    pub timings_ms: std::collections::BTreeMap<String, f64>,
+    pub timings_ms: StageTimings,
+}
+
+/// Per-stage wall times of a run `[ms]`, summed over the axes and rule sets planned.
+///
+/// The fields are in alphabetical order: the JSON keeps the key order of the sorted map this
+/// struct replaced.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct StageTimings {
+    /// Aligning the object on its principal axis.
+    pub align: f64,
+    /// Loading and validating the mesh.
+    pub load: f64,
+    /// The search for feasible grasps (with the physics checks of candidates).
+    pub search: f64,
+    /// Stage 1: the search domain.
+    pub stage1_domain: f64,
+    /// Stage 2: curvature grades.
+    pub stage2_curvature: f64,
+    /// Stage 2: Effective Diameter grades.
+    pub stage2_diameter: f64,
+    /// Stage 3: palm grades and sorting.
+    pub stage3_palm: f64,
+}
+
+impl StageTimings {
+    /// Adds `other`'s times to these, stage by stage.
+    pub fn add(&mut self, other: &StageTimings) {
+        self.align += other.align;
+        self.load += other.load;
+        self.search += other.search;
+        self.stage1_domain += other.stage1_domain;
+        self.stage2_curvature += other.stage2_curvature;
+        self.stage2_diameter += other.stage2_diameter;
+        self.stage3_palm += other.stage3_palm;
+    }
+}
+
+/// The planner's outcome.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlanStatus {
+    /// A kinematically feasible grasp was found.
+    Feasible,
+    /// None was.
+    Ungraspable,
+}
+
+impl PlanStatus {
+    /// The name used in JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            PlanStatus::Feasible => "feasible",
+            PlanStatus::Ungraspable => "ungraspable",
+        }
+    }
+}
+
+impl std::fmt::Display for PlanStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
 }
 
 /// A feasible grasp.
@@ -253,7 +317,7 @@ impl GraspReport {
 #[derive(Debug, Clone, Serialize)]
 pub struct CandidateCheck {
     /// `hold`, `slip` or `drop`.
-    pub verdict: String,
+    pub verdict: Verdict,
     /// Worst direction's translation relative to the palm `[mm]`.
     pub translation_mm: f64,
     /// Worst direction's rotation relative to the palm `[deg]`.
@@ -334,14 +398,79 @@ pub struct GradesReport {
     pub palm: Vec<Option<f64>>,
 }
 
+/// Whether the physics check ran: its verdict, or why it did not run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SimVerdict {
+    /// The check did not run (`--no-sim`, no grasp to check, a pose that cannot be placed).
+    NotRun {
+        /// Why.
+        reason: String,
+    },
+    /// The check ran.
+    Ran(Verdict),
+}
+
+impl SimVerdict {
+    /// The verdict, when the check ran.
+    pub fn verdict(&self) -> Option<Verdict> {
+        match self {
+            SimVerdict::Ran(v) => Some(*v),
+            SimVerdict::NotRun { .. } => None,
+        }
+    }
+
+    /// Why the check did not run, when it did not.
+    pub fn reason(&self) -> Option<&str> {
+        match self {
+            SimVerdict::NotRun { reason } => Some(reason),
+            SimVerdict::Ran(_) => None,
+        }
+    }
+
+    /// The JSON's `verdict`: `hold`, `slip`, `drop` or `not_run`.
+    pub fn as_str(&self) -> &'static str {
+        match self {
+            SimVerdict::Ran(v) => v.as_str(),
+            SimVerdict::NotRun { .. } => "not_run",
+        }
+    }
+}
+
+impl std::fmt::Display for SimVerdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
+/// As the two JSON fields `verdict` and, when the check did not run, `reason`.
+impl Serialize for SimVerdict {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut map = serializer.serialize_map(None)?;
+        map.serialize_entry("verdict", self.as_str())?;
+        if let SimVerdict::NotRun { reason } = self {
+            map.serialize_entry("reason", reason)?;
+        }
+        map.end()
+    }
+}
+
+/// Where the grasp the physics check ran on came from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum GraspSource {
+    /// The planner's chosen grasp.
+    Planner,
+    /// The scenario's `[sim] override_angles`.
+    OverrideAngles,
+}
+
 /// The `sim` part of the report.
-#[derive(Debug, Clone, Serialize, Default)]
+#[derive(Debug, Clone, Serialize)]
 pub struct SimReport {
-    /// `hold`, `slip`, `drop` or `not_run`.
-    pub verdict: String,
-    /// Why it did not run.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub reason: Option<String>,
+    /// `verdict` (`hold`, `slip`, `drop` or `not_run`) and, when not run, `reason`.
+    #[serde(flatten)]
+    pub verdict: SimVerdict,
     /// Object translation relative to the palm during the hold, worst direction `[mm]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub translation_mm: Option<f64>,
@@ -369,7 +498,7 @@ pub struct SimReport {
     pub mass_kg: Option<f64>,
     /// `override_angles` when the grasp came from the scenario, `planner` otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub grasp_source: Option<String>,
+    pub grasp_source: Option<GraspSource>,
     /// Largest mass multiplier (up to 64) at which the grasp still holds (`--payload`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub payload_margin: Option<f64>,
@@ -383,6 +512,29 @@ pub struct SimReport {
     pub directions: Vec<crate::sim::DirectionOutcome>,
 }
 
+impl SimReport {
+    /// The report of a check that did not run, and why.
+    pub fn not_run(reason: &str) -> SimReport {
+        SimReport {
+            verdict: SimVerdict::NotRun {
+                reason: reason.to_string(),
+            },
+            translation_mm: None,
+            rotation_deg: None,
+            simulated_s: None,
+            steps: None,
+            wall_ms: None,
+            start: None,
+            collider: None,
+            mass_kg: None,
+            grasp_source: None,
+            payload_margin: None,
+            payload_fails_at: None,
+            directions: Vec::new(),
+        }
+    }
+}
+
 /// The `expect` part of the report.
 ///
 /// A scenario without `[expect]` (and a bare mesh) keeps the same shape, so scripts reading
@@ -391,18 +543,24 @@ pub struct SimReport {
 #[derive(Debug, Clone, Serialize)]
 pub struct ExpectReport {
     /// The expected outcome, or `none` when the scenario states none.
-    pub outcome: String,
+    #[serde(serialize_with = "outcome_or_none")]
+    pub outcome: Option<Outcome>,
     /// True when every judged expectation held; `null` when nothing was judged.
     pub met: Option<bool>,
     /// What was compared, or why nothing was.
     pub details: String,
 }
 
+/// `None` as `"none"`.
+fn outcome_or_none<S: serde::Serializer>(o: &Option<Outcome>, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(o.map_or("none", Outcome::as_str))
+}
+
 impl ExpectReport {
     /// The report when there is no expectation: nothing judged.
     pub fn none() -> ExpectReport {
         ExpectReport {
-            outcome: "none".to_string(),
+            outcome: None,
             met: None,
             details: "no expectation given ([expect] absent): nothing judged".to_string(),
         }
@@ -410,8 +568,117 @@ impl ExpectReport {
 
     /// Returns true if and only if there was an expectation to judge.
     pub fn is_given(&self) -> bool {
-        self.outcome != "none"
+        self.outcome.is_some()
     }
+
+    /// The expected outcome's name, or `none`.
+    pub fn outcome_name(&self) -> &'static str {
+        self.outcome.map_or("none", Outcome::as_str)
+    }
+
+    /// Judges `[expect]`: the planning part (status and reference values), then, when the
+    /// physics check ran, its verdict against the expected outcome. A scenario that fixes the
+    /// joint angles (`override_angles`) is judged on the verdict alone.
+    pub fn judge(expect: &Expect, plan: &PlanReport, sim: &SimReport) -> ExpectReport {
+        let outcome = Some(expect.outcome);
+        if sim.grasp_source == Some(GraspSource::OverrideAngles) {
+            let verdict = sim.verdict.verdict();
+            return ExpectReport {
+                outcome,
+                met: Some(verdict.is_some() && verdict == expect.outcome.verdict()),
+                details: format!("sim-only (override_angles): verdict {}", sim.verdict),
+            };
+        }
+        let (met, details) = match (expect.outcome, &plan.grasp) {
+            (Outcome::Ungraspable, None) => (true, "planner: ungraspable, as expected".to_string()),
+            (Outcome::Ungraspable, Some(_)) => (
+                false,
+                "planner found a feasible grasp; expected ungraspable".to_string(),
+            ),
+            (_, None) => (false, format!("planner: {}; expected a grasp", plan.status)),
+            (_, Some(g)) => {
+                let misses = planning_misses(expect, g);
+                if !misses.is_empty() {
+                    let misses = misses.join("; ");
+                    (false, format!("planning part not met: {misses}"))
+                } else {
+                    judge_check(expect.outcome, &sim.verdict)
+                }
+            }
+        };
+        ExpectReport {
+            outcome,
+            met: Some(met),
+            details,
+        }
+    }
+}
+
+/// Once the planning part is met: the physics check's verdict against the expected outcome.
+fn judge_check(expected: Outcome, verdict: &SimVerdict) -> (bool, String) {
+    match verdict.verdict() {
+        None => (
+            true,
+            "planning part met (feasible, reference values within tolerance); physics check \
+             not run"
+                .to_string(),
+        ),
+        Some(v) if expected.verdict() == Some(v) => {
+            (true, format!("planning part met; physics check: {v}"))
+        }
+        Some(v) => (
+            false,
+            format!("physics check: {v}, expected {}", expected.as_str()),
+        ),
+    }
+}
+
+/// The reference values of `expect` that the grasp misses, each in words.
+fn planning_misses(expect: &Expect, g: &GraspReport) -> Vec<String> {
+    let mut misses = Vec::new();
+    if let Some(a) = expect.approach_angle_deg {
+        if (g.approach_angle_deg - a).abs() > 1e-9 {
+            misses.push(format!(
+                "approach {} deg (expected {a})",
+                g.approach_angle_deg
+            ));
+        }
+    }
+    if let Some(p) = expect.palm_pitch_deg {
+        if (g.palm_pitch_deg - p).abs() > expect.pitch_tolerance_deg {
+            misses.push(format!(
+                "pitch {:.1} deg (expected {p} +- {})",
+                g.palm_pitch_deg, expect.pitch_tolerance_deg
+            ));
+        }
+    }
+    if let Some(i) = expect.elevation_index {
+        if (g.elevation_index as i64 - i).abs() > expect.index_tolerance {
+            misses.push(format!(
+                "index {} (expected {i} +- {})",
+                g.elevation_index, expect.index_tolerance
+            ));
+        }
+    }
+    if let Some(t) = &expect.theta_deg {
+        let tol2 = expect
+            .theta2_tolerance_deg
+            .unwrap_or(expect.theta_tolerance_deg);
+        for (f, [t1, t2]) in g.fingers.iter().zip(t) {
+            for (got, want, which, tol) in [
+                (f.theta1_deg, *t1, "theta1", expect.theta_tolerance_deg),
+                (f.theta2_deg, *t2, "theta2", tol2),
+            ] {
+                if (got - want).abs() > tol {
+                    misses.push(format!(
+                        "{} {which} {got:.1} (expected {want} +- {tol})",
+                        f.name
+                    ));
+                }
+            }
+        }
+    }
+    misses
 }
 
 impl RunReport {
@@ -477,7 +744,7 @@ impl RunReport {
         );
         let plan_line = match &p.reason {
             Some(r) => format!("{} ({r})", p.status),
-            None => p.status.clone(),
+            None => p.status.to_string(),
         };
         let checked = if p.candidates_checked > 0 {
             format!(", {} checked", p.candidates_checked)
@@ -538,11 +805,10 @@ impl RunReport {
                 pp.quaternion_wxyz[0], pp.quaternion_wxyz[1], pp.quaternion_wxyz[2], pp.quaternion_wxyz[3]
             );
         }
-        let sim_line = match (&self.sim.reason, self.sim.translation_mm) {
-            (Some(r), _) => format!("{} ({r})", self.sim.verdict.replace('_', " ")),
-            (None, Some(t)) => format!(
-                "{}: moved {:.2} mm and {:.2} deg relative to the palm while held; {} steps, {:.0} ms{}",
-                self.sim.verdict,
+        let sim_line = match (&self.sim.verdict, self.sim.translation_mm) {
+            (SimVerdict::NotRun { reason }, _) => format!("not run ({reason})"),
+            (SimVerdict::Ran(verdict), Some(t)) => format!(
+                "{verdict}: moved {:.2} mm and {:.2} deg relative to the palm while held; {} steps, {:.0} ms{}",
                 t,
                 self.sim.rotation_deg.unwrap_or(0.0),
                 self.sim.steps.unwrap_or(0),
@@ -552,7 +818,7 @@ impl RunReport {
                     None => String::new(),
                 }
             ),
-            (None, None) => self.sim.verdict.clone(),
+            (SimVerdict::Ran(verdict), None) => verdict.to_string(),
         };
         let _ = writeln!(s, "  Sim         {sim_line}");
         if let Some(q) = &self.quality {
@@ -568,7 +834,8 @@ impl RunReport {
             let _ = writeln!(
                 s,
                 "  Expect      {}: {met} ({})",
-                self.expect.outcome, self.expect.details
+                self.expect.outcome_name(),
+                self.expect.details
             );
         } else {
             let _ = writeln!(s, "  Expect      none given: nothing judged");
@@ -600,17 +867,20 @@ impl RunReport {
             sim.translation_mm.unwrap_or(0.0),
             sim.rotation_deg.unwrap_or(0.0)
         );
-        match sim.verdict.as_str() {
-            "hold" => format!("{grasp}: HELD under gravity (moved {moved})"),
-            "slip" => format!(
+        match &sim.verdict {
+            SimVerdict::Ran(Verdict::Hold) => {
+                format!("{grasp}: HELD under gravity (moved {moved})")
+            }
+            SimVerdict::Ran(Verdict::Slip) => format!(
                 "{grasp}: NOT held: the object slipped {moved}, beyond the hold limits, but stayed \
                  in the hand"
             ),
-            "drop" => format!("{grasp}: NOT held: the object fell out of the hand (moved {moved})"),
-            _ => format!(
-                "{grasp}; not checked in physics ({})",
-                sim.reason.as_deref().unwrap_or("not run")
-            ),
+            SimVerdict::Ran(Verdict::Drop) => {
+                format!("{grasp}: NOT held: the object fell out of the hand (moved {moved})")
+            }
+            SimVerdict::NotRun { reason } => {
+                format!("{grasp}; not checked in physics ({reason})")
+            }
         }
     }
 }

@@ -12,6 +12,7 @@ use crate::hand::{Hand, HandError};
 use crate::mesh::LengthUnit;
 pub use crate::plan::PlannerParams;
 pub use crate::sim::params::{GravityMode, Protocol, SimParams};
+use crate::sim::Verdict;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -84,6 +85,19 @@ pub struct ObjectSpec {
     pub friction: f64,
 }
 
+impl ObjectSpec {
+    /// The object `mesh` with the defaults a scenario's `[object]` table gets for what it
+    /// leaves out: millimetres, [`DEFAULT_DENSITY_KG_M3`], [`DEFAULT_FRICTION`].
+    pub fn with_defaults(mesh: PathBuf) -> ObjectSpec {
+        ObjectSpec {
+            mesh,
+            units: LengthUnit::default(),
+            mass: MassSpec::Density(DEFAULT_DENSITY_KG_M3),
+            friction: DEFAULT_FRICTION,
+        }
+    }
+}
+
 /// The object's mass, from a density or given outright.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum MassSpec {
@@ -91,6 +105,16 @@ pub enum MassSpec {
     Density(f64),
     /// Total mass `[kg]`.
     Mass(f64),
+}
+
+impl MassSpec {
+    /// The mass `[kg]` of an object of `volume_mm3` `[mm³]`.
+    pub fn mass_kg(self, volume_mm3: f64) -> f64 {
+        match self {
+            MassSpec::Mass(m) => m,
+            MassSpec::Density(d) => d * volume_mm3 * 1e-9,
+        }
+    }
 }
 
 /// Expected outcome of a scenario.
@@ -115,6 +139,16 @@ impl Outcome {
             Outcome::Slip => "slip",
             Outcome::Drop => "drop",
             Outcome::Ungraspable => "ungraspable",
+        }
+    }
+
+    /// The physics check's verdict this outcome expects (`None` for `ungraspable`).
+    pub fn verdict(self) -> Option<Verdict> {
+        match self {
+            Outcome::Hold => Some(Verdict::Hold),
+            Outcome::Slip => Some(Verdict::Slip),
+            Outcome::Drop => Some(Verdict::Drop),
+            Outcome::Ungraspable => None,
         }
     }
 }
@@ -184,8 +218,11 @@ struct RawObject {
 }
 
 fn default_friction() -> f64 {
-    0.3
+    DEFAULT_FRICTION
 }
+
+/// Coulomb friction between hand and object when the scenario gives none (the thesis's).
+pub const DEFAULT_FRICTION: f64 = 0.3;
 
 #[derive(Deserialize, Default)]
 #[serde(deny_unknown_fields)]

@@ -18,6 +18,7 @@ use crate::hand::Hand;
 use crate::mesh::{align_with, AlignedObject, GraspAxis, MassProperties, Mesh};
 use crate::plan::search::{search_with, Grasp, Rejection};
 use crate::plan::{self, GradedDomain, RuleSet};
+use crate::report::StageTimings;
 use crate::scenario::PlannerParams;
 use crate::sim::{SimOutcome, Verdict};
 use std::collections::BTreeMap;
@@ -115,7 +116,7 @@ pub fn select(
     mesh: &Mesh,
     props: &MassProperties,
     p: &SelectParams,
-    timings: &mut BTreeMap<String, f64>,
+    timings: &mut StageTimings,
 ) -> Selection {
     let mut sel = Selection {
         axes: Vec::new(),
@@ -135,7 +136,7 @@ pub fn select(
             let aligned = aligned_cache[k]
                 .get_or_insert_with(|| align_with(mesh, props, *axis))
                 .clone();
-            let mut t = BTreeMap::new();
+            let mut t = StageTimings::default();
             let graded = match p.domains {
                 None => plan::grade_domain_with(
                     &aligned.mesh,
@@ -188,10 +189,8 @@ pub fn select(
                     stopped = is_done(&sel, p, collect);
                     !stopped
                 });
-            *t.entry("search".to_string()).or_insert(0.0) += ms(t0);
-            for (key, v) in t {
-                *timings.entry(key).or_insert(0.0) += v;
-            }
+            t.search += ms(t0);
+            timings.add(&t);
             sel.axes.push(AxisPlan {
                 aligned,
                 rules,

@@ -11,89 +11,184 @@
 //! produce is simulated once (its physics does not depend on how it was found).
 
 use crate::batch::{scenario_for, Item};
-use crate::mesh::{load_mesh, AlignedObject};
+use crate::mesh::AlignedObject;
 use crate::plan::{self, Domain};
-use crate::scenario::{validate_planner, MassSpec, PlannerParams, Scenario};
+use crate::prepared::PreparedObject;
+use crate::report::StageTimings;
+use crate::scenario::{validate_planner, PlannerParams, Scenario};
 use crate::sim::{self, ObjectShape, SimHand, Verdict};
 use crate::Error;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::collections::{BTreeMap, HashMap};
+use std::collections::HashMap;
 
-/// The parameters the tuner can sweep.
-pub const PARAMETERS: [&str; 8] = [
-    "sf_c",
-    "height_step_mm",
-    "angular_step_deg",
-    "vertical_deviation_deg",
-    "joint_deviation_deg",
-    "joint_deviation_theta1_deg",
-    "joint_deviation_theta2_deg",
-    "pitch_range_deg",
-];
+/// A planner parameter the tuner can sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum TunedParam {
+    /// `sf_c`: the curvature significance factor Sf_c.
+    SfC,
+    /// `height_step_mm`: the HeightStep.
+    HeightStepMm,
+    /// `angular_step_deg`: the AngularStep.
+    AngularStepDeg,
+    /// `vertical_deviation_deg`: the Vertical Deviation Range.
+    VerticalDeviationDeg,
+    /// `joint_deviation_deg`: the Joint Angular Deviation of both joints at once.
+    JointDeviationDeg,
+    /// `joint_deviation_theta1_deg`: the Joint Angular Deviation of joint 1.
+    JointDeviationTheta1Deg,
+    /// `joint_deviation_theta2_deg`: the Joint Angular Deviation of joint 2.
+    JointDeviationTheta2Deg,
+    /// `pitch_range_deg`: the largest palm pitch tried either way.
+    PitchRangeDeg,
+}
+
+impl TunedParam {
+    /// Every parameter, in the order the help lists them.
+    pub const ALL: [TunedParam; 8] = [
+        TunedParam::SfC,
+        TunedParam::HeightStepMm,
+        TunedParam::AngularStepDeg,
+        TunedParam::VerticalDeviationDeg,
+        TunedParam::JointDeviationDeg,
+        TunedParam::JointDeviationTheta1Deg,
+        TunedParam::JointDeviationTheta2Deg,
+        TunedParam::PitchRangeDeg,
+    ];
+
+    /// The name: the `[planner]` key it sets; `joint_deviation_deg` sets both
+    /// `joint_deviation_theta1_deg` and `joint_deviation_theta2_deg`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            TunedParam::SfC => "sf_c",
+            TunedParam::HeightStepMm => "height_step_mm",
+            TunedParam::AngularStepDeg => "angular_step_deg",
+            TunedParam::VerticalDeviationDeg => "vertical_deviation_deg",
+            TunedParam::JointDeviationDeg => "joint_deviation_deg",
+            TunedParam::JointDeviationTheta1Deg => "joint_deviation_theta1_deg",
+            TunedParam::JointDeviationTheta2Deg => "joint_deviation_theta2_deg",
+            TunedParam::PitchRangeDeg => "pitch_range_deg",
+        }
+    }
+
+    /// Every name, comma-separated.
+    pub fn names() -> String {
+        TunedParam::ALL.map(TunedParam::as_str).join(", ")
+    }
+
+    /// Sets this parameter of `p` to `v`.
+    pub fn apply(self, p: &mut PlannerParams, v: f64) {
+        match self {
+            TunedParam::SfC => p.sf_c = v,
+            TunedParam::HeightStepMm => p.height_step_mm = v,
+            TunedParam::AngularStepDeg => p.angular_step_deg = v,
+            TunedParam::VerticalDeviationDeg => p.vertical_deviation_deg = v,
+            TunedParam::JointDeviationDeg => {
+                p.joint_deviation_theta1_deg = v;
+                p.joint_deviation_theta2_deg = v;
+            }
+            TunedParam::JointDeviationTheta1Deg => p.joint_deviation_theta1_deg = v,
+            TunedParam::JointDeviationTheta2Deg => p.joint_deviation_theta2_deg = v,
+            TunedParam::PitchRangeDeg => p.pitch_range_deg = v,
+        }
+    }
+}
+
+impl std::fmt::Display for TunedParam {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
+impl std::str::FromStr for TunedParam {
+    type Err = SweepError;
+
+    fn from_str(name: &str) -> Result<Self, SweepError> {
+        TunedParam::ALL
+            .into_iter()
+            .find(|p| p.as_str() == name)
+            .ok_or_else(|| SweepError::UnknownParameter(name.to_string()))
+    }
+}
+
+impl Serialize for TunedParam {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.as_str())
+    }
+}
 
 /// One swept parameter: its name and values.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Sweep {
-    /// Parameter name (one of [`PARAMETERS`]).
-    pub name: String,
+    /// The parameter.
+    pub name: TunedParam,
     /// Values, in order.
     pub values: Vec<f64>,
+}
+
+/// Why a `--param` value is not a sweep; each variant holds the value given.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SweepError {
+    /// Not of the form `NAME=START:END:STEP`.
+    #[error("`{0}` is not NAME=START:END:STEP")]
+    NotASweep(String),
+    /// A name that is not a [`TunedParam`].
+    #[error("unknown parameter `{0}` (one of {names})", names = TunedParam::names())]
+    UnknownParameter(String),
+    /// START, END or STEP is not a number.
+    #[error("`{0}`: START, END and STEP must be numbers")]
+    NotNumbers(String),
+    /// STEP ≤ 0, END < START, or a bound not finite.
+    #[error("`{0}`: need STEP > 0 and END >= START")]
+    BadRange(String),
+    /// More than 1000 values.
+    #[error("`{sweep}`: {values} values, more than 1000")]
+    TooManyValues {
+        /// The value given.
+        sweep: String,
+        /// How many values it makes.
+        values: usize,
+    },
 }
 
 /// Parses `NAME=START:END:STEP`.
 ///
 /// # Errors
-/// A one-line message.
-pub fn parse_sweep(s: &str) -> Result<Sweep, String> {
-    let (name, range) = s
-        .split_once('=')
-        .ok_or_else(|| format!("`{s}` is not NAME=START:END:STEP"))?;
-    if !PARAMETERS.contains(&name) {
-        return Err(format!(
-            "unknown parameter `{name}` (one of {})",
-            PARAMETERS.join(", ")
-        ));
-    }
+/// [`SweepError`] saying what is wrong.
+pub fn parse_sweep(s: &str) -> Result<Sweep, SweepError> {
+    let not_a_sweep = || SweepError::NotASweep(s.to_string());
+    let (name, range) = s.split_once('=').ok_or_else(not_a_sweep)?;
+    let name: TunedParam = name.parse()?;
     let parts: Vec<f64> = range
         .split(':')
         .map(|v| v.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| format!("`{s}`: START, END and STEP must be numbers"))?;
+        .map_err(|_| SweepError::NotNumbers(s.to_string()))?;
     let [start, end, step] = parts[..] else {
-        return Err(format!("`{s}` is not NAME=START:END:STEP"));
+        return Err(not_a_sweep());
     };
     if !(step > 0.0 && end >= start && start.is_finite() && end.is_finite()) {
-        return Err(format!("`{s}`: need STEP > 0 and END >= START"));
+        return Err(SweepError::BadRange(s.to_string()));
     }
     let n = ((end - start) / step + 1e-9).floor() as usize + 1;
     if n > 1000 {
-        return Err(format!("`{s}`: {n} values, more than 1000"));
+        return Err(SweepError::TooManyValues {
+            sweep: s.to_string(),
+            values: n,
+        });
     }
     // Rounded to 1e-9 so that 0.1 steps give 0.3, not 0.30000000000000004.
     let values = (0..n)
         .map(|i| ((start + i as f64 * step) * 1e9).round() / 1e9)
         .collect();
-    Ok(Sweep {
-        name: name.to_string(),
-        values,
-    })
+    Ok(Sweep { name, values })
 }
 
-fn apply(p: &mut PlannerParams, name: &str, v: f64) {
-    match name {
-        "sf_c" => p.sf_c = v,
-        "height_step_mm" => p.height_step_mm = v,
-        "angular_step_deg" => p.angular_step_deg = v,
-        "vertical_deviation_deg" => p.vertical_deviation_deg = v,
-        "joint_deviation_deg" => {
-            p.joint_deviation_theta1_deg = v;
-            p.joint_deviation_theta2_deg = v;
-        }
-        "joint_deviation_theta1_deg" => p.joint_deviation_theta1_deg = v,
-        "joint_deviation_theta2_deg" => p.joint_deviation_theta2_deg = v,
-        "pitch_range_deg" => p.pitch_range_deg = v,
-        _ => {}
+impl std::str::FromStr for Sweep {
+    type Err = SweepError;
+
+    fn from_str(s: &str) -> Result<Self, SweepError> {
+        parse_sweep(s)
     }
 }
 
@@ -115,16 +210,36 @@ pub fn grid(sweeps: &[Sweep]) -> Vec<Vec<f64>> {
     out
 }
 
+/// What became of an object at one setting.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ObjectStatus {
+    /// Planned: a feasible grasp found.
+    Feasible,
+    /// No feasible grasp.
+    Ungraspable,
+    /// The scenario fixes the joint angles (`[sim] override_angles`): checked with them, not
+    /// planned.
+    OverrideAngles,
+    /// The setting breaks a rule for this object's hand: not run.
+    Invalid,
+}
+
+/// `None` as `"not_run"`.
+fn verdict_or_not_run<S: serde::Serializer>(v: &Option<Verdict>, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_str(v.map_or("not_run", Verdict::as_str))
+}
+
 /// An object's result at one setting.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ObjectResult {
     /// Scenario name.
     pub scenario: String,
-    /// `feasible`, `ungraspable`, `override_angles` (the scenario fixes the joint angles: checked
-    /// with them, not planned), or `invalid` (the setting breaks a rule for this hand).
-    pub status: String,
-    /// `hold`, `slip`, `drop` or `not_run`.
-    pub verdict: String,
+    /// What became of the object.
+    pub status: ObjectStatus,
+    /// The physics check's verdict; `not_run` in JSON when it did not run (`None`).
+    #[serde(serialize_with = "verdict_or_not_run")]
+    pub verdict: Option<Verdict>,
     /// Translation during the hold `[mm]`.
     pub translation_mm: Option<f64>,
     /// Payload margin (held objects only).
@@ -184,34 +299,14 @@ pub struct TuneResult {
 
 struct Prepared {
     scenario: Scenario,
-    /// The mesh as loaded (original frame), for planning on every axis.
-    mesh: crate::mesh::Mesh,
-    props: crate::mesh::MassProperties,
-    aligned: AlignedObject,
-    shape: ObjectShape,
-    mass_kg: f64,
+    object: PreparedObject,
 }
 
-/// Simulated grasps by (axis, fingerprint): verdict, translation, payload margin of a hold, and
-/// the outcome.
-type SimCache =
-    HashMap<(crate::mesh::GraspAxis, Vec<u64>), (Verdict, f64, Option<f64>, sim::SimOutcome)>;
+/// A simulated grasp: verdict, translation, payload margin of a hold, and the outcome.
+type Simulated = (Verdict, f64, Option<f64>, sim::SimOutcome);
 
-/// The object's collider about `a`'s axis (the thesis axis's is prepared; others made once).
-fn shape_for(
-    p: &Prepared,
-    a: &AlignedObject,
-    shapes: &std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>>,
-) -> ObjectShape {
-    if a.axis == p.aligned.axis {
-        return p.shape.clone();
-    }
-    shapes
-        .borrow_mut()
-        .entry(a.axis)
-        .or_insert_with(|| ObjectShape::from_mesh(&a.mesh, p.props.volume_mm3))
-        .clone()
-}
+/// Simulated grasps by (axis, fingerprint).
+type SimCache = HashMap<(crate::mesh::GraspAxis, Vec<u64>), Simulated>;
 
 /// The physics check of a pose (and its payload margin when it holds), cached by `key`.
 fn simulate(
@@ -221,19 +316,12 @@ fn simulate(
     key: (crate::mesh::GraspAxis, Vec<u64>),
     sims: &mut SimCache,
     counters: &mut TuneCounters,
-) -> (Verdict, f64, Option<f64>, sim::SimOutcome) {
+) -> Simulated {
     if let Some(o) = sims.get(&key) {
         counters.sim_reused += 1;
         return o.clone();
     }
-    let case = sim::Case {
-        hand: &p.scenario.hand,
-        pose,
-        object: shape,
-        mass_kg: p.mass_kg,
-        friction: p.scenario.object.friction,
-        params: &p.scenario.sim,
-    };
+    let case = p.object.case(&p.scenario, pose, shape);
     let out = sim::check(&case);
     counters.sim_runs += 1;
     let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
@@ -290,23 +378,8 @@ pub fn tune_with_progress(
     let mut prepared = Vec::new();
     for item in items {
         let scenario = scenario_for(item, template)?;
-        let loaded = load_mesh(&scenario.object.mesh, scenario.object.units)?;
-        let props = crate::mesh::mass_properties(&loaded.mesh);
-        let aligned = crate::mesh::align_with(&loaded.mesh, &props, crate::mesh::GraspAxis::THESIS);
-        let volume = aligned.original.volume_mm3;
-        let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
-        let mass_kg = match scenario.object.mass {
-            MassSpec::Mass(m) => m,
-            MassSpec::Density(d) => d * volume * 1e-9,
-        };
-        prepared.push(Prepared {
-            scenario,
-            mesh: loaded.mesh,
-            props,
-            aligned,
-            shape,
-            mass_kg,
-        });
+        let object = PreparedObject::load(&scenario.object, &mut StageTimings::default())?;
+        prepared.push(Prepared { scenario, object });
     }
     let work = || -> Vec<PerObject> {
         prepared
@@ -369,7 +442,10 @@ fn score(values: Vec<f64>, objects: Vec<ObjectResult>) -> SettingResult {
         .iter()
         .find_map(|o| o.reason.as_ref().map(|r| format!("{}: {r}", o.scenario)));
     let n = objects.len().max(1) as f64;
-    let held: Vec<&ObjectResult> = objects.iter().filter(|o| o.verdict == "hold").collect();
+    let held: Vec<&ObjectResult> = objects
+        .iter()
+        .filter(|o| o.verdict == Some(Verdict::Hold))
+        .collect();
     let mean_translation_mm = (!held.is_empty())
         .then(|| held.iter().filter_map(|o| o.translation_mm).sum::<f64>() / held.len() as f64);
     SettingResult {
@@ -394,14 +470,7 @@ fn run_object(
     candidates: usize,
     progress: &(dyn Fn(&str) + Sync),
 ) -> PerObject {
-    let mut counters = TuneCounters::default();
-    let mut domains: HashMap<(u64, u64), Domain> = HashMap::new();
-    let mut sims: SimCache = HashMap::new();
-    let select_domains: crate::select::DomainCache = Default::default();
-    let shapes: std::cell::RefCell<HashMap<crate::mesh::GraspAxis, ObjectShape>> =
-        Default::default();
-    let hand = &p.scenario.hand;
-    let friction = p.scenario.object.friction;
+    let mut shared = Shared::default();
     let mut results = Vec::with_capacity(settings.len());
     for values in settings {
         if !results.is_empty() {
@@ -409,140 +478,155 @@ fn run_object(
         }
         let mut params = p.scenario.planner.clone();
         for (s, v) in sweeps.iter().zip(values) {
-            apply(&mut params, &s.name, *v);
+            s.name.apply(&mut params, *v);
         }
-        let name = p.scenario.name.clone();
-        if let Err((key, why)) = validate_planner(&params, hand, friction) {
-            results.push(ObjectResult {
-                scenario: name,
-                status: "invalid".to_string(),
-                verdict: "not_run".to_string(),
-                translation_mm: None,
-                payload_margin: None,
-                reason: Some(format!("{key} {why}")),
-            });
-            continue;
-        }
-        let s = &p.scenario.sim;
-        // A scenario that fixes the joint angles (`[sim] override_angles`) is checked with them,
-        // as `grasp-sim scenario.toml` does: its outcome does not depend on the planner.
-        if let Some(angles) = &s.override_angles {
-            let key = (
-                params.angular_step_deg.to_bits(),
-                params.height_step_mm.to_bits(),
-            );
-            let domain = domains
-                .entry(key)
-                .or_insert_with(|| {
-                    counters.domains_built += 1;
-                    Domain::build(&p.aligned.mesh, &params, hand)
-                })
-                .clone();
-            let mut t = BTreeMap::new();
-            let graded = plan::grade_built(domain, hand, &params, friction, &mut t);
-            let pose = crate::override_pose(&p.aligned.mesh, hand, &graded, s, angles);
-            let outcome = pose.ok().map(|pose| {
-                let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
-                simulate(p, &pose, &p.shape, key, &mut sims, &mut counters)
-            });
-            results.push(ObjectResult {
-                scenario: name,
-                status: "override_angles".to_string(),
-                verdict: outcome
-                    .as_ref()
-                    .map_or("not_run", |o| o.0.as_str())
-                    .to_string(),
-                translation_mm: outcome.as_ref().map(|o| o.1),
-                payload_margin: outcome.as_ref().and_then(|o| o.2),
-                reason: None,
-            });
-            continue;
-        }
-        // As a run plans and chooses (every axis, the extended rules when the thesis's find
-        // nothing, candidates checked until one holds): the grasp a setting leads to. A grasp
-        // two settings share is simulated once.
-        let sims_cell = std::cell::RefCell::new(std::mem::take(&mut sims));
-        let counters_cell = std::cell::RefCell::new(std::mem::take(&mut counters));
-        let check = |a: &AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
-            let pose = SimHand::from_grasp(g);
-            let shape = shape_for(p, a, &shapes);
-            let key = (a.axis, fingerprint(&pose));
-            let o = simulate(
-                p,
-                &pose,
-                &shape,
-                key,
-                &mut sims_cell.borrow_mut(),
-                &mut counters_cell.borrow_mut(),
-            );
-            sim::SimOutcome {
-                verdict: o.0,
-                translation_mm: o.1,
-                ..o.3.clone()
+        let valid = validate_planner(&params, &p.scenario.hand, p.scenario.object.friction);
+        results.push(match (valid, &p.scenario.sim.override_angles) {
+            (Err((key, why)), _) => {
+                object_result(p, ObjectStatus::Invalid, None, Some(format!("{key} {why}")))
             }
-        };
-        let mut t = BTreeMap::new();
-        let selection = crate::select::select(
-            &p.mesh,
-            &p.props,
-            &crate::select::SelectParams {
-                hand,
-                planner: &params,
-                friction,
-                collect: candidates,
-                max_checked: Some(s.max_checked.max(1)),
-                check: &check,
-                domains: Some(&select_domains),
-            },
-            &mut t,
-        );
-        sims = sims_cell.into_inner();
-        counters = counters_cell.into_inner();
-        counters.domains_built = domains.len() + select_domains.borrow().len();
-        counters.plans += 1;
-        let chosen = selection.chosen().and_then(|c| {
-            let a = &selection.axes[c.axis_plan].aligned;
-            let pose = SimHand::from_grasp(&c.grasp);
-            sims.get(&(a.axis, fingerprint(&pose))).cloned()
-        });
-        let Some(best) = chosen else {
-            results.push(ObjectResult {
-                scenario: name,
-                status: if selection.chosen.is_some() {
-                    "feasible"
-                } else {
-                    "ungraspable"
-                }
-                .to_string(),
-                verdict: "not_run".to_string(),
-                translation_mm: None,
-                payload_margin: None,
-                reason: None,
-            });
-            continue;
-        };
-        let status = "feasible";
-        let (verdict, translation, margin) = (best.0, best.1, best.2);
-        results.push(ObjectResult {
-            scenario: name,
-            status: status.to_string(),
-            verdict: verdict.as_str().to_string(),
-            translation_mm: Some(translation),
-            payload_margin: margin,
-            reason: None,
+            // A scenario that fixes the joint angles (`[sim] override_angles`) is checked with
+            // them, as `grasp-sim scenario.toml` does: its outcome does not depend on the planner.
+            (Ok(()), Some(angles)) => run_override(p, &params, angles, &mut shared),
+            (Ok(()), None) => run_planned(p, &params, candidates, &mut shared),
         });
     }
     if !results.is_empty() {
         progress(&p.scenario.name);
     }
-    PerObject { results, counters }
+    PerObject {
+        results,
+        counters: shared.counters,
+    }
+}
+
+/// What an object's runs at different settings share.
+#[derive(Default)]
+struct Shared {
+    counters: TuneCounters,
+    /// Thesis-axis stage-1 domains by (AngularStep, HeightStep) bits, for `override_angles`.
+    domains: HashMap<(u64, u64), Domain>,
+    sims: SimCache,
+    /// Stage-1 domains of the planner's selection, every axis and rule set.
+    select_domains: crate::select::DomainCache,
+}
+
+fn object_result(
+    p: &Prepared,
+    status: ObjectStatus,
+    outcome: Option<&Simulated>,
+    reason: Option<String>,
+) -> ObjectResult {
+    ObjectResult {
+        scenario: p.scenario.name.clone(),
+        status,
+        verdict: outcome.map(|o| o.0),
+        translation_mm: outcome.map(|o| o.1),
+        payload_margin: outcome.and_then(|o| o.2),
+        reason,
+    }
+}
+
+/// An `override_angles` scenario at one setting: the fixed angles at the pose the setting's
+/// graded domain (thesis axis) gives.
+fn run_override(
+    p: &Prepared,
+    params: &PlannerParams,
+    angles: &[[f64; 2]],
+    shared: &mut Shared,
+) -> ObjectResult {
+    let (hand, aligned) = (&p.scenario.hand, &p.object.aligned);
+    let key = (
+        params.angular_step_deg.to_bits(),
+        params.height_step_mm.to_bits(),
+    );
+    let counters = &mut shared.counters;
+    let domain = shared
+        .domains
+        .entry(key)
+        .or_insert_with(|| {
+            counters.domains_built += 1;
+            Domain::build(&aligned.mesh, params, hand)
+        })
+        .clone();
+    let mut t = StageTimings::default();
+    let graded = plan::grade_built(domain, hand, params, p.scenario.object.friction, &mut t);
+    let pose = SimHand::from_override(&aligned.mesh, hand, &graded, &p.scenario.sim, angles);
+    let outcome = pose.ok().map(|pose| {
+        let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
+        let shape = p.object.shape(aligned);
+        simulate(
+            p,
+            &pose,
+            &shape,
+            key,
+            &mut shared.sims,
+            &mut shared.counters,
+        )
+    });
+    object_result(p, ObjectStatus::OverrideAngles, outcome.as_ref(), None)
+}
+
+/// A planned object at one setting, planned and chosen as a run does (every axis, the extended
+/// rules when the thesis's find nothing, candidates checked until one holds). A grasp two
+/// settings share is simulated once.
+fn run_planned(
+    p: &Prepared,
+    params: &PlannerParams,
+    candidates: usize,
+    shared: &mut Shared,
+) -> ObjectResult {
+    let cache = std::cell::RefCell::new((
+        std::mem::take(&mut shared.sims),
+        std::mem::take(&mut shared.counters),
+    ));
+    let check = |a: &AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
+        let pose = SimHand::from_grasp(g);
+        let shape = p.object.shape(a);
+        let key = (a.axis, fingerprint(&pose));
+        let (sims, counters) = &mut *cache.borrow_mut();
+        let o = simulate(p, &pose, &shape, key, sims, counters);
+        sim::SimOutcome {
+            verdict: o.0,
+            translation_mm: o.1,
+            ..o.3
+        }
+    };
+    let mut t = StageTimings::default();
+    let selection = crate::select::select(
+        p.object.mesh(),
+        &p.object.props,
+        &crate::select::SelectParams {
+            hand: &p.scenario.hand,
+            planner: params,
+            friction: p.scenario.object.friction,
+            collect: candidates,
+            max_checked: Some(p.scenario.sim.max_checked.max(1)),
+            check: &check,
+            domains: Some(&shared.select_domains),
+        },
+        &mut t,
+    );
+    (shared.sims, shared.counters) = cache.into_inner();
+    shared.counters.domains_built = shared.domains.len() + shared.select_domains.borrow().len();
+    shared.counters.plans += 1;
+    let best = selection.chosen().and_then(|c| {
+        let a = &selection.axes[c.axis_plan].aligned;
+        let pose = SimHand::from_grasp(&c.grasp);
+        shared.sims.get(&(a.axis, fingerprint(&pose))).cloned()
+    });
+    let status = match selection.chosen {
+        Some(_) => ObjectStatus::Feasible,
+        None => ObjectStatus::Ungraspable,
+    };
+    object_result(p, status, best.as_ref(), None)
 }
 
 /// The results as CSV: one row per setting, a column per swept parameter.
 pub fn to_csv(r: &TuneResult) -> String {
     let mut s = String::new();
     for sw in &r.sweeps {
-        s.push_str(&sw.name);
+        s.push_str(sw.name.as_str());
         s.push(',');
     }
     s.push_str("hold_rate,mean_payload_margin,mean_translation_mm,held,feasible,objects,invalid\n");
@@ -559,11 +643,15 @@ pub fn to_csv(r: &TuneResult) -> String {
             ));
             continue;
         }
-        let held = set.objects.iter().filter(|o| o.verdict == "hold").count();
+        let held = set
+            .objects
+            .iter()
+            .filter(|o| o.verdict == Some(Verdict::Hold))
+            .count();
         let feasible = set
             .objects
             .iter()
-            .filter(|o| o.status == "feasible")
+            .filter(|o| o.status == ObjectStatus::Feasible)
             .count();
         s.push_str(&format!(
             "{:.6},{:.6},{},{held},{feasible},{},\n",
@@ -604,12 +692,22 @@ pub fn to_table(r: &TuneResult) -> String {
     s
 }
 
+/// A score plot that could not be drawn or written.
+#[derive(Debug, thiserror::Error)]
+#[error("{}: cannot draw: {message}", path.display())]
+pub struct PlotError {
+    /// The SVG file.
+    pub path: std::path::PathBuf,
+    /// What went wrong.
+    pub message: String,
+}
+
 /// Writes one SVG per swept parameter: hold rate and mean payload margin of the best setting at
 /// each value of that parameter.
 ///
 /// # Errors
-/// A message when the plot cannot be drawn or written.
-pub fn plot(r: &TuneResult, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> {
+/// [`PlotError`] when a plot cannot be drawn or written.
+pub fn plot(r: &TuneResult, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, PlotError> {
     use plotters::prelude::*;
     let mut written = Vec::new();
     for (i, sw) in r.sweeps.iter().enumerate() {
@@ -677,8 +775,35 @@ pub fn plot(r: &TuneResult, dir: &std::path::Path) -> Result<Vec<std::path::Path
             root.present()?;
             Ok(())
         };
-        draw().map_err(|e| format!("{}: cannot draw: {e}", path.display()))?;
+        draw().map_err(|e| PlotError {
+            path: path.clone(),
+            message: e.to_string(),
+        })?;
         written.push(path);
     }
     Ok(written)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_tuned_parameter_parses_from_its_name_and_sets_a_planner_value() {
+        for p in TunedParam::ALL {
+            assert_eq!(p.as_str().parse::<TunedParam>(), Ok(p));
+            let mut params = PlannerParams::default();
+            p.apply(&mut params, 0.125);
+            assert_ne!(params, PlannerParams::default(), "{p}");
+        }
+        assert_eq!(
+            "colour".parse::<TunedParam>(),
+            Err(SweepError::UnknownParameter("colour".to_string()))
+        );
+    }
+
+    #[test]
+    fn names_keep_their_padding_in_tables() {
+        assert_eq!(format!("{:>6}|", TunedParam::SfC), "  sf_c|");
+    }
 }

@@ -50,7 +50,8 @@ fn parse_records(path: &Path, bytes: &[u8]) -> Result<ReadRecords, BatchError> {
             why,
         };
         let text = std::str::from_utf8(line).map_err(|_| not_record("not UTF-8".into()))?;
-        let record = Record::parse(text.trim_end_matches('\r')).map_err(not_record)?;
+        let record =
+            Record::parse(text.trim_end_matches('\r')).map_err(|e| not_record(e.to_string()))?;
         out.records.push((i + 1, record));
     }
     Ok(out)

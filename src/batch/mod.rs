@@ -18,10 +18,10 @@ pub mod journal;
 pub mod record;
 
 pub use isolate::{Interrupted, Worker};
-pub use record::{input_hash, Key, Record};
+pub use record::{input_hash, Key, Record, RecordError};
 
 use crate::hand::Hand;
-use crate::scenario::{MassSpec, ObjectSpec, PlannerParams, Scenario, ScenarioError, SimParams};
+use crate::scenario::{ObjectSpec, PlannerParams, Scenario, ScenarioError, SimParams};
 use crate::{run, Error, RunOptions};
 use rayon::prelude::*;
 use record::BatchInfo;
@@ -158,12 +158,7 @@ pub fn default_template() -> Scenario {
     Scenario {
         path: PathBuf::from("<built-in template>"),
         name: String::new(),
-        object: ObjectSpec {
-            mesh: PathBuf::new(),
-            units: Default::default(),
-            mass: MassSpec::Density(crate::scenario::DEFAULT_DENSITY_KG_M3),
-            friction: 0.3,
-        },
+        object: ObjectSpec::with_defaults(PathBuf::new()),
         hand,
         hand_file: PathBuf::from("<built-in thesis hand>"),
         planner: PlannerParams::default(),
@@ -192,32 +187,71 @@ pub fn scenario_for(item: &Item, template: &Scenario) -> Result<Scenario, Error>
     }
 }
 
+/// A shard `K/N`: the K-th (1-based) of N contiguous blocks of the inputs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Shard {
+    /// Which block, 1 ≤ K ≤ N.
+    pub k: usize,
+    /// How many blocks.
+    pub n: usize,
+}
+
+/// Why a `--shard` value is not `K/N`; each variant holds the value given.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum ShardError {
+    /// No `/`.
+    #[error("shard `{0}` is not K/N")]
+    NotKOverN(String),
+    /// K or N is not a number.
+    #[error("shard `{shard}`: {part} is not a number")]
+    NotANumber {
+        /// The value given.
+        shard: String,
+        /// `K` or `N`.
+        part: char,
+    },
+    /// Not 1 ≤ K ≤ N.
+    #[error("shard `{0}`: need 1 <= K <= N")]
+    OutOfRange(String),
+}
+
 /// Parses `K/N` (1 ≤ K ≤ N).
 ///
 /// # Errors
-/// A message saying what is wrong.
-pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+/// [`ShardError`] saying what is wrong.
+pub fn parse_shard(s: &str) -> Result<Shard, ShardError> {
     let (k, n) = s
         .split_once('/')
-        .ok_or_else(|| format!("shard `{s}` is not K/N"))?;
-    let k: usize = k
-        .trim()
-        .parse()
-        .map_err(|_| format!("shard `{s}`: K is not a number"))?;
-    let n: usize = n
-        .trim()
-        .parse()
-        .map_err(|_| format!("shard `{s}`: N is not a number"))?;
+        .ok_or_else(|| ShardError::NotKOverN(s.to_string()))?;
+    let number = |v: &str, part: char| {
+        v.trim()
+            .parse::<usize>()
+            .map_err(|_| ShardError::NotANumber {
+                shard: s.to_string(),
+                part,
+            })
+    };
+    let (k, n) = (number(k, 'K')?, number(n, 'N')?);
     if n == 0 || k == 0 || k > n {
-        return Err(format!("shard `{s}`: need 1 <= K <= N"));
+        return Err(ShardError::OutOfRange(s.to_string()));
     }
-    Ok((k, n))
+    Ok(Shard { k, n })
 }
 
-/// The K-th (1-based) of N contiguous blocks of `items`.
-pub fn shard<T: Clone>(items: &[T], k: usize, n: usize) -> Vec<T> {
-    let len = items.len();
-    items[(k - 1) * len / n..k * len / n].to_vec()
+impl std::str::FromStr for Shard {
+    type Err = ShardError;
+
+    fn from_str(s: &str) -> Result<Self, ShardError> {
+        parse_shard(s)
+    }
+}
+
+impl Shard {
+    /// This shard's block of `items`.
+    pub fn of<T: Clone>(self, items: &[T]) -> Vec<T> {
+        let (k, n, len) = (self.k, self.n, items.len());
+        items[(k - 1) * len / n..k * len / n].to_vec()
+    }
 }
 
 /// How each object runs.
@@ -499,5 +533,34 @@ pub fn plural(n: usize, thing: &str) -> String {
         format!("1 {thing}")
     } else {
         format!("{n} {thing}s")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn shards_parse_and_split_into_contiguous_blocks() {
+        let table = [
+            ("2/3", Ok(Shard { k: 2, n: 3 })),
+            (" 1 / 1 ", Ok(Shard { k: 1, n: 1 })),
+            ("3/2", Err(ShardError::OutOfRange("3/2".to_string()))),
+            ("0/2", Err(ShardError::OutOfRange("0/2".to_string()))),
+            ("2", Err(ShardError::NotKOverN("2".to_string()))),
+            (
+                "x/2",
+                Err(ShardError::NotANumber {
+                    shard: "x/2".to_string(),
+                    part: 'K',
+                }),
+            ),
+        ];
+        for (text, expected) in table {
+            assert_eq!(text.parse::<Shard>(), expected, "{text}");
+        }
+        let items: Vec<u32> = (1..=7).collect();
+        let blocks: Vec<Vec<u32>> = (1..=3).map(|k| Shard { k, n: 3 }.of(&items)).collect();
+        assert_eq!(blocks, [vec![1, 2], vec![3, 4], vec![5, 6, 7]]);
     }
 }

@@ -36,6 +36,17 @@ pub struct BatchInfo {
     pub wall_ms: f64,
 }
 
+/// Why a line is not a batch record.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum RecordError {
+    /// Not JSON, with the parser's message.
+    #[error("not JSON ({0})")]
+    NotJson(String),
+    /// JSON without `batch.<field>`.
+    #[error("no `batch.{0}` (not a line written by `batch`)")]
+    NoBatchField(&'static str),
+}
+
 /// One object's line, kept as the text written (so a line read back from a file is written
 /// again byte for byte) and as parsed JSON (to count outcomes).
 #[derive(Debug, Clone, PartialEq)]
@@ -110,15 +121,15 @@ impl Record {
     /// `batch.input_hash`.
     ///
     /// # Errors
-    /// What is wrong with the line, in a few words.
-    pub fn parse(line: &str) -> Result<Record, String> {
+    /// [`RecordError`]: what is wrong with the line.
+    pub fn parse(line: &str) -> Result<Record, RecordError> {
         let value: serde_json::Value =
-            serde_json::from_str(line).map_err(|e| format!("not JSON ({e})"))?;
-        let field = |name: &str| {
+            serde_json::from_str(line).map_err(|e| RecordError::NotJson(e.to_string()))?;
+        let field = |name: &'static str| {
             value["batch"][name]
                 .as_str()
                 .map(str::to_string)
-                .ok_or_else(|| format!("no `batch.{name}` (not a line written by `batch`)"))
+                .ok_or(RecordError::NoBatchField(name))
         };
         let key = Key {
             input: field("input")?,
@@ -206,7 +217,7 @@ mod tests {
             ("{\"batch\":", "not JSON"),
             ("[1,2]", "no `batch.input`"),
         ] {
-            let e = Record::parse(line).unwrap_err();
+            let e = Record::parse(line).unwrap_err().to_string();
             assert!(e.contains(why), "{line}: {e}");
         }
     }

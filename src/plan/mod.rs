@@ -29,7 +29,7 @@ pub use params::PlannerParams;
 
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use std::collections::BTreeMap;
+use crate::report::StageTimings;
 use std::time::Instant;
 
 /// A grade of an indexed elevation: a number (larger is better), or ungraspable.
@@ -110,7 +110,7 @@ pub fn grade_domain(
     hand: &Hand,
     params: &PlannerParams,
     friction: f64,
-    timings: &mut BTreeMap<String, f64>,
+    timings: &mut StageTimings,
 ) -> GradedDomain {
     grade_domain_with(mesh, hand, params, friction, RuleSet::Thesis, timings)
 }
@@ -123,11 +123,11 @@ pub fn grade_domain_with(
     params: &PlannerParams,
     friction: f64,
     rules: RuleSet,
-    timings: &mut BTreeMap<String, f64>,
+    timings: &mut StageTimings,
 ) -> GradedDomain {
     let t = Instant::now();
     let domain = stage1_with(mesh, hand, params, rules);
-    timings.insert("stage1_domain".to_string(), ms(t));
+    timings.stage1_domain = ms(t);
     grade_built_with(domain, hand, params, friction, rules, timings)
 }
 
@@ -150,7 +150,7 @@ pub fn grade_built(
     hand: &Hand,
     params: &PlannerParams,
     friction: f64,
-    timings: &mut BTreeMap<String, f64>,
+    timings: &mut StageTimings,
 ) -> GradedDomain {
     grade_built_with(domain, hand, params, friction, RuleSet::Thesis, timings)
 }
@@ -162,7 +162,7 @@ pub fn grade_built_with(
     params: &PlannerParams,
     friction: f64,
     rules: RuleSet,
-    timings: &mut BTreeMap<String, f64>,
+    timings: &mut StageTimings,
 ) -> GradedDomain {
     let t = Instant::now();
     let mut cparams = CurvatureParams::from_planner(params, hand, friction);
@@ -170,15 +170,15 @@ pub fn grade_built_with(
         cparams.ungraspable_grade = Some(EXTENDED_CURVATURE_FLOOR);
     }
     let (curvature, floored) = curvature::grade_elevations_marked(&domain, &cparams);
-    timings.insert("stage2_curvature".to_string(), ms(t));
+    timings.stage2_curvature = ms(t);
     let t = Instant::now();
     let range = kinematics::graspable_range_with(hand, params.magnify_factor);
     let diameter = diameter::grade_elevations(&domain, range.used());
-    timings.insert("stage2_diameter".to_string(), ms(t));
+    timings.stage2_diameter = ms(t);
     let t = Instant::now();
     let mut graded = palm_grade::rank_with(domain, curvature, diameter, range, params, hand, rules);
     graded.curvature_relaxed = floored;
-    timings.insert("stage3_palm".to_string(), ms(t));
+    timings.stage3_palm = ms(t);
     graded
 }
 
@@ -198,12 +198,12 @@ pub fn plan(
     params: &PlannerParams,
     friction: f64,
     max_grasps: usize,
-    timings: &mut BTreeMap<String, f64>,
+    timings: &mut StageTimings,
 ) -> (GradedDomain, search::SearchResult) {
     let graded = grade_domain(mesh, hand, params, friction, timings);
     let t = Instant::now();
     let found = search::search(mesh, hand, &graded, params, max_grasps.max(1));
-    timings.insert("search".to_string(), ms(t));
+    timings.search = ms(t);
     (graded, found)
 }
 

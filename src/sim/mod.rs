@@ -35,7 +35,7 @@ pub use protocol::{
     check, check_closed, check_with_payload, payload_bracket, payload_margin, Closed,
     DirectionOutcome, EarlyDecision, SimOutcome, Verdict,
 };
-pub use scene::{collider_inertia, Case, ObjectShape, SimHand};
+pub use scene::{collider_inertia, Case, ColliderKind, ObjectShape, OverrideError, SimHand};
 
 /// A body's pose: position `[m]` and orientation, aligned object frame.
 pub type BodyPose = (nalgebra::Vector3<f64>, nalgebra::UnitQuaternion<f64>);

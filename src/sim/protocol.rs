@@ -40,6 +40,12 @@ impl Verdict {
     }
 }
 
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
 /// The result for one gravity direction (reported as is in the JSON's `sim.directions`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct DirectionOutcome {

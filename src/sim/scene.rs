@@ -19,7 +19,46 @@ pub struct SimHand {
     pub theta_deg: Vec<[f64; 2]>,
 }
 
+/// Why a scenario's `[sim] override_angles` cannot be checked.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OverrideError {
+    /// The graded domain has no indexed elevation to put the palm on.
+    #[error("override_angles: the object has no indexed elevation")]
+    NoElevation,
+    /// The palm could not be placed at the chosen elevation.
+    #[error("override_angles: palm placement failed: {0:?}")]
+    PalmPlacement(crate::plan::palm::PalmRejection),
+}
+
 impl SimHand {
+    /// The hand pose for a scenario whose joint angles are fixed by `[sim] override_angles`:
+    /// the palm at approach 0 and pitch 0 on indexed elevation `override_index` (default: the
+    /// middle one) of the graded domain.
+    ///
+    /// # Errors
+    /// [`OverrideError`]: why the grasp cannot be checked.
+    pub fn from_override(
+        mesh: &Mesh,
+        hand: &Hand,
+        graded: &crate::plan::GradedDomain,
+        p: &SimParams,
+        angles: &[[f64; 2]],
+    ) -> Result<SimHand, OverrideError> {
+        let n = graded.domain.elevations.len();
+        if n == 0 {
+            return Err(OverrideError::NoElevation);
+        }
+        let index = p.override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
+        let z1 = graded.domain.elevations[index - 1];
+        let palm = crate::plan::palm::place_palm(mesh, hand, z1, 0.0, 0.0)
+            .map_err(OverrideError::PalmPlacement)?;
+        Ok(SimHand {
+            origin_mm: palm.origin,
+            axes: palm.axes,
+            theta_deg: angles.to_vec(),
+        })
+    }
+
     /// The palm pose and the centre ALS's joint angles of a planned grasp.
     pub fn from_grasp(g: &crate::plan::search::Grasp) -> SimHand {
         SimHand {
@@ -34,13 +73,39 @@ impl SimHand {
     }
 }
 
+/// How the object's collider was made.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ColliderKind {
+    /// The convex hull of the mesh (the mesh is convex).
+    ConvexHull,
+    /// A convex decomposition (V-HACD) of the mesh.
+    ConvexDecomposition,
+}
+
+impl ColliderKind {
+    /// The name used in JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            ColliderKind::ConvexHull => "convex_hull",
+            ColliderKind::ConvexDecomposition => "convex_decomposition",
+        }
+    }
+}
+
+impl std::fmt::Display for ColliderKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
 /// The object's collision shape, built once per object and shared by every run.
 #[derive(Clone)]
 pub struct ObjectShape {
     /// The shape in metres, aligned frame.
     pub shape: SharedShape,
-    /// How it was made: `convex_hull` or `convex_decomposition`.
-    pub kind: &'static str,
+    /// How it was made.
+    pub kind: ColliderKind,
     /// Number of convex parts.
     pub parts: usize,
     /// True if and only if the object is inertially a body of revolution about its principal
@@ -61,7 +126,7 @@ impl ObjectShape {
             if hull_mm3 <= volume_mm3 * 1.02 {
                 return ObjectShape {
                     shape: hull,
-                    kind: "convex_hull",
+                    kind: ColliderKind::ConvexHull,
                     parts: 1,
                     is_revolution,
                 };
@@ -76,7 +141,7 @@ impl ObjectShape {
         let parts = shape.as_compound().map_or(1, |c| c.shapes().len());
         ObjectShape {
             shape,
-            kind: "convex_decomposition",
+            kind: ColliderKind::ConvexDecomposition,
             parts,
             is_revolution,
         }

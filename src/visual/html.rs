@@ -1,6 +1,6 @@
 //! report.html: one self-contained page (figures inline, no scripts, fonts or network).
 
-use crate::report::RunReport;
+use crate::report::{RunReport, SimVerdict};
 
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -11,9 +11,9 @@ fn esc(s: &str) -> String {
 /// The physics check in words: its verdict and numbers, or why it did not run.
 fn verdict_sentence(report: &RunReport) -> String {
     let sim = &report.sim;
-    let word = match sim.verdict.as_str() {
-        "not_run" => "not run",
-        other => other,
+    let word = match &sim.verdict {
+        SimVerdict::NotRun { .. } => "not run",
+        SimVerdict::Ran(v) => v.as_str(),
     };
     match (sim.translation_mm, sim.rotation_deg) {
         (Some(t), Some(r)) => format!(
@@ -22,7 +22,7 @@ fn verdict_sentence(report: &RunReport) -> String {
                 .map(|m| format!("; payload margin {m:.2}x"))
                 .unwrap_or_default()
         ),
-        _ => match &sim.reason {
+        _ => match sim.verdict.reason() {
             Some(why) => format!("Physics check: {word} ({why})"),
             None => format!("Physics check: {word}"),
         },
@@ -125,11 +125,11 @@ pub fn page(report: &RunReport, figures: &[(String, String)], scenes: &[&str]) -
     ));
     s.push_str(&format!(
         "<p>Plan: {}; {}</p>",
-        esc(&report.plan.status),
+        esc(report.plan.status.as_str()),
         if report.expect.is_given() {
             format!(
                 "expected outcome {}: {}",
-                esc(&report.expect.outcome),
+                esc(report.expect.outcome_name()),
                 match report.expect.met {
                     Some(true) => "met",
                     Some(false) => "NOT met",

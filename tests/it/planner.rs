@@ -48,7 +48,7 @@ fn effective_elevations_match_the_thesis() {
 #[test]
 fn d10_is_too_thin_everywhere_and_d40_is_not() {
     let r = plan("cylinder_d10");
-    assert_eq!(r.plan.status, "ungraspable");
+    assert_eq!(r.plan.status, grasp_sim::report::PlanStatus::Ungraspable);
     assert!(
         r.plan.reason.as_deref().unwrap().contains("too thin"),
         "{:?}",

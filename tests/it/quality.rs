@@ -38,7 +38,10 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
     // compound objects (epsilon 0 on grasps that held 27x their weight).
     let s = Scenario::load(&crate::root().join("scenarios/chapter4.toml")).unwrap();
     let r = run(&s, &with_quality()).unwrap();
-    assert_eq!(r.sim.verdict, "hold");
+    assert_eq!(
+        r.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold)
+    );
     assert!(
         r.sim
             .collider

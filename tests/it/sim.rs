@@ -46,7 +46,12 @@ fn the_scene_matches_the_plan() {
     // With the default 10° overshoot the fingers grip and the cylinder is held.
     let (_d, s) = scenario_with("cylinder_d40.stl", "");
     let r = run(&s, &with_sim()).unwrap();
-    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim);
+    assert_eq!(
+        r.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        "{:?}",
+        r.sim
+    );
     assert!(r.sim.translation_mm.unwrap() < 5.0, "{:?}", r.sim);
 }
 
@@ -69,8 +74,8 @@ fn no_sim_reports_the_check_as_not_run() {
         ..RunOptions::default()
     };
     let r = run(&s, &opts).unwrap();
-    assert_eq!(r.sim.verdict, "not_run");
-    assert!(r.sim.reason.as_deref().unwrap().contains("--no-sim"));
+    assert_eq!(r.sim.verdict.verdict(), None);
+    assert!(r.sim.verdict.reason().unwrap().contains("--no-sim"));
     assert!(r.sim.translation_mm.is_none());
 }
 
@@ -99,7 +104,7 @@ fn rapier_tolerances_are_pinned_at_hand_scale() {
     let (_d, s) = scenario_with("cylinder_d40.stl", "");
     let mesh = grasp_sim::objects::cylinder(40.0, 124.0);
     let shape = ObjectShape::from_mesh(&mesh, grasp_sim::mesh::mass_properties(&mesh).volume_mm3);
-    assert_eq!(shape.kind, "convex_hull");
+    assert_eq!(shape.kind, grasp_sim::sim::ColliderKind::ConvexHull);
     let pose = SimHand {
         origin_mm: nalgebra::Point3::new(20.0, 0.0, 87.0),
         axes: [
@@ -131,7 +136,10 @@ fn rapier_tolerances_are_pinned_at_hand_scale() {
     // The chapter 4 object is not convex: it gets a convex decomposition, not a hull.
     let c4 = grasp_sim::objects::chapter4(&grasp_sim::objects::Chapter4Dims::default());
     let c4_shape = ObjectShape::from_mesh(&c4, grasp_sim::mesh::mass_properties(&c4).volume_mm3);
-    assert_eq!(c4_shape.kind, "convex_decomposition");
+    assert_eq!(
+        c4_shape.kind,
+        grasp_sim::sim::ColliderKind::ConvexDecomposition
+    );
     assert!(c4_shape.parts > 1);
 }
 
@@ -147,17 +155,32 @@ fn hold_slip_and_drop_are_told_apart() {
     // still in the hand); with weaker motors still the cup slides out, and a slippery, heavy
     // cylinder falls out.
     let hold = scenario("cup");
-    assert_eq!(hold.sim.verdict, "hold", "{:?}", hold.sim);
+    assert_eq!(
+        hold.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        "{:?}",
+        hold.sim
+    );
     assert!(hold.sim.translation_mm.unwrap() < 5.0);
     let slip = scenario("sim_chapter4_weak_motors");
-    assert_eq!(slip.sim.verdict, "slip", "{:?}", slip.sim);
+    assert_eq!(
+        slip.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Slip),
+        "{:?}",
+        slip.sim
+    );
     let t = slip.sim.translation_mm.unwrap();
     assert!(t > 5.0 && t < 40.0, "slip of {t} mm");
     assert!(slip.sim.directions[0].in_contact);
     let mut drops = Vec::new();
     for name in ["sim_cup_weak_motors", "sim_d40_slippery_heavy"] {
         let drop = scenario(name);
-        assert_eq!(drop.sim.verdict, "drop", "{name}: {:?}", drop.sim);
+        assert_eq!(
+            drop.sim.verdict,
+            grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Drop),
+            "{name}: {:?}",
+            drop.sim
+        );
         assert!(!drop.sim.directions[0].in_contact);
         drops.push(drop);
     }
@@ -215,8 +238,14 @@ fn payload_margin_is_found_by_bisection() {
         };
         run(&heavier, &first_only).unwrap().sim.verdict
     };
-    assert_eq!(check(m), "hold");
-    assert_ne!(check(failed), "hold");
+    assert_eq!(
+        check(m),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold)
+    );
+    assert_ne!(
+        check(failed),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold)
+    );
 }
 
 /// The D40 cylinder's planned grasp as a physics case, for the tests of the protocol itself.
@@ -235,7 +264,7 @@ fn d40_case<R>(
         &grasp_sim::scenario::PlannerParams::default(),
         0.3,
         1,
-        &mut std::collections::BTreeMap::new(),
+        &mut grasp_sim::report::StageTimings::default(),
     );
     let pose = SimHand::from_grasp(&found.grasps[0]);
     let volume = grasp_sim::mesh::mass_properties(&aligned.mesh).volume_mm3;
@@ -339,7 +368,7 @@ fn fast_and_full_protocols_agree_on_the_bundled_scenarios() {
         let full = by(Protocol::Full);
         let fast = by(Protocol::Fast);
         assert_eq!(full.verdict, fast.verdict, "{}", path.display());
-        if full.verdict == "not_run" {
+        if full.verdict.verdict().is_none() {
             continue;
         }
         for (a, b) in full.directions.iter().zip(&fast.directions) {
@@ -367,7 +396,12 @@ fn penetration_after_closing_is_reported_and_bounded() {
     let (_d, s) = scenario_with("cylinder_d40.stl", "max_checked = 1");
     let r = run(&s, &with_sim()).unwrap();
     let depth = r.sim.directions[0].closing_penetration_mm;
-    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim);
+    assert_eq!(
+        r.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        "{:?}",
+        r.sim
+    );
     assert!(depth < 0.5, "{depth} mm");
     // Soft contacts (300 Hz) let the motors drive the fingers about 6 mm into it. The object
     // does not move, but a grasp made by fingers inside the object is not a hold ...
@@ -379,7 +413,12 @@ fn penetration_after_closing_is_reported_and_bounded() {
     let dir = &r.sim.directions[0];
     assert!(dir.closing_penetration_mm > 4.0, "{dir:?}");
     assert!(dir.translation_mm < 1.0, "{dir:?}");
-    assert_eq!(r.sim.verdict, "slip", "{:?}", r.sim);
+    assert_eq!(
+        r.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Slip),
+        "{:?}",
+        r.sim
+    );
     assert_eq!(r.expect.met, Some(false));
     // ... unless the bound is raised past the depth.
     let (_d, s) = scenario_with(
@@ -387,7 +426,12 @@ fn penetration_after_closing_is_reported_and_bounded() {
         "max_checked = 1\ncontact_stiffness_hz = 300.0\nmax_penetration_mm = 10.0",
     );
     let r = run(&s, &with_sim()).unwrap();
-    assert_eq!(r.sim.verdict, "hold", "{:?}", r.sim);
+    assert_eq!(
+        r.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        "{:?}",
+        r.sim
+    );
 }
 
 #[test]

@@ -19,7 +19,12 @@ fn plan(name: &str) -> RunReport {
 
 fn grasp(name: &str) -> GraspReport {
     let r = plan(name);
-    assert_eq!(r.plan.status, "feasible", "{name}: {:?}", r.plan.reason);
+    assert_eq!(
+        r.plan.status,
+        grasp_sim::report::PlanStatus::Feasible,
+        "{name}: {:?}",
+        r.plan.reason
+    );
     r.plan.grasp.unwrap()
 }
 
@@ -116,7 +121,7 @@ fn prism_within_tolerance_but_theta2() {
 #[test]
 fn cylinder_d10_is_ungraspable() {
     let r = plan("cylinder_d10");
-    assert_eq!(r.plan.status, "ungraspable");
+    assert_eq!(r.plan.status, grasp_sim::report::PlanStatus::Ungraspable);
     assert!(r.plan.grasp.is_none());
 }
 

@@ -1,7 +1,7 @@
 //! `grasp-sim tune`: a grid over planner parameters ranked by simulated outcomes.
 
 use grasp_sim::batch::{default_template, expand};
-use grasp_sim::tune::{grid, parse_sweep, tune};
+use grasp_sim::tune::{grid, parse_sweep, tune, ObjectStatus};
 
 #[test]
 fn sweeps_parse_and_grids_multiply() {
@@ -10,6 +10,7 @@ fn sweeps_parse_and_grids_multiply() {
     assert_eq!(s.values[3], 0.3);
     assert!(parse_sweep("colour=0:1:0.1")
         .unwrap_err()
+        .to_string()
         .contains("unknown parameter"));
     assert!(parse_sweep("sf_c=1:0:0.1").is_err());
     assert!(parse_sweep("sf_c=0:1").is_err());
@@ -56,6 +57,8 @@ fn settings_that_must_rank_differently_do_and_geometry_is_built_once() {
         "best {:?}",
         r.settings[r.best].values
     );
+    let cup_no_pitch = &r.settings[0].objects[0];
+    assert_eq!(cup_no_pitch.status, ObjectStatus::Feasible);
     // Loading, alignment and the vertical slices are done once per object and per axis and
     // rule set planned, not per setting: neither swept parameter changes the AngularStep or the
     // HeightStep. The cup without pitch is planned on all 6 axes under the thesis's rules and
@@ -92,7 +95,7 @@ fn invalid_settings_are_marked_not_run() {
         1,
     )
     .unwrap();
-    assert_eq!(r.settings[1].objects[0].status, "invalid");
+    assert_eq!(r.settings[1].objects[0].status, ObjectStatus::Invalid);
     assert_eq!(r.settings[1].hold_rate, 0.0);
     assert_eq!(r.best, 0);
 }
@@ -113,8 +116,8 @@ fn a_scenario_with_fixed_joint_angles_is_checked_with_them() {
     .unwrap();
     for s in &r.settings {
         let o = &s.objects[0];
-        assert_eq!(o.status, "override_angles");
-        assert_eq!(o.verdict, "drop", "{o:?}");
+        assert_eq!(o.status, ObjectStatus::OverrideAngles);
+        assert_eq!(o.verdict, Some(grasp_sim::sim::Verdict::Drop), "{o:?}");
         assert_eq!(s.hold_rate, 0.0);
     }
     assert_eq!(r.counters.plans, 0);

@@ -1,0 +1,94 @@
+//! The object as every pipeline needs it, built once: the mesh loaded and validated, its mass
+//! properties, its alignment on the thesis's axis, its mass, and its colliders.
+//!
+//! `run` (one scenario) and `tune` (a grid of planner settings) both start from a
+//! [`PreparedObject`], so loading, aligning, the mass formula and the collider are written once.
+
+use crate::mesh::{self, AlignedObject, GraspAxis, LoadedMesh, MassProperties, Mesh, MeshError};
+use crate::report::StageTimings;
+use crate::scenario::{ObjectSpec, Scenario};
+use crate::sim::{Case, ObjectShape, SimHand};
+use std::collections::BTreeMap;
+use std::sync::Mutex;
+use std::time::Instant;
+
+/// A scenario's object, loaded and aligned, with its mass and (made on demand, once per axis)
+/// its colliders.
+pub struct PreparedObject {
+    /// The mesh as loaded (original frame), with what loading found and repaired.
+    pub loaded: LoadedMesh,
+    /// Mass properties of the loaded mesh (unit density, original frame).
+    pub props: MassProperties,
+    /// The object aligned on the thesis's axis (least moment of inertia).
+    pub aligned: AlignedObject,
+    /// Mass `[kg]`, from the scenario's density or mass.
+    pub mass_kg: f64,
+    /// Colliders by axis, each made the first time it is asked for.
+    shapes: Mutex<BTreeMap<GraspAxis, ObjectShape>>,
+}
+
+impl PreparedObject {
+    /// Loads, validates and aligns `object`'s mesh and computes its mass; `timings` receives
+    /// `load` and `align` `[ms]`.
+    ///
+    /// # Errors
+    /// [`MeshError`] for a bad mesh file.
+    pub fn load(object: &ObjectSpec, timings: &mut StageTimings) -> Result<Self, MeshError> {
+        let t0 = Instant::now();
+        let loaded = mesh::load_mesh(&object.mesh, object.units)?;
+        timings.load = ms(t0);
+        let t1 = Instant::now();
+        let props = mesh::mass_properties(&loaded.mesh);
+        let aligned = mesh::align_with(&loaded.mesh, &props, GraspAxis::THESIS);
+        timings.align = ms(t1);
+        let mass_kg = object.mass.mass_kg(props.volume_mm3);
+        Ok(PreparedObject {
+            loaded,
+            props,
+            aligned,
+            mass_kg,
+            shapes: Mutex::default(),
+        })
+    }
+
+    /// The mesh as loaded (original frame).
+    pub fn mesh(&self) -> &Mesh {
+        &self.loaded.mesh
+    }
+
+    /// Enclosed volume `[mm³]`.
+    pub fn volume_mm3(&self) -> f64 {
+        self.props.volume_mm3
+    }
+
+    /// The collider of the object aligned as `a` is (made once per axis).
+    pub fn shape(&self, a: &AlignedObject) -> ObjectShape {
+        let mut shapes = self.shapes.lock().unwrap_or_else(|e| e.into_inner());
+        shapes
+            .entry(a.axis)
+            .or_insert_with(|| ObjectShape::from_mesh(&a.mesh, self.props.volume_mm3))
+            .clone()
+    }
+
+    /// The physics check's case for `scenario`'s hand, friction and protocol, this object's
+    /// mass, `shape` and the hand `pose`.
+    pub fn case<'a>(
+        &self,
+        scenario: &'a Scenario,
+        pose: &'a SimHand,
+        shape: &'a ObjectShape,
+    ) -> Case<'a> {
+        Case {
+            hand: &scenario.hand,
+            pose,
+            object: shape,
+            mass_kg: self.mass_kg,
+            friction: scenario.object.friction,
+            params: &scenario.sim,
+        }
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1000.0
+}
