@@ -18,8 +18,8 @@
 //!   is exact up to round-off, not sampled. It ends: each step adds a vertex of `W` not yet in
 //!   `Q`, and `W` has finitely many; [`EPA_MAX_POINTS`] bounds it all the same.
 //! - **Volume** needs the whole hull: the incremental Minkowski sum, pruned to its hull's
-//!   vertices (qhull) after each contact, while the next candidate set stays within
-//!   [`VOLUME_MAX_POINTS`]; `None` beyond.
+//!   vertices (qhull) after each contact, when the unpruned sum (the product of the contacts'
+//!   edges + 1) is within [`VOLUME_MAX_POINTS`]; `None` beyond.
 //!
 //! Contacts whose edge wrenches agree (rapier can report one contact twice) are merged first:
 //! `P + P = 2P` exactly for a convex `P`.
@@ -32,11 +32,11 @@ use std::collections::{BinaryHeap, HashMap};
 pub const EPS_REL_TOL: f64 = 1e-9;
 
 /// The search gives up (epsilon `None`, with the reason) after adding this many support
-/// points to the inner polytope (docs/QUALITY.md: the grasps measured needed at most XXX).
-pub const EPA_MAX_POINTS: usize = 2_000;
+/// points to the inner polytope (docs/QUALITY.md: the 179 grasps measured needed at most 84).
+pub const EPA_MAX_POINTS: usize = 1_000;
 
-/// The L∞ volume is computed while every hull the incremental Minkowski sum needs has at most
-/// this many input points (the partial sum's vertices times (edges + 1)); `None` beyond. At 8
+/// The L∞ volume is computed when the unpruned Minkowski sum has at most this many points (the
+/// product over contacts of edges + 1); `None` beyond. At 8
 /// cone edges that is 3 contacts (the sum of two has 81 points and no volume: two point
 /// contacts cannot resist torque about the line through them): the hull of 729 points took
 /// 0.5–1.2 s (release); 4 contacts need one of about 3000 (8–13 s), and the sum's vertices
@@ -627,10 +627,18 @@ pub fn evaluate(per_contact: &[Vec<Wrench>]) -> Linf {
             Some(format!("L-infinity epsilon not computed: {why}")),
         ),
     };
-    let volume = minkowski_sum(&merged, VOLUME_MAX_POINTS).map(|(_, v)| v);
+    // Tried only when the whole sum, unpruned, is within the budget: a hull of the first
+    // three contacts' 729 points costs as much as the check, wasted if a fourth follows.
+    let unpruned = merged
+        .iter()
+        .try_fold(1usize, |n, e| n.checked_mul(e.len() + 1))
+        .unwrap_or(usize::MAX);
+    let volume = (unpruned <= VOLUME_MAX_POINTS)
+        .then(|| minkowski_sum(&merged, VOLUME_MAX_POINTS).map(|(_, v)| v))
+        .flatten();
     if volume.is_none() && note.is_none() {
         note = Some(format!(
-            "L-infinity volume not computed: the Minkowski sum of {} contacts needs a hull of over {VOLUME_MAX_POINTS} points",
+            "L-infinity volume not computed: the Minkowski sum of {} contacts has over {VOLUME_MAX_POINTS} points to hull (at most 3 contacts at 8 cone edges)",
             merged.len()
         ));
     }
