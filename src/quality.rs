@@ -11,7 +11,10 @@
 //!   every contact's friction-cone edge wrenches, i.e. the sum of the contacts' normal forces
 //!   bounded by 1.
 //! - **L∞**: each contact's normal force bounded by 1 independently: the Minkowski sum of the
-//!   contacts' hulls of {0, edge wrenches}.
+//!   contacts' hulls of {0, edge wrenches}. Too many vertices to hull for more than a few
+//!   contacts, so epsilon comes from an expanding inner polytope checked against the sum's
+//!   support function (exact to a relative 1e-9, for any number of contacts, [`linf`]); the
+//!   volume from the hull while it stays small ([`linf::VOLUME_MAX_POINTS`]).
 //!
 //! Conventions (GraspIt!'s): the Coulomb cone is linearised with `cone_edges` edges (8 by
 //! default), each edge a force with unit normal component, `n + μ (cos φ t₁ + sin φ t₂)`;
@@ -33,10 +36,7 @@ use serde::Serialize;
 /// Number of friction-cone edges by default.
 pub const DEFAULT_CONE_EDGES: usize = 8;
 
-/// The L∞ wrench space is computed for at most this many contacts (else reported as `None`):
-/// its Minkowski sum grows as (edges + 1)^contacts before pruning, and qhull took over a
-/// minute (debug build) on the 6561 points of four 8-edge contacts.
-pub const LINF_MAX_CONTACTS: usize = 3;
+pub mod linf;
 
 /// A point contact between the hand and the object.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -77,6 +77,16 @@ pub struct SpaceMetrics {
     pub volume: f64,
 }
 
+/// The metrics of the L∞ wrench space.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LinfMetrics {
+    /// Ferrari–Canny epsilon (0 when the origin is not inside).
+    pub epsilon: f64,
+    /// Volume (6-D, in the scaled units); `None` when the hull of the Minkowski sum would be
+    /// too large ([`linf::VOLUME_MAX_POINTS`]: in practice more than 3 contacts).
+    pub volume: Option<f64>,
+}
+
 /// The analytic quality of a grasp.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Quality {
@@ -93,9 +103,12 @@ pub struct Quality {
     pub force_closure: bool,
     /// L1 wrench space: sum of normal forces ≤ 1.
     pub l1: SpaceMetrics,
-    /// L∞ wrench space: each normal force ≤ 1 (`None` for more than [`LINF_MAX_CONTACTS`]
-    /// contacts).
-    pub linf: Option<SpaceMetrics>,
+    /// L∞ wrench space: each normal force ≤ 1 (`None` if the search for its epsilon did not
+    /// finish, with the reason in `linf_note`).
+    pub linf: Option<LinfMetrics>,
+    /// Why the L∞ epsilon or volume is missing, when one is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub linf_note: Option<String>,
     /// Friction-cone edges used.
     pub cone_edges: usize,
     /// Friction coefficient used.
@@ -155,9 +168,15 @@ pub fn evaluate(source: &'static str, contacts: Vec<Contact>, params: &QualityPa
     let per_contact = edge_wrenches(&contacts, params);
     let points: Vec<Wrench> = per_contact.iter().flatten().copied().collect();
     let (l1, l1_note) = metrics(&points);
-    let linf = (per_contact.len() <= LINF_MAX_CONTACTS)
-        .then(|| minkowski_sum(&per_contact).map(|pts| metrics(&pts).0))
-        .flatten();
+    let l = linf::evaluate(&per_contact);
+    let linf = l.epsilon.map(|epsilon| LinfMetrics {
+        epsilon,
+        volume: l.volume,
+    });
+    // A not-force-closure L∞ space says so in `note` already (the two agree on it).
+    let linf_note = l
+        .note
+        .filter(|n| !n.starts_with("not force closure") && n != "no contacts");
     let force_closure = l1.epsilon > 0.0;
     Quality {
         source,
@@ -167,6 +186,7 @@ pub fn evaluate(source: &'static str, contacts: Vec<Contact>, params: &QualityPa
         force_closure,
         l1,
         linf,
+        linf_note,
         cone_edges: params.cone_edges,
         friction: params.friction,
         torque_scale_mm: params.max_radius_mm,
@@ -315,29 +335,6 @@ fn affine_rank(points: &[Wrench]) -> usize {
     let scale = m.amax().max(1e-300);
     let sv = m.svd(false, false).singular_values;
     sv.iter().filter(|s| **s > 1e-9 * scale).count()
-}
-
-/// The vertices of the L∞ wrench space: the Minkowski sum over contacts of
-/// conv({0} ∪ edges), pruned to its hull's vertices after each contact once it is
-/// full-dimensional.
-fn minkowski_sum(per_contact: &[Vec<Wrench>]) -> Option<Vec<Wrench>> {
-    let mut set: Vec<Wrench> = vec![[0.0; 6]];
-    for edges in per_contact {
-        let mut next = Vec::with_capacity(set.len() * (edges.len() + 1));
-        for s in &set {
-            next.push(*s);
-            for e in edges {
-                next.push(std::array::from_fn(|i| s[i] + e[i]));
-            }
-        }
-        if affine_rank(&next) == 6 {
-            if let Some(h) = hull(&next) {
-                next = h.vertices.iter().map(|&i| next[i]).collect();
-            }
-        }
-        set = next;
-    }
-    Some(set)
 }
 
 /// The object's centroid (aligned frame) and its largest distance from it `[mm]`.
@@ -493,6 +490,11 @@ mod tests {
     /// fixed pseudo-random sequence, each refined by a shrinking random search. An upper bound
     /// that converges on epsilon from above.
     fn epsilon_by_support(points: &[Wrench]) -> f64 {
+        epsilon_by_support_fn(|u| support(points, u))
+    }
+
+    /// [`epsilon_by_support`] for any support function `h`.
+    fn epsilon_by_support_fn(h_of: impl Fn(&[f64; 6]) -> f64) -> f64 {
         let mut state: u64 = 0x9E37_79B9_7F4A_7C15;
         let mut rand = move || {
             state ^= state << 13;
@@ -507,13 +509,13 @@ mod tests {
         let mut best = f64::INFINITY;
         for _ in 0..100 {
             let mut u = unit(std::array::from_fn(|_| rand()));
-            let mut h = support(points, &u);
+            let mut h = h_of(&u);
             let mut step = 0.5;
             while step > 1e-7 {
                 let mut improved = false;
                 for _ in 0..40 {
                     let v = unit(std::array::from_fn(|i| u[i] + step * rand()));
-                    let hv = support(points, &v);
+                    let hv = h_of(&v);
                     if hv < h {
                         (u, h) = (v, hv);
                         improved = true;
@@ -643,10 +645,11 @@ mod tests {
                 q.epsilon
             );
             assert!(q.volume > 0.0);
-            if k <= LINF_MAX_CONTACTS {
-                let linf = q.linf.expect("L-infinity computed");
-                // The L1 space lies inside the L-infinity space.
-                assert!(linf.epsilon >= q.epsilon - 1e-9 && linf.volume >= q.volume);
+            let linf = q.linf.expect("L-infinity computed");
+            // The L1 space lies inside the L-infinity space.
+            assert!(linf.epsilon >= q.epsilon - 1e-9);
+            if let Some(v) = linf.volume {
+                assert!(v >= q.volume);
             }
         }
         // More friction, a larger wrench space.
@@ -714,7 +717,14 @@ mod tests {
             q1.volume
         );
         let (a, b) = (q0.linf.unwrap(), q1.linf.unwrap());
-        assert!(rel(a.epsilon, b.epsilon) < 1e-9 && rel(a.volume, b.volume) < 1e-9);
+        assert!(rel(a.epsilon, b.epsilon) < 1e-9);
+        assert!(rel(a.volume.unwrap(), b.volume.unwrap()) < 1e-9);
+        // Six contacts: the L∞ epsilon by the search, too.
+        let c = scattered(6, 5);
+        let q0 = evaluate("planned", c.clone(), &params);
+        let q1 = evaluate_moved(&c, &params, nalgebra::UnitQuaternion::identity(), shift);
+        let (a, b) = (q0.linf.unwrap().epsilon, q1.linf.unwrap().epsilon);
+        assert!(a > 0.0 && rel(a, b) < 1e-9, "{a} vs {b}");
     }
 
     #[test]
@@ -722,6 +732,7 @@ mod tests {
         // A rotation turns the wrench space rigidly, except that each linearised cone's edges
         // keep the phase of their tangent basis (picked from the normal alone, as GraspIt!
         // does): with 8 edges epsilon moved 2.7 % here, with 64 the cone is round to 0.1 %.
+        // Both L1 and L∞.
         let c = symmetric(4);
         let params = QualityParams {
             cone_edges: 64,
@@ -742,5 +753,374 @@ mod tests {
             q0.volume,
             q1.volume
         );
+        let (a, b) = (q0.linf.unwrap().epsilon, q1.linf.unwrap().epsilon);
+        assert!(a > q0.epsilon && rel(a, b) < 5e-3, "L-infinity {a} vs {b}");
+    }
+
+    /// The support function of the L∞ space `Σᵢ conv({0} ∪ per_contact[i])`, written out
+    /// here independently of [`linf::support`].
+    fn linf_h(per_contact: &[Vec<Wrench>], u: &[f64; 6]) -> f64 {
+        per_contact.iter().map(|e| support(e, u).max(0.0)).sum()
+    }
+
+    /// The unit vector orthogonal to five vectors (cofactors of the 5×6 matrix), if they are
+    /// independent.
+    fn orthogonal_to(v: [&Wrench; 5]) -> Option<[f64; 6]> {
+        let n: [f64; 6] = std::array::from_fn(|i| {
+            let m = nalgebra::Matrix5::from_fn(|r, c| v[r][if c < i { c } else { c + 1 }]);
+            if i % 2 == 0 {
+                m.determinant()
+            } else {
+                -m.determinant()
+            }
+        });
+        let len = n.iter().map(|x| x * x).sum::<f64>().sqrt();
+        (len > 1e-9).then(|| n.map(|x| x / len))
+    }
+
+    /// Epsilon of a Minkowski sum of polytopes by brute force: every facet of the sum is
+    /// parallel to five independent edges of the summands, so its normal is among the unit
+    /// vectors orthogonal to five of `edges`; the smallest support value over all those
+    /// candidates (both signs) is epsilon (each candidate's value bounds it from above).
+    fn epsilon_over_edge_normals(edges: &[Wrench], h: impl Fn(&[f64; 6]) -> f64) -> f64 {
+        let n = edges.len();
+        let mut best = f64::INFINITY;
+        let mut idx = [0usize, 1, 2, 3, 4];
+        loop {
+            if let Some(u) = orthogonal_to(idx.map(|i| &edges[i])) {
+                best = best.min(h(&u)).min(h(&u.map(|x| -x)));
+            }
+            // The next 5-subset in lexicographic order.
+            let mut k = 5;
+            while k > 0 && idx[k - 1] == n - 5 + k - 1 {
+                k -= 1;
+            }
+            if k == 0 {
+                return best.max(0.0);
+            }
+            idx[k - 1] += 1;
+            for j in k..5 {
+                idx[j] = idx[j - 1] + 1;
+            }
+        }
+    }
+
+    /// The edges of each contact's pyramid conv({0} ∪ cone edges): apex to every edge
+    /// wrench, and round the base.
+    fn pyramid_edges(per_contact: &[Vec<Wrench>]) -> Vec<Wrench> {
+        let mut out = Vec::new();
+        for e in per_contact {
+            for (j, w) in e.iter().enumerate() {
+                out.push(*w);
+                let next = e[(j + 1) % e.len()];
+                out.push(std::array::from_fn(|i| next[i] - w[i]));
+            }
+        }
+        out
+    }
+
+    /// `k` contacts on a 10 mm sphere, pushing towards its centre, at fixed pseudo-random
+    /// places (deterministic), each within a cap so that the grasp closes.
+    fn scattered(k: usize, seed: u64) -> Vec<Contact> {
+        let mut state = seed;
+        let mut rand = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let base = symmetric(4);
+        (0..k)
+            .map(|i| {
+                let d0 = -Vector3::from(base[i % 4].normal);
+                let d = (d0 + 0.3 * Vector3::new(rand(), rand(), rand())).normalize();
+                contact((d * 10.0).into(), (-d).into())
+            })
+            .collect()
+    }
+
+    #[test]
+    fn linf_epsilon_of_the_cube_from_twelve_segments() {
+        // Twelve one-edge "contacts" ±e_k: their Minkowski sum is the cube [−1, 1]^6,
+        // epsilon 1, volume 64.
+        let per_contact: Vec<Vec<Wrench>> = (0..12)
+            .map(|k| {
+                let mut w = [0.0; 6];
+                w[k % 6] = if k < 6 { 1.0 } else { -1.0 };
+                vec![w]
+            })
+            .collect();
+        let s = linf::epsilon(&per_contact, linf::EPA_MAX_POINTS).expect("settles");
+        assert!((s.epsilon - 1.0).abs() < 1e-9, "{s:?}");
+        assert!(s.bracket.1 - s.bracket.0 <= 1e-9, "{s:?}");
+        let (vertices, volume) = linf::minkowski_sum(&per_contact, 1000).expect("small");
+        // (qhull's joggled input keeps some points on the cube's faces as vertices: they lie
+        // in the sum all the same.)
+        assert!(vertices.len() >= 64);
+        // To the hull's accuracy on joggled input (as for the cube's corners twice, above).
+        assert!((volume - 64.0).abs() < 1e-4, "volume {volume}");
+        // A grasp's volume is tried only when the unpruned sum (2^12 points here) is within
+        // the budget: said so.
+        let l = linf::evaluate(&per_contact);
+        assert!((l.epsilon.unwrap() - 1.0).abs() < 1e-9);
+        assert_eq!(l.volume, None);
+        assert!(l.note.unwrap().contains("volume not computed"));
+        // So are eight real contacts.
+        let l = linf::evaluate(&edge_wrenches(&scattered(8, 9), &sphere_params(0.5)));
+        assert_eq!(l.volume, None);
+        assert!(l.note.unwrap().contains("volume not computed"));
+    }
+
+    #[test]
+    fn linf_epsilon_of_zonotopes_matches_their_facets() {
+        // Segments [−g, g] (as two one-edge contacts, g and −g) sum to a zonotope, whose
+        // support function is Σ|g·u| and whose facets are orthogonal to 5 generators: epsilon
+        // is the smallest support value over those normals (closed form, all 252 of them).
+        let mut state: u64 = 0x1234_5678_9ABC_DEF1;
+        let mut rand = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        for _ in 0..3 {
+            let gens: Vec<Wrench> = (0..10).map(|_| std::array::from_fn(|_| rand())).collect();
+            let per_contact: Vec<Vec<Wrench>> = gens
+                .iter()
+                .flat_map(|g| [vec![*g], vec![g.map(|x| -x)]])
+                .collect();
+            let h = |u: &[f64; 6]| {
+                gens.iter()
+                    .map(|g| g.iter().zip(u).map(|(a, b)| a * b).sum::<f64>().abs())
+                    .sum::<f64>()
+            };
+            let exact = epsilon_over_edge_normals(&gens, h);
+            let s = linf::epsilon(&per_contact, linf::EPA_MAX_POINTS).expect("settles");
+            assert!(rel(exact, s.epsilon) < 1e-9, "{} vs {exact}", s.epsilon);
+        }
+    }
+
+    #[test]
+    fn linf_epsilon_of_four_and_five_contacts_matches_brute_force_over_facet_normals() {
+        // 4 cone edges, so that every 5 of the pyramids' edges can be tried (201 376 and
+        // 658 008 normals): the brute force is exact and shares no code with the search.
+        for (k, seed) in [(4, 7), (4, 11), (5, 13)] {
+            let params = QualityParams {
+                cone_edges: 4,
+                ..sphere_params(0.5)
+            };
+            let per_contact = edge_wrenches(&scattered(k, seed), &params);
+            let exact = epsilon_over_edge_normals(&pyramid_edges(&per_contact), |u| {
+                linf_h(&per_contact, u)
+            });
+            let q = evaluate("planned", scattered(k, seed), &params);
+            let linf = q.linf.expect("settles");
+            assert!(q.force_closure && exact > 0.0, "{k} contacts: {:?}", q.note);
+            assert!(
+                rel(exact, linf.epsilon) < 1e-9,
+                "{k} contacts (seed {seed}): {} vs {exact}",
+                linf.epsilon
+            );
+            assert!(linf.epsilon >= q.epsilon, "L1 lies inside L-infinity");
+        }
+    }
+
+    #[test]
+    fn linf_epsilon_of_four_to_eight_contacts_agrees_with_the_support_function() {
+        // 8 cone edges (the default): too many edge 5-subsets to try, so the search is held
+        // against the definition, as L1 is: never above any support value found, and within
+        // 1 % of the smallest.
+        for (k, seed) in [(4, 3), (6, 5), (8, 9)] {
+            let c = scattered(k, seed);
+            let params = sphere_params(0.5);
+            let per_contact = edge_wrenches(&c, &params);
+            let s = linf::epsilon(&per_contact, linf::EPA_MAX_POINTS).expect("settles");
+            let independent = epsilon_by_support_fn(|u| linf_h(&per_contact, u));
+            assert!(
+                s.epsilon <= independent + 1e-9 && independent <= 1.01 * s.epsilon,
+                "{k} contacts: epsilon {}, by the support function ~{independent}",
+                s.epsilon
+            );
+            assert!(s.bracket.1 - s.bracket.0 <= 1e-9 * s.bracket.1, "{s:?}");
+            let q = evaluate("planned", c, &params);
+            assert!(q.linf.unwrap().epsilon >= q.epsilon, "L1 inside L-infinity");
+        }
+    }
+
+    #[test]
+    fn linf_epsilon_and_volume_of_three_contacts_agree_with_the_hull_of_the_sum() {
+        // Three contacts: the whole Minkowski sum (729 points) can be hulled, and its
+        // smallest facet distance must be the search's epsilon.
+        let c = symmetric(3);
+        let params = sphere_params(0.5);
+        let per_contact = edge_wrenches(&c, &params);
+        let (vertices, volume) = linf::minkowski_sum(&per_contact, 1000).expect("small");
+        let (by_hull, _) = metrics(&vertices);
+        let q = evaluate("planned", c, &params);
+        let linf = q.linf.expect("settles");
+        assert!(
+            rel(by_hull.epsilon, linf.epsilon) < 1e-6,
+            "{} vs {}",
+            by_hull.epsilon,
+            linf.epsilon
+        );
+        assert!(rel(by_hull.volume, volume) < 1e-6);
+        assert_eq!(linf.volume, Some(volume));
+        assert!(volume > q.volume, "L1 inside L-infinity");
+    }
+
+    #[test]
+    fn linf_of_every_contact_twice_is_twice_as_large() {
+        // Each contact reported twice (as rapier may): L1 is unchanged (the same hull), L∞
+        // doubles exactly (P + P = 2P), with or without the merging of identical contacts.
+        let c = scattered(6, 21);
+        let params = sphere_params(0.4);
+        let once = evaluate("planned", c.clone(), &params);
+        let twice = evaluate("planned", [c.clone(), c].concat(), &params);
+        assert!(rel(once.epsilon, twice.epsilon) < 1e-9);
+        let (a, b) = (once.linf.unwrap().epsilon, twice.linf.unwrap().epsilon);
+        assert!(rel(2.0 * a, b) < 1e-9, "{a} twice is not {b}");
+        let doubled: Vec<Vec<Wrench>> = edge_wrenches(&scattered(6, 21), &params)
+            .into_iter()
+            .map(|e| e.into_iter().map(|w| w.map(|x| 2.0 * x)).collect())
+            .collect();
+        let s = linf::epsilon(&doubled, linf::EPA_MAX_POINTS).unwrap();
+        assert!(rel(b, s.epsilon) < 1e-9);
+    }
+
+    #[test]
+    fn linf_is_zero_without_force_closure_and_bounded_when_the_search_is_cut_short() {
+        let opposed = vec![
+            contact([10.0, 0.0, 0.0], [-1.0, 0.0, 0.0]),
+            contact([-10.0, 0.0, 0.0], [1.0, 0.0, 0.0]),
+        ];
+        let q = evaluate("planned", opposed, &sphere_params(0.5));
+        assert_eq!(q.linf.unwrap().epsilon, 0.0);
+        let q = evaluate("planned", symmetric(3), &sphere_params(0.0));
+        assert_eq!(q.linf.unwrap().epsilon, 0.0);
+        // Too few support points allowed: no answer, and the reason, not a hang.
+        let per_contact = edge_wrenches(&scattered(8, 9), &sphere_params(0.5));
+        let err = linf::epsilon(&per_contact, 2).unwrap_err();
+        assert!(err.contains("not settled after 2 support points"), "{err}");
+    }
+
+    /// The cost per grasp of L1 and L∞ beside the physics check (BENCHMARKS.md): every
+    /// scenario in `$QUALITY_COST_SCENARIOS` (paths, space-separated; default the bundled
+    /// scenarios and the tuning set), up to 3 candidates each, each checked with gravity
+    /// `down`, then L1 and L∞ timed apart on the contacts at the end of closing. Run with
+    /// `cargo test --release --lib quality::tests::cost_per_grasp -- --ignored --nocapture`.
+    #[test]
+    #[ignore = "a measurement (minutes), not a test"]
+    fn cost_per_grasp() {
+        use std::time::Instant;
+        let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+        let paths: Vec<std::path::PathBuf> = match std::env::var("QUALITY_COST_SCENARIOS") {
+            Ok(list) => list.split_whitespace().map(Into::into).collect(),
+            Err(_) => ["scenarios", "assets/objects/train"]
+                .iter()
+                .flat_map(|d| std::fs::read_dir(root.join(d)).unwrap())
+                .map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect(),
+        };
+        let mut paths = paths;
+        paths.sort();
+        let ms = |t: Instant| t.elapsed().as_secs_f64() * 1e3;
+        // Contacts, check, L1 and L∞ milliseconds, L∞ support points added.
+        type Row = (usize, f64, f64, f64, usize);
+        let mut rows: Vec<Row> = Vec::new();
+        println!("scenario | candidate | contacts | check ms | L1 ms | L∞ ms | L∞ points added | epsilon L1 | epsilon L∞");
+        for path in &paths {
+            let sc = crate::scenario::Scenario::load(path).unwrap();
+            let Ok(loaded) = crate::mesh::load_mesh(&sc.object.mesh, sc.object.units) else {
+                continue;
+            };
+            let props = crate::mesh::mass_properties(&loaded.mesh);
+            let mass_kg = match sc.object.mass {
+                crate::scenario::MassSpec::Mass(m) => m,
+                crate::scenario::MassSpec::Density(d) => d * props.volume_mm3 * 1e-9,
+            };
+            let no_check =
+                |_: &crate::mesh::AlignedObject,
+                 _: &crate::plan::search::Grasp|
+                 -> crate::sim::SimOutcome { unreachable!("max_checked is None") };
+            let selection = crate::select::select(
+                &loaded.mesh,
+                &props,
+                &crate::select::SelectParams {
+                    hand: &sc.hand,
+                    planner: &sc.planner,
+                    friction: sc.object.friction,
+                    collect: 3,
+                    max_checked: None,
+                    check: &no_check,
+                    domains: None,
+                },
+                &mut std::collections::BTreeMap::new(),
+            );
+            for (k, c) in selection.candidates.iter().enumerate() {
+                let axis = &selection.axes[c.axis_plan];
+                let shape =
+                    crate::sim::ObjectShape::from_mesh(&axis.aligned.mesh, props.volume_mm3);
+                let pose = crate::sim::SimHand::from_grasp(&c.grasp);
+                let mut sim_params = sc.sim.clone();
+                sim_params.gravity = crate::scenario::GravityMode::Down;
+                let t = Instant::now();
+                let down = crate::sim::check(&crate::sim::Case {
+                    hand: &sc.hand,
+                    pose: &pose,
+                    object: &shape,
+                    mass_kg,
+                    friction: sc.object.friction,
+                    params: &sim_params,
+                });
+                let ms_check = ms(t);
+                let contacts = sim_contacts(&down.grip_contacts, &sc.hand);
+                let (centroid_mm, max_radius_mm) = torque_scale(&axis.aligned.mesh);
+                let params = QualityParams {
+                    friction: sc.object.friction,
+                    cone_edges: DEFAULT_CONE_EDGES,
+                    centroid_mm,
+                    max_radius_mm,
+                };
+                let per_contact = edge_wrenches(&contacts, &params);
+                let points: Vec<Wrench> = per_contact.concat();
+                let t = Instant::now();
+                let (l1, _) = metrics(&points);
+                let ms_l1 = ms(t);
+                let t = Instant::now();
+                let l = linf::evaluate(&per_contact);
+                let ms_linf = ms(t);
+                println!(
+                    "{} | {} | {} | {ms_check:.0} | {ms_l1:.1} | {ms_linf:.1} | {} | {:.4} | {:?}",
+                    sc.name,
+                    k + 1,
+                    contacts.len(),
+                    l.points_added,
+                    l1.epsilon,
+                    l.epsilon
+                );
+                assert!(l.epsilon.is_some(), "{:?}", l.note);
+                rows.push((contacts.len(), ms_check, ms_l1, ms_linf, l.points_added));
+            }
+        }
+        let stats = |f: &dyn Fn(&Row) -> f64| {
+            let mut v: Vec<f64> = rows.iter().map(f).collect();
+            v.sort_by(f64::total_cmp);
+            let at = |q: f64| v[((v.len() - 1) as f64 * q).round() as usize];
+            format!(
+                "median {:.1}, 90th percentile {:.1}, largest {:.1}",
+                at(0.5),
+                at(0.9),
+                at(1.0)
+            )
+        };
+        println!("{} grasps", rows.len());
+        println!("contacts: {}", stats(&|r| r.0 as f64));
+        println!("check ms: {}", stats(&|r| r.1));
+        println!("L1 ms: {}", stats(&|r| r.2));
+        println!("L-infinity ms: {}", stats(&|r| r.3));
+        println!("L-infinity points added: {}", stats(&|r| r.4 as f64));
+        println!("L-infinity / check: {}", stats(&|r| r.3 / r.1));
     }
 }
