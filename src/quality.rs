@@ -1056,7 +1056,7 @@ mod tests {
                     check: &no_check,
                     domains: None,
                 },
-                &mut std::collections::BTreeMap::new(),
+                &mut crate::report::StageTimings::default(),
             );
             for (k, c) in selection.candidates.iter().enumerate() {
                 let axis = &selection.axes[c.axis_plan];
