@@ -331,6 +331,33 @@ fn check_names(r: &RunReport) -> Vec<String> {
         .collect()
 }
 
+/// The grasp of a run that the thesis's rules found nothing for on any axis, asserting that it
+/// came from `rules` with every relaxation of `needs` and held.
+fn held_beyond_the_thesis<'a>(
+    r: &'a RunReport,
+    rules: RuleSet,
+    needs: &[Relaxation],
+) -> &'a grasp_sim::report::GraspReport {
+    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
+    let g = r.plan.grasp.as_ref().expect("a grasp");
+    assert_eq!(g.rules, rules);
+    for rule in needs {
+        assert!(
+            g.relaxations.contains(rule),
+            "{rule:?} not in {:?}",
+            g.relaxations
+        );
+    }
+    assert_eq!(
+        r.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        "{:?} {:?}",
+        r.sim.translation_mm,
+        check_names(r)
+    );
+    g
+}
+
 #[test]
 fn a_flat_disc_is_wrapped_across_its_faces() {
     // A 45 x 25 mm disc: its least moment is about a diameter (m (3 r^2 + h^2) / 12 = 179 m
@@ -371,24 +398,13 @@ fn a_60_mm_sphere_is_held_under_the_extended_rules() {
     // between the outer fingers: the thesis rejects a ball everywhere, a hand wraps it.
     let sphere = soup_of(&grasp_sim::objects::uv_sphere(30.0, 72));
     let r = run_soup(&sphere, true);
-    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
-    let g = r.plan.grasp.as_ref().expect("the sphere gets a grasp");
-    assert_eq!(g.rules, RuleSet::Extended);
-    for rule in [
-        Relaxation::OuterFingerBeyondElevation,
-        Relaxation::CurvatureGraded,
-    ] {
-        assert!(
-            g.relaxations.contains(&rule),
-            "{rule:?} not in {:?}",
-            g.relaxations
-        );
-    }
-    assert_eq!(
-        r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
-        "{:?}",
-        r.sim.translation_mm
+    held_beyond_the_thesis(
+        &r,
+        RuleSet::Extended,
+        &[
+            Relaxation::OuterFingerBeyondElevation,
+            Relaxation::CurvatureGraded,
+        ],
     );
 }
 
@@ -408,21 +424,7 @@ fn a_rounded_figurine_is_held_under_the_extended_rules() {
         .collect();
     let fig = soup_of(&grasp_sim::objects::revolved(&profile));
     let r = run_soup(&fig, true);
-    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
-    let g = r.plan.grasp.as_ref().expect("the figurine gets a grasp");
-    assert_eq!(g.rules, RuleSet::Extended);
-    assert!(
-        g.relaxations.contains(&Relaxation::CurvatureGraded),
-        "{:?}",
-        g.relaxations
-    );
-    assert_eq!(
-        r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
-        "{:?} {:?}",
-        r.sim.translation_mm,
-        check_names(&r)
-    );
+    held_beyond_the_thesis(&r, RuleSet::Extended, &[Relaxation::CurvatureGraded]);
 }
 
 #[test]
@@ -440,19 +442,7 @@ fn a_bar_with_bosses_is_held_with_the_palm_backed_off() {
         bar.extend(cuboid([x * 18.0, y * 18.0, 60.0], size));
     }
     let r = run_soup(&bar, true);
-    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
-    let g = r.plan.grasp.as_ref().expect("the bar gets a grasp");
-    assert!(
-        g.relaxations.contains(&Relaxation::PalmBackedOff),
-        "{:?}",
-        g.relaxations
-    );
-    assert_eq!(
-        r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
-        "{:?}",
-        r.sim.translation_mm
-    );
+    held_beyond_the_thesis(&r, RuleSet::Extended, &[Relaxation::PalmBackedOff]);
 }
 
 #[test]
@@ -463,20 +453,7 @@ fn a_flat_box_is_pinched_by_the_fingertips_with_the_palm_on_its_narrow_face() {
     // but the last: joint 1 closes on until phalanx 2 meets the broad faces.
     let soup = cuboid([0.0, 0.0, 75.0], [100.0, 30.0, 150.0]);
     let r = run_soup(&soup, true);
-    assert!(r.plan.axes[..6].iter().all(|a| a.grasps_found == 0));
-    let g = r.plan.grasp.as_ref().expect("the box gets a grasp");
-    assert_eq!(g.rules, RuleSet::Pinch);
-    assert!(
-        g.relaxations.contains(&Relaxation::DistalContactOnly),
-        "{:?}",
-        g.relaxations
-    );
-    assert_eq!(
-        r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
-        "{:?}",
-        r.sim.translation_mm
-    );
+    held_beyond_the_thesis(&r, RuleSet::Pinch, &[Relaxation::DistalContactOnly]);
 
     // The planned contacts: every finger touches with phalanx 2 only, on the broad faces, the
     // thumb opposite the other two, 30 mm apart across the box (a phalanx's push is its own
