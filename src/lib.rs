@@ -5,12 +5,15 @@
 //! Data flow (each stage a plain function, so tests, benches and the tuner can call one alone):
 //!
 //! ```text
-//! scenario.toml → scenario::Scenario → mesh::load_mesh → mesh::align → slice::slice → plan … → report
+//! scenario.toml → scenario::Scenario → prepared::PreparedObject (mesh::load_mesh, mass, collider)
+//!   → select::select: for each rule set (thesis, extended, pinch) and axis: mesh::align →
+//!     plan (stages 1–3 on slice::slice, then the search) → each candidate's sim check
+//!   → quality (optional) → report::RunReport (JSON, summary; expectations judged)
 //! ```
 //!
 //! Units: the mesh, slicer and planner work in millimetres and degrees in the aligned object frame
-//! (principal axis +Z, bottom at Z = 0), as the thesis does; the physics check will work in SI
-//! units, converted once at its boundary.
+//! (principal axis +Z, bottom at Z = 0), as the thesis does; the physics check works in SI units,
+//! converted once at its boundary ([`sim::convert`]).
 //!
 //! Math types: the planner uses nalgebra (f64). rapier3d 0.36 and parry3d 0.31 use glam types
 //! (`Vec3`, `Pose3`, f32 by default); the conversion between the two lives in [`sim::convert`],
