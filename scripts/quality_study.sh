@@ -11,8 +11,8 @@
 #   payload margin;
 # - real-object set: up to 3 candidates per object, gravity `down` only, payload margin (`six`
 #   on them too would double the run's length);
-# - left out: libero_black_book (33 shells: its search runs about 3 minutes and finds no grasp,
-#   docs/REAL_OBJECTS.md).
+# - left out: libero_black_book (33 shells: its search runs 4 to 10 minutes before the fingertip
+#   pinch finds its grasp, docs/REAL_OBJECTS.md).
 #
 # The real-object meshes that are not committed (their licence) are written by
 # scripts/real_objects.py when missing.
