@@ -696,6 +696,11 @@ mod tests {
         (a - b).abs() / a.abs().max(1e-12)
     }
 
+    /// Asserts `a` and `b` agree to `tol` relative, naming `what`.
+    fn assert_near(a: f64, b: f64, tol: f64, what: &str) {
+        assert!(rel(a, b) < tol, "{what}: {a} vs {b}");
+    }
+
     #[test]
     fn epsilon_is_invariant_under_moving_object_and_grasp_together() {
         // A translation leaves every wrench as it is: equal to round-off, L-infinity too.
@@ -704,18 +709,8 @@ mod tests {
         let q0 = evaluate("planned", c.clone(), &params);
         let shift = Vector3::new(120.0, -35.0, 7.5);
         let q1 = evaluate_moved(&c, &params, nalgebra::UnitQuaternion::identity(), shift);
-        assert!(
-            rel(q0.epsilon, q1.epsilon) < 1e-9,
-            "{} vs {}",
-            q0.epsilon,
-            q1.epsilon
-        );
-        assert!(
-            rel(q0.volume, q1.volume) < 1e-9,
-            "{} vs {}",
-            q0.volume,
-            q1.volume
-        );
+        assert_near(q0.epsilon, q1.epsilon, 1e-9, "L1 epsilon");
+        assert_near(q0.volume, q1.volume, 1e-9, "L1 volume");
         let (a, b) = (q0.linf.unwrap(), q1.linf.unwrap());
         assert!(rel(a.epsilon, b.epsilon) < 1e-9);
         assert!(rel(a.volume.unwrap(), b.volume.unwrap()) < 1e-9);
@@ -741,18 +736,8 @@ mod tests {
         let q0 = evaluate("planned", c.clone(), &params);
         let rot = nalgebra::UnitQuaternion::from_euler_angles(0.3, -1.2, 2.5);
         let q1 = evaluate_moved(&c, &params, rot, Vector3::new(120.0, -35.0, 7.5));
-        assert!(
-            rel(q0.epsilon, q1.epsilon) < 5e-3,
-            "{} vs {}",
-            q0.epsilon,
-            q1.epsilon
-        );
-        assert!(
-            rel(q0.volume, q1.volume) < 5e-3,
-            "{} vs {}",
-            q0.volume,
-            q1.volume
-        );
+        assert_near(q0.epsilon, q1.epsilon, 5e-3, "L1 epsilon");
+        assert_near(q0.volume, q1.volume, 5e-3, "L1 volume");
         let (a, b) = (q0.linf.unwrap().epsilon, q1.linf.unwrap().epsilon);
         assert!(a > q0.epsilon && rel(a, b) < 5e-3, "L-infinity {a} vs {b}");
     }
