@@ -137,8 +137,17 @@ pub fn select(
                 .get_or_insert_with(|| align_with(mesh, props, *axis))
                 .clone();
             let mut t = StageTimings::default();
-            let graded = match p.domains {
-                None => plan::grade_domain_with(
+            // The pinch pass searches the extended rules' graded domain again (it changes only
+            // how a finger is placed): reuse it rather than slice and grade a second time.
+            let extended = sel
+                .axes
+                .iter()
+                .find(|a| a.rules == RuleSet::Extended && a.aligned.axis == *axis)
+                .filter(|_| rules == RuleSet::Pinch)
+                .map(|a| a.graded.clone());
+            let graded = match (extended, p.domains) {
+                (Some(graded), _) => graded,
+                (None, None) => plan::grade_domain_with(
                     &aligned.mesh,
                     p.hand,
                     p.planner,
@@ -146,7 +155,7 @@ pub fn select(
                     rules,
                     &mut t,
                 ),
-                Some(cache) => {
+                (None, Some(cache)) => {
                     let key = (
                         *axis,
                         rules.domain_rules(),
