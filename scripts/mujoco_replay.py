@@ -7,8 +7,10 @@ Prints one JSON object per scene: the verdict (hold / slip / drop) with the same
 grasp-sim's rapier check, the object's translation and rotation relative to the palm during the
 hold, and whether it still touches the hand. Protocol (docs/SIM.md), read from protocol.json:
 fingers start at the `open` keyframe; gravity off; joint 1 closes towards its target (planned
-bend plus squeeze) while joint 2 is held open; halfway through the closing time joint 1 locks
-where it stopped (a TorqueSwitch) and joint 2 closes; then gravity on for the hold.
+bend plus squeeze) while joint 2 is held open; when the hand and the object have stopped
+(`close_until_stalled`), or at the latest halfway through the closing time, joint 1 locks where
+it stopped (a TorqueSwitch) and joint 2 closes, again until they stop; then gravity on for the
+hold (its whole length: the replay is the full-length protocol).
 Needs `pip install mujoco`.
 """
 import json
@@ -57,8 +59,22 @@ def replay(scene_dir):
     obj = m.body("object").id
     # The simulation loop alone is timed (`wall_ms`): no Python start-up, no model loading.
     t0 = time.perf_counter()
-    for i in range(close_steps):
-        if i == close_steps // 2:
+    # Joint 1 closes for at most half the closing time, then joint 2 for the rest; with
+    # `close_until_stalled` each phase ends once every finger joint and the object have stayed
+    # slower than the `stall` speeds for its window (the same rule as grasp-sim's).
+    stall = proto["stall"] if proto.get("close_until_stalled") else None
+    hinge_dofs = [m.jnt_dofadr[m.actuator_trnid[a, 0]] for a in range(2 * n)]
+    od = m.jnt_dofadr[m.body_jntadr[obj]]
+
+    def quiet():
+        joint = max(abs(float(d.qvel[i])) for i in hinge_dofs)
+        v = float(np.linalg.norm(d.qvel[od:od + 3])) * 1000.0
+        w = float(np.linalg.norm(d.qvel[od + 3:od + 6]))
+        return joint < stall["joint_rad_s"] and v < stall["object_mm_s"] and w < stall["object_rad_s"]
+
+    closed = 0
+    for phase, max_steps in enumerate([close_steps // 2, close_steps - close_steps // 2]):
+        if phase == 1:
             for k in range(n):
                 a = 2 * k
                 joint = m.actuator_trnid[a, 0]
@@ -67,7 +83,18 @@ def replay(scene_dir):
                 m.actuator_biasprm[a, 1] = -10.0 * kp
                 m.actuator_forcerange[a] = [-lock, lock]
                 d.ctrl[a + 1] = target[a + 1]
-        mujoco.mj_step(m, d)
+        quiet_steps = 0
+        for _ in range(max_steps):
+            mujoco.mj_step(m, d)
+            closed += 1
+            if stall is None:
+                continue
+            if quiet():
+                quiet_steps += 1
+                if quiet_steps * dt >= stall["window_s"]:
+                    break
+            else:
+                quiet_steps = 0
     pc, rc = relative_pose(m, d, palm, obj)
     m.opt.gravity[:] = gravity
     for _ in range(hold_steps):
@@ -103,7 +130,8 @@ def replay(scene_dir):
         "full_rotation_deg": full_rotation,
         "in_contact": in_contact,
         "wall_ms": wall_ms,
-        "steps": close_steps + hold_steps,
+        "steps": closed + hold_steps,
+        "closed_at_s": closed * dt,
     }
 
 

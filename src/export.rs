@@ -384,6 +384,13 @@ fn protocol(input: &ExportInput, keys: &Keyframes) -> serde_json::Value {
         "open_bend_rad": keys.open,
         "target_bend_rad": keys.ctrl,
         "close_duration_s": sim.close_duration_s,
+        "close_until_stalled": sim.close_until_stalled,
+        "stall": {
+            "joint_rad_s": crate::sim::STALL.joint_rad_s,
+            "object_mm_s": crate::sim::STALL.object_mm_s,
+            "object_rad_s": crate::sim::STALL.object_rad_s,
+            "window_s": crate::sim::STALL.window_s,
+        },
         "duration_s": sim.duration_s,
         "joint1_lock_torque_nm": sim.joint1_lock_torque_nm,
         "motor_stiffness_nm_per_rad": sim.motor_stiffness_nm_per_rad,

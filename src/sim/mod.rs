@@ -18,10 +18,12 @@
 //! bare triangle mesh has no inside and lets fingers sink in).
 //!
 //! Protocol ([`protocol`]): fingers start open (each joint `open_margin_deg` short of its plan),
-//! gravity off; the motors close for `close_duration_s`, joint 1 first and joint 2 from halfway
-//! (thesis 3.6.2 fixes phalanx 1 before phalanx 2; closing both at once lets phalanx 2's tip,
-//! which sweeps the larger arc, reach the object first and hold phalanx 1 off it); gravity turns on (`down`: −Z; `six`: ±X, ±Y, ±Z in turn,
-//! each in a fresh scene, as DexGraspNet and BODex test) for `duration_s`. The object's motion
+//! gravity off; joint 1 closes first, then joint 2 (thesis 3.6.2 fixes phalanx 1 before phalanx
+//! 2; closing both at once lets phalanx 2's tip, which sweeps the larger arc, reach the object
+//! first and hold phalanx 1 off it), each phase until the hand and the object stop
+//! (`close_until_stalled`) and at most half of `close_duration_s`; gravity turns on (`down`:
+//! −Z; `six`: ±X, ±Y, ±Z, as DexGraspNet and BODex test) for `duration_s`, or under the `fast`
+//! protocol until the verdict can no longer change. The object's motion
 //! relative to the palm during the hold gives the verdict: `hold` within the thresholds, `slip`
 //! beyond them while still touching the hand, `drop` when it has left the hand.
 
@@ -33,7 +35,7 @@ pub mod scene;
 
 pub use protocol::{
     check, check_closed, check_with_payload, payload_bracket, payload_margin, Closed,
-    DirectionOutcome, EarlyDecision, SimOutcome, Verdict,
+    DirectionOutcome, EarlyDecision, SimOutcome, Stall, Verdict, STALL,
 };
 pub use scene::{collider_inertia, Case, ColliderKind, ObjectShape, OverrideError, SimHand};
 

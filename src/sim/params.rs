@@ -41,6 +41,9 @@ pub struct SimParams {
     /// `fast` protocol: the fastest motion of that window is projected to the end of the hold
     /// at this many times its speed.
     pub rest_safety: f64,
+    /// `fast` protocol: a `hold` is decided early only if the object stays within this
+    /// fraction of `hold_translation_mm` and `hold_rotation_deg`, the projected motion included.
+    pub rest_margin: f64,
     /// Hold time per gravity direction `[s]`.
     pub duration_s: f64,
     /// Physics timestep `[s]`.
@@ -57,8 +60,13 @@ pub struct SimParams {
     pub hold_translation_mm: f64,
     /// Largest rotation relative to the palm that still counts as `hold` `[deg]`.
     pub hold_rotation_deg: f64,
-    /// Time the fingers get to close before gravity is turned on `[s]`.
+    /// Time the fingers get to close before gravity is turned on `[s]`: with
+    /// `close_until_stalled`, the longest they get.
     pub close_duration_s: f64,
+    /// Each closing phase (joint 1, then joint 2) ends as soon as the hand and the object have
+    /// stopped (`sim::STALL`), at most at half `close_duration_s`; `false`: each phase takes
+    /// its half of `close_duration_s` (the check before issue 15).
+    pub close_until_stalled: bool,
     /// Constraint solver iterations (substeps) per step.
     pub solver_iterations: usize,
     /// PGS sweeps per solver iteration.
@@ -95,8 +103,9 @@ impl Default for SimParams {
         SimParams {
             gravity: GravityMode::Down,
             protocol: Protocol::Fast,
-            rest_window_s: 0.5,
+            rest_window_s: 0.2,
             rest_safety: 2.0,
+            rest_margin: 0.8,
             duration_s: 2.0,
             timestep_s: 1.0 / 960.0,
             squeeze_deg: 10.0,
@@ -106,6 +115,7 @@ impl Default for SimParams {
             hold_translation_mm: 5.0,
             hold_rotation_deg: 5.0,
             close_duration_s: 0.5,
+            close_until_stalled: true,
             solver_iterations: 8,
             pgs_iterations: 8,
             stabilization_iterations: 2,
@@ -144,6 +154,7 @@ impl SimParams {
             open_margin_deg,
             rest_window_s,
             rest_safety,
+            rest_margin,
             max_penetration_mm,
         ) {
             if !(v.is_finite() && v > 0.0) {
@@ -166,6 +177,15 @@ impl SimParams {
                 format!(
                     "must be zero or positive, got {}",
                     s.motor_damping_nms_per_rad
+                ),
+            ));
+        }
+        if s.rest_margin > 1.0 {
+            return Err((
+                "sim.rest_margin",
+                format!(
+                    "must be at most 1 (a fraction of the thresholds), got {}",
+                    s.rest_margin
                 ),
             ));
         }

@@ -68,6 +68,9 @@ pub struct DirectionOutcome {
     /// (rapier's contact depth): a grasp that holds only because a finger passed into the object
     /// shows here (issue 14).
     pub closing_penetration_mm: f64,
+    /// How long the fingers closed before gravity came on `[s]`: `close_duration_s`, or less
+    /// under the `fast` protocol when the hand and the object stopped sooner.
+    pub closed_at_s: f64,
     /// Largest difference between a joint's bend after closing and its planned bend `[deg]`
     /// (negative: stopped short of the plan, i.e. contact earlier than planned).
     pub joint_error_deg: f64,
@@ -119,8 +122,6 @@ const G: f64 = 9.81;
 /// The early-decision rule of the `fast` protocol (docs/SIM.md, "Deciding early").
 #[derive(Debug, Clone, Copy)]
 pub struct EarlyDecision {
-    /// The object's pose relative to the palm is sampled this often `[s]`.
-    pub sample_s: f64,
     /// The window over which its motion is measured, and the least time held before a `rest`
     /// decision `[s]`.
     pub window_s: f64,
@@ -134,19 +135,152 @@ pub struct EarlyDecision {
     pub report_deg: f64,
     /// ... or this fraction of the value reported, whichever is larger.
     pub report_fraction: f64,
+    /// A rest decision keeps the object within this fraction of the hold thresholds, motion to
+    /// come included: an object near a threshold runs to the end of the hold.
+    pub margin: f64,
 }
 
 impl EarlyDecision {
     /// The rule with the scenario's `rest_window_s` and `rest_safety`.
     pub fn from_params(params: &SimParams) -> EarlyDecision {
         EarlyDecision {
-            sample_s: 1.0 / 48.0,
             window_s: params.rest_window_s,
             safety: params.rest_safety,
             report_mm: 0.5,
             report_deg: 0.5,
             report_fraction: 0.1,
+            margin: params.rest_margin,
         }
+    }
+}
+
+/// The object's pose relative to the palm is sampled this often during a hold `[s]`.
+pub const SAMPLE_S: f64 = 1.0 / 48.0;
+
+/// What the samples of a hold are measured against: the pose after closing, and how the
+/// rotation is judged.
+#[derive(Debug, Clone, Copy)]
+pub struct RestFrame {
+    /// Object translation relative to the palm after closing `[mm]`.
+    pub pc: Vector3<f64>,
+    /// Object rotation relative to the palm after closing.
+    pub qc: UnitQuaternion<f64>,
+    /// Only the tilt of the principal axis is judged (a body of revolution).
+    pub is_revolution: bool,
+    /// Time between samples `[s]`.
+    pub sample_dt: f64,
+}
+
+impl RestFrame {
+    /// The judged rotation between two orientations `[deg]`.
+    fn judged(&self, a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
+        let (full, tilt) = rotations(a, b);
+        if self.is_revolution {
+            tilt
+        } else {
+            full
+        }
+    }
+}
+
+impl EarlyDecision {
+    /// The rest rule: true when the motion of the last `window_s` of `samples` (the poses
+    /// relative to the palm so far, one every `frame.sample_dt`), its mean drift and its
+    /// spread, at `safety` times their size and continued for `remaining_s`, keeps the object
+    /// within the hold thresholds and the numbers reported now within what they may differ from
+    /// the full protocol's.
+    pub fn at_rest(
+        &self,
+        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
+        frame: &RestFrame,
+        remaining_s: f64,
+        params: &SimParams,
+    ) -> bool {
+        let window = ((self.window_s / frame.sample_dt).round() as usize).max(1);
+        if samples.len() <= window {
+            return false;
+        }
+        let recent = &samples[samples.len() - window - 1..];
+        let window_s = window as f64 * frame.sample_dt;
+        let (first, last) = (recent[0], recent[window]);
+        let mut spread_mm = 0.0f64;
+        let mut spread_deg = 0.0f64;
+        for (i, a) in recent.iter().enumerate() {
+            for b in &recent[i + 1..] {
+                spread_mm = spread_mm.max((a.0 - b.0).norm());
+                spread_deg = spread_deg.max(frame.judged(&a.1, &b.1));
+            }
+        }
+        let drift_mm = (last.0 - first.0).norm() / window_s;
+        let drift_deg = frame.judged(&first.1, &last.1) / window_s;
+        let now_mm = (last.0 - frame.pc).norm();
+        let now_deg = frame.judged(&frame.qc, &last.1);
+        let more_mm = self.safety * (drift_mm * remaining_s + spread_mm);
+        let more_deg = self.safety * (drift_deg * remaining_s + spread_deg);
+        now_mm + more_mm <= self.margin * params.hold_translation_mm
+            && now_deg + more_deg <= self.margin * params.hold_rotation_deg
+            && more_mm <= self.report_mm.max(self.report_fraction * now_mm)
+            && more_deg <= self.report_deg.max(self.report_fraction * now_deg)
+    }
+}
+
+/// A full-length hold's samples (one every [`SAMPLE_S`]) and outcome, collected by [`traced`]
+/// for the study of the rest rule (`examples/early_rule.rs`).
+#[derive(Debug, Clone)]
+pub struct HoldTrace {
+    /// What the samples are measured against.
+    pub frame: RestFrame,
+    /// The object's pose relative to the palm, one per sample.
+    pub samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)>,
+    /// The hold's length `[s]`.
+    pub duration_s: f64,
+    /// Its outcome.
+    pub outcome: DirectionOutcome,
+}
+
+thread_local! {
+    static TRACES: std::cell::RefCell<Option<Vec<HoldTrace>>> =
+        const { std::cell::RefCell::new(None) };
+}
+
+/// Runs `f`, collecting the trace of every full-length hold (`protocol = "full"`) it runs on
+/// this thread.
+pub fn traced<R>(f: impl FnOnce() -> R) -> (R, Vec<HoldTrace>) {
+    TRACES.with(|t| *t.borrow_mut() = Some(Vec::new()));
+    let r = f();
+    let traces = TRACES.with(|t| t.borrow_mut().take()).unwrap_or_default();
+    (r, traces)
+}
+
+/// The end of a closing phase with `close_until_stalled` (docs/SIM.md, "Closing until the hand
+/// stops"): every joint, and the object relative to the palm, slower than these for
+/// `window_s`.
+#[derive(Debug, Clone, Copy)]
+pub struct Stall {
+    /// Fastest joint `[rad/s]`.
+    pub joint_rad_s: f64,
+    /// Fastest object translation `[mm/s]`.
+    pub object_mm_s: f64,
+    /// Fastest object rotation `[rad/s]`.
+    pub object_rad_s: f64,
+    /// How long all of them must stay below `[s]`.
+    pub window_s: f64,
+}
+
+/// The rule, for rapier and the MuJoCo replay (`protocol.json`).
+pub const STALL: Stall = Stall {
+    joint_rad_s: 0.02,
+    object_mm_s: 0.5,
+    object_rad_s: 0.01,
+    window_s: 0.02,
+};
+
+impl Stall {
+    /// True if `(joint, object translation, object rotation)` speeds are all below the rule's.
+    fn quiet(&self, (joint, object_mm_s, object_rad_s): (f64, f64, f64)) -> bool {
+        joint < self.joint_rad_s
+            && object_mm_s < self.object_mm_s
+            && object_rad_s < self.object_rad_s
     }
 }
 
@@ -235,7 +369,8 @@ pub fn check_with_payload(case: &Case, payload: bool) -> (SimOutcome, Option<(f6
             let t0 = Instant::now();
             let closed = Closed::new(case);
             let out = check_closed(&closed, case, 1.0, t0);
-            let bracket = (payload && out.verdict == Verdict::Hold).then(|| payload_bracket(case));
+            let bracket = (payload && out.verdict == Verdict::Hold)
+                .then(|| payload_bracket_closed(&closed, case));
             (out, bracket)
         }
     }
@@ -370,16 +505,34 @@ fn relative(scene: &Scene) -> (Vector3<f64>, UnitQuaternion<f64>) {
     )
 }
 
-/// Closes the hand, gravity off: joint 1 first, joint 2 from halfway through the closing time.
+/// Closes the hand, gravity off: joint 1 first, then joint 2, each for half `close_duration_s`
+/// or, with `close_until_stalled`, until the hand and the object have stopped ([`STALL`]).
 fn close(scene: &mut Scene, params: &SimParams) -> Closing {
+    let stall = params.close_until_stalled.then_some(&STALL);
     let dt = params.timestep_s;
     let close_steps = (params.close_duration_s / dt).round() as usize;
     let (p0, _) = relative(scene);
-    for i in 0..close_steps {
-        if i == close_steps / 2 {
+    // Joint 1 closes for at most half the closing time, joint 2 for the rest.
+    let phases = [close_steps / 2, close_steps - close_steps / 2];
+    let mut steps = 0;
+    for (phase, max_steps) in phases.into_iter().enumerate() {
+        if phase == 1 {
             scene.release_joint2();
         }
-        scene.world.step();
+        let mut quiet_steps = 0;
+        for _ in 0..max_steps {
+            scene.world.step();
+            steps += 1;
+            let Some(rule) = stall else { continue };
+            if rule.quiet(motion(scene)) {
+                quiet_steps += 1;
+                if quiet_steps as f64 * dt >= rule.window_s {
+                    break;
+                }
+            } else {
+                quiet_steps = 0;
+            }
+        }
     }
     let (pc, qc) = relative(scene);
     Closing {
@@ -388,9 +541,24 @@ fn close(scene: &mut Scene, params: &SimParams) -> Closing {
         qc,
         penetration_mm: penetration_mm(scene),
         joint_errors_deg: joint_errors(scene),
-        steps: close_steps,
+        steps,
         contacts: super::contacts::grip_contacts(scene),
     }
+}
+
+/// The hand's and the object's motion relative to the palm: (fastest joint `[rad/s]`, object
+/// speed `[mm/s]`, object angular speed `[rad/s]`).
+fn motion(scene: &Scene) -> (f64, f64, f64) {
+    let b = &scene.world.bodies;
+    let n = |v: Vector| f64::from(v.length());
+    let mut joint = 0.0f64;
+    for f in &scene.fingers {
+        let w1 = b[f.phalanx1].angvel();
+        let w2 = b[f.phalanx2].angvel();
+        joint = joint.max(n(w1)).max(n(w2 - w1));
+    }
+    let o = &b[scene.object];
+    (joint, n(o.linvel()) * 1000.0, n(o.angvel()))
 }
 
 /// The deepest penetration of a hand collider into the object now `[mm]` (0 when none).
@@ -460,7 +628,8 @@ fn hold(
     let g = gravity * G;
     scene.world.gravity = Vector::new(g.x as f32, g.y as f32, g.z as f32);
     let judged = |full: f64, tilt: f64| if is_revolution { tilt } else { full };
-    let sample_every = early.map_or(usize::MAX, |r| ((r.sample_s / dt).round() as usize).max(1));
+    let sample_every = ((SAMPLE_S / dt).round() as usize).max(1);
+    let tracing = TRACES.with(|t| t.borrow().is_some());
     // Samples of the object's pose relative to the palm, for the rest rule.
     let mut samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)> = Vec::new();
     let mut decided: Option<Decision> = None;
@@ -468,52 +637,26 @@ fn hold(
     while steps < hold_steps {
         scene.world.step();
         steps += 1;
-        let Some(rule) = early else { continue };
-        if steps % sample_every != 0 {
+        if steps % sample_every != 0 || (early.is_none() && !tracing) {
             continue;
         }
-        let (p, q) = relative(scene);
-        samples.push((p, q));
-        let remaining_s = (hold_steps - steps) as f64 * dt;
+        samples.push(relative(scene));
+        let Some(rule) = early else { continue };
         // Drop: the object has left the hand's reach and its free flight never brings it back.
         if let Some(p_end) = out_of_reach(scene, g, params, hold_steps - steps) {
             decided = Some(Decision::OutOfReach(steps, p_end));
             break;
         }
-        // Hold: the motion of the last window (its mean drift, and the spread of the poses
-        // about it), at `safety` times its size, continued to the end of the hold, keeps the
-        // object within the thresholds and the numbers reported now within what they may
-        // differ from the full protocol's.
-        let window = ((rule.window_s / (sample_every as f64 * dt)).round() as usize).max(1);
-        if samples.len() > window {
-            let recent = &samples[samples.len() - window - 1..];
-            let window_s = window as f64 * sample_every as f64 * dt;
-            let (first, last) = (recent[0], recent[window]);
-            let mut spread_mm = 0.0f64;
-            let mut spread_deg = 0.0f64;
-            for (i, a) in recent.iter().enumerate() {
-                for b in &recent[i + 1..] {
-                    spread_mm = spread_mm.max((a.0 - b.0).norm());
-                    let (full, tilt) = rotations(&a.1, &b.1);
-                    spread_deg = spread_deg.max(judged(full, tilt));
-                }
-            }
-            let drift_mm = (last.0 - first.0).norm() / window_s;
-            let (full, tilt) = rotations(&first.1, &last.1);
-            let drift_deg = judged(full, tilt) / window_s;
-            let (full, tilt) = rotations(&qc, &q);
-            let now_mm = (p - pc).norm();
-            let now_deg = judged(full, tilt);
-            let more_mm = rule.safety * (drift_mm * remaining_s + spread_mm);
-            let more_deg = rule.safety * (drift_deg * remaining_s + spread_deg);
-            if now_mm + more_mm <= params.hold_translation_mm
-                && now_deg + more_deg <= params.hold_rotation_deg
-                && more_mm <= rule.report_mm.max(rule.report_fraction * now_mm)
-                && more_deg <= rule.report_deg.max(rule.report_fraction * now_deg)
-            {
-                decided = Some(Decision::Rest(steps));
-                break;
-            }
+        let remaining_s = (hold_steps - steps) as f64 * dt;
+        let frame = RestFrame {
+            pc,
+            qc,
+            is_revolution,
+            sample_dt: sample_every as f64 * dt,
+        };
+        if rule.at_rest(&samples, &frame, remaining_s, params) {
+            decided = Some(Decision::Rest(steps));
+            break;
         }
     }
     let (pe, qe) = relative(scene);
@@ -548,25 +691,41 @@ fn hold(
     } else {
         Verdict::Drop
     };
-    (
-        DirectionOutcome {
-            gravity: [gravity.x, gravity.y, gravity.z],
-            verdict,
-            translation_mm,
-            rotation_deg: judged_rotation,
-            full_rotation_deg: rotation_deg,
-            tilt_deg,
-            closing_translation_mm: (pc - p0).norm(),
-            closing_penetration_mm: closing.penetration_mm,
-            joint_error_deg,
-            joint_errors_deg,
-            in_contact,
-            decided_at_s,
-            decided_by,
-            translation_at_decision_mm: at_decision_mm,
-        },
-        steps,
-    )
+    let outcome = DirectionOutcome {
+        gravity: [gravity.x, gravity.y, gravity.z],
+        verdict,
+        translation_mm,
+        rotation_deg: judged_rotation,
+        full_rotation_deg: rotation_deg,
+        tilt_deg,
+        closing_translation_mm: (pc - p0).norm(),
+        closing_penetration_mm: closing.penetration_mm,
+        closed_at_s: closing.steps as f64 * dt,
+        joint_error_deg,
+        joint_errors_deg,
+        in_contact,
+        decided_at_s,
+        decided_by,
+        translation_at_decision_mm: at_decision_mm,
+    };
+    if tracing && early.is_none() {
+        TRACES.with(|t| {
+            if let Some(v) = t.borrow_mut().as_mut() {
+                v.push(HoldTrace {
+                    frame: RestFrame {
+                        pc,
+                        qc,
+                        is_revolution,
+                        sample_dt: sample_every as f64 * dt,
+                    },
+                    samples,
+                    duration_s: hold_steps as f64 * dt,
+                    outcome: outcome.clone(),
+                });
+            }
+        });
+    }
+    (outcome, steps)
 }
 
 /// How a direction was decided before the end of the hold.
@@ -666,13 +825,20 @@ pub fn payload_margin(case: &Case) -> f64 {
 
 /// The payload search of [`payload_margin`], with the bracket it ends on: the largest
 /// multiplier seen to hold and the one seen to fail just above it (within 5 %), or `None` if
-/// the grasp held at 64×. Every multiplier builds and closes a fresh scene with the heavier
-/// object, under either protocol: continuing every multiplier from one closing with the
-/// scenario's mass was tried and gave other margins (chapter 4: 45× against 27×), because a
-/// heavier object, though weightless while the fingers close, resists their pushes and ends
-/// seated differently (docs/SIM.md).
+/// the grasp held at 64×. Under the `full` protocol every multiplier builds and closes a fresh
+/// scene with the heavier object; under `fast` every multiplier continues from one closing
+/// with the scenario's mass, the object made heavier as gravity comes on (the grasp as it was
+/// made, loaded: docs/SIM.md, "Payload from one closing").
 pub fn payload_bracket(case: &Case) -> (f64, Option<f64>) {
-    search(|k| check(&case.heavier(k)).verdict)
+    match case.params.protocol {
+        Protocol::Full => search(|k| check(&case.heavier(k)).verdict),
+        Protocol::Fast => payload_bracket_closed(&Closed::new(case), case),
+    }
+}
+
+/// [`payload_bracket`] under the `fast` protocol, from a closed scene.
+fn payload_bracket_closed(closed: &Closed, case: &Case) -> (f64, Option<f64>) {
+    search(|k| check_closed(closed, case, k, Instant::now()).verdict)
 }
 
 /// Doubling from 2× until `verdict` is not `hold` (or 64× holds), then bisection to 5 %.

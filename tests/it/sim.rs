@@ -2,6 +2,7 @@
 //! planner's.
 
 use grasp_sim::scenario::Scenario;
+use grasp_sim::sim::Verdict;
 use grasp_sim::{run, RunOptions};
 
 fn scenario_with(mesh: &str, sim: &str) -> (tempfile::TempDir, Scenario) {
@@ -253,10 +254,20 @@ fn d40_case<R>(
     params: grasp_sim::scenario::SimParams,
     f: impl FnOnce(&grasp_sim::sim::Case) -> R,
 ) -> R {
+    cylinder_case(40.0, params, f)
+}
+
+/// The planned grasp of a cylinder `d` mm across and 124 mm tall (density 500 kg/m³, μ 0.3, as
+/// the thesis scenarios) as a physics case.
+fn cylinder_case<R>(
+    d: f64,
+    params: grasp_sim::scenario::SimParams,
+    f: impl FnOnce(&grasp_sim::sim::Case) -> R,
+) -> R {
     use grasp_sim::sim::{Case, ObjectShape, SimHand};
     let hand =
         grasp_sim::hand::Hand::load(&crate::root().join("assets/hands/thesis.toml"), &[]).unwrap();
-    let mesh = grasp_sim::objects::cylinder(40.0, 124.0);
+    let mesh = grasp_sim::objects::cylinder(d, 124.0);
     let aligned = grasp_sim::mesh::align(&mesh);
     let (_, found) = grasp_sim::plan::plan(
         &aligned.mesh,
@@ -277,6 +288,75 @@ fn d40_case<R>(
         friction: 0.3,
         params: &params,
     })
+}
+
+#[test]
+fn the_closing_ends_when_the_hand_and_the_object_stop() {
+    // With `close_until_stalled` (the default) each closing phase ends once every joint and the
+    // object have stopped; the fixed schedule closes for the whole 0.5 s. On D40 both end in
+    // the same grip: joint angles within a tenth of a degree, and both hold.
+    use grasp_sim::scenario::SimParams;
+    let fixed = SimParams {
+        close_until_stalled: false,
+        ..Default::default()
+    };
+    let (stalled, fixed) = (
+        d40_case(SimParams::default(), grasp_sim::sim::check),
+        d40_case(fixed, grasp_sim::sim::check),
+    );
+    let (a, b) = (&stalled.directions[0], &fixed.directions[0]);
+    assert_eq!(b.closed_at_s, 0.5);
+    // Joint 1 stops within 50 ms, joint 2 within about 100 ms of its release, each followed by
+    // the 20 ms the rule waits.
+    assert!(
+        a.closed_at_s > 0.1 && a.closed_at_s < 0.2,
+        "{}",
+        a.closed_at_s
+    );
+    for (s, f) in a.joint_errors_deg.iter().zip(&b.joint_errors_deg) {
+        for j in 0..2 {
+            assert!((s[j] - f[j]).abs() < 0.1, "{s:?} against {f:?}");
+        }
+    }
+    assert_eq!(a.verdict, Verdict::Hold);
+    assert_eq!(b.verdict, Verdict::Hold);
+    // The steps reported are the closing's and the hold's: the closing saved is saved.
+    let dt = SimParams::default().timestep_s;
+    let steps = |d: &grasp_sim::sim::DirectionOutcome| {
+        ((d.closed_at_s + d.decided_at_s) / dt).round() as usize
+    };
+    assert_eq!(stalled.steps, steps(a));
+    assert_eq!(fixed.steps, steps(b));
+    assert!(stalled.steps < fixed.steps);
+}
+
+#[test]
+fn the_fast_payload_search_loads_one_closed_grasp() {
+    // Under `fast` every multiplier continues from the one closing with the scenario's mass;
+    // the bracket it reports is what that closed grasp does when loaded, and on the D60
+    // cylinder it agrees with the full protocol's (a fresh closing per multiplier) within 25 %.
+    use grasp_sim::scenario::{Protocol, SimParams};
+    use grasp_sim::sim::{check_closed, payload_bracket, Closed};
+    let fast = cylinder_case(60.0, SimParams::default(), |case| {
+        let (held, failed) = payload_bracket(case);
+        let failed = failed.expect("D60 fails below 64x");
+        let closed = Closed::new(case);
+        let at = |k| check_closed(&closed, case, k, std::time::Instant::now()).verdict;
+        assert_eq!(at(held), Verdict::Hold);
+        assert_ne!(at(failed), Verdict::Hold);
+        assert!(failed > held && failed <= held * 1.05 + 1e-9);
+        held
+    });
+    let full = SimParams {
+        protocol: Protocol::Full,
+        ..Default::default()
+    };
+    let (full, _) = cylinder_case(60.0, full, payload_bracket);
+    assert!(fast > 8.0 && fast < 64.0, "{fast}");
+    assert!(
+        (fast / full).max(full / fast) < 1.25,
+        "fast {fast}x, full {full}x"
+    );
 }
 
 #[test]
