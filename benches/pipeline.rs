@@ -7,7 +7,8 @@
 //! - `plan/*`: the whole kinematic planner (align, stages 1–3, search) on each thesis object.
 //! - `plan_scaling/*`: the planner on the cup as AngularStep and HeightStep change.
 //! - `sim/*`: the physics check of the planned D40 grasp: `down`, `six` and `payload` (fast
-//!   protocol), `full_down` and `full_six` (the full-length reference).
+//!   protocol), `full_down` and `full_six` (the full-length reference), `before_down`,
+//!   `before_six` and `before_payload` (the check before issue 15).
 //! - `quality/*`: the analytic grasp quality (issue 18) of the planned grasp of D40, the cup
 //!   and the chapter 4 object, from the contacts at the end of the `down` check's closing
 //!   (`sim_*`) and from the planned contacts (`planned_*`), beside that same `down` check
@@ -156,18 +157,34 @@ fn bench_sim(c: &mut Criterion) {
     let mut g = c.benchmark_group("sim");
     g.sample_size(10);
     // `down`, `six` and `payload` (the check and its payload search) under the default `fast`
-    // protocol; `full_down` and `full_six` are the full-length reference (the figures before
-    // issue 15).
-    for (name, gravity, protocol, payload) in [
-        ("down", GravityMode::Down, Protocol::Fast, false),
-        ("six", GravityMode::Six, Protocol::Fast, false),
-        ("payload", GravityMode::Down, Protocol::Fast, true),
-        ("full_down", GravityMode::Down, Protocol::Full, false),
-        ("full_six", GravityMode::Six, Protocol::Full, false),
+    // protocol; `full_down` and `full_six` are the full-length reference with the same closing;
+    // `before_*` the check before issue 15 (full-length, fixed 0.5 s closing).
+    for (name, gravity, protocol, payload, stalled) in [
+        ("down", GravityMode::Down, Protocol::Fast, false, true),
+        ("six", GravityMode::Six, Protocol::Fast, false, true),
+        ("payload", GravityMode::Down, Protocol::Fast, true, true),
+        ("full_down", GravityMode::Down, Protocol::Full, false, true),
+        ("full_six", GravityMode::Six, Protocol::Full, false, true),
+        (
+            "before_down",
+            GravityMode::Down,
+            Protocol::Full,
+            false,
+            false,
+        ),
+        ("before_six", GravityMode::Six, Protocol::Full, false, false),
+        (
+            "before_payload",
+            GravityMode::Down,
+            Protocol::Full,
+            true,
+            false,
+        ),
     ] {
         let params = SimParams {
             gravity,
             protocol,
+            close_until_stalled: stalled,
             ..SimParams::default()
         };
         g.bench_function(name, |b| {

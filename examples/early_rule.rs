@@ -1,0 +1,168 @@
+//! The study of the `fast` protocol's rest rule (docs/SIM.md, "Deciding early"): runs each
+//! scenario's first grasp under the full-length protocol, keeps every hold's sampled motion, and
+//! replays the rest rule on it for several windows. The fast protocol's run is the full one's up
+//! to its decision (the same closing, a copy that continues bit for bit), so a rule that decides
+//! a hold here decides it there, at the same time, on the same numbers.
+//!
+//!     cargo run --release --example early_rule -- [--six] [--set KEY=VALUE ...] SCENARIO...
+//!
+//! Prints, per window, how many holds it decided early, how early on average, and every
+//! decision that the full-length hold contradicts: a verdict that changes later (`wrong`), or a
+//! translation or rotation that moves on by more than the report tolerance (0.5 mm or 10 %,
+//! 0.5° or 10 %) (`numbers`).
+
+use grasp_sim::scenario::{GravityMode, Protocol, Scenario, SimParams};
+use grasp_sim::sim::protocol::{traced, HoldTrace};
+use grasp_sim::sim::{EarlyDecision, Verdict};
+use grasp_sim::{run, RunOptions};
+
+/// (window `[s]`, margin) pairs studied.
+const RULES: [(f64, f64); 8] = [
+    (0.1, 1.0),
+    (0.2, 1.0),
+    (0.3, 1.0),
+    (0.5, 1.0),
+    (0.1, 0.8),
+    (0.2, 0.8),
+    (0.3, 0.8),
+    (0.5, 0.8),
+];
+
+/// Where the rule with `window_s` and `margin` decides `t`'s hold: (time, translation, rotation) at the
+/// decision, or `None` if it runs to the end.
+fn decide(
+    t: &HoldTrace,
+    params: &SimParams,
+    (window_s, margin): (f64, f64),
+) -> Option<(f64, f64, f64)> {
+    let rule = EarlyDecision {
+        window_s,
+        margin,
+        ..EarlyDecision::from_params(params)
+    };
+    let dt = t.frame.sample_dt;
+    for i in 0..t.samples.len() {
+        let at = (i + 1) as f64 * dt;
+        let remaining = t.duration_s - at;
+        if remaining <= 1e-9 {
+            return None;
+        }
+        if rule.at_rest(&t.samples[..=i], &t.frame, remaining, params) {
+            let (p, q) = t.samples[i];
+            let (full, tilt) = (t.frame.qc.angle_to(&q).to_degrees(), {
+                let z = nalgebra::Vector3::z();
+                (t.frame.qc * z).angle(&(q * z)).to_degrees()
+            });
+            let rot = if t.frame.is_revolution { tilt } else { full };
+            return Some((at, (p - t.frame.pc).norm(), rot));
+        }
+    }
+    None
+}
+
+fn main() {
+    let mut six = false;
+    let mut sets: Vec<(String, toml::Value)> = Vec::new();
+    let mut files = Vec::new();
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--six" => six = true,
+            "--set" => {
+                let kv = args.next().expect("KEY=VALUE");
+                let (k, v) = kv.split_once('=').expect("KEY=VALUE");
+                let v: toml::Table = toml::from_str(&format!("v = {v}")).expect("a TOML value");
+                sets.push((k.to_string(), v["v"].clone()));
+            }
+            _ => files.push(a),
+        }
+    }
+    // Per window: holds decided early, the sum of their decision times, and the contradictions.
+    let mut decided = [0usize; RULES.len()];
+    let mut at_sum = [0.0f64; RULES.len()];
+    let mut bad: Vec<Vec<String>> = vec![Vec::new(); RULES.len()];
+    let mut holds = 0;
+    let mut runs = 0;
+    for f in &files {
+        let path = std::path::Path::new(f);
+        let mut table: toml::Table =
+            toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+        let sim = table
+            .entry("sim")
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        for (k, v) in &sets {
+            sim.as_table_mut().unwrap().insert(k.clone(), v.clone());
+        }
+        let mut s = match Scenario::parse(&toml::to_string(&table).unwrap(), path) {
+            Ok(s) => s,
+            Err(e) => {
+                eprintln!("{f}: {e}");
+                std::process::exit(2);
+            }
+        };
+        s.sim.protocol = Protocol::Full;
+        if six {
+            s.sim.gravity = GravityMode::Six;
+        }
+        let options = RunOptions {
+            max_checked: Some(1),
+            ..RunOptions::default()
+        };
+        let (r, traces) = traced(|| run(&s, &options));
+        if let Err(e) = r {
+            eprintln!("{f}: {e}");
+            continue;
+        }
+        for t in &traces {
+            runs += 1;
+            let o = &t.outcome;
+            if o.verdict == Verdict::Hold {
+                holds += 1;
+            }
+            for (w, &window) in RULES.iter().enumerate() {
+                let Some((at, mm, deg)) = decide(t, &s.sim, window) else {
+                    continue;
+                };
+                decided[w] += 1;
+                at_sum[w] += at;
+                let g = o.gravity;
+                let name = format!("{} g=({:.0},{:.0},{:.0})", s.name, g[0], g[1], g[2]);
+                let close = |a: f64, b: f64, abs: f64| {
+                    (a - b).abs() <= abs || (a - b).abs() <= 0.1 * a.abs().max(b.abs())
+                };
+                // A rest decision is a `hold` by motion; the full verdict may also be `slip`
+                // for a penetration, which both protocols share.
+                if o.verdict != Verdict::Hold
+                    && o.closing_penetration_mm <= s.sim.max_penetration_mm
+                {
+                    bad[w].push(format!(
+                        "wrong: {name}: rest at {at:.2} s ({mm:.2} mm, {deg:.2}°), full {} ({:.2} mm, {:.2}°)",
+                        o.verdict, o.translation_mm, o.rotation_deg
+                    ));
+                } else if !close(mm, o.translation_mm, 0.5) || !close(deg, o.rotation_deg, 0.5) {
+                    bad[w].push(format!(
+                        "numbers: {name}: rest at {at:.2} s ({mm:.2} mm, {deg:.2}°), full end ({:.2} mm, {:.2}°)",
+                        o.translation_mm, o.rotation_deg
+                    ));
+                }
+            }
+        }
+    }
+    println!("{runs} holds simulated full-length ({holds} of them `hold`)\n");
+    println!("| window [s] | margin | decided early | mean decision [s] | wrong verdicts | numbers beyond tolerance |");
+    println!("|---|---|---|---|---|---|");
+    for (w, (window, margin)) in RULES.iter().enumerate() {
+        let wrong = bad[w].iter().filter(|b| b.starts_with("wrong")).count();
+        println!(
+            "| {window} | {margin} | {} | {:.2} | {wrong} | {} |",
+            decided[w],
+            at_sum[w] / decided[w].max(1) as f64,
+            bad[w].len() - wrong
+        );
+    }
+    for (w, (window, margin)) in RULES.iter().enumerate() {
+        for b in &bad[w] {
+            println!("window {window}, margin {margin}: {b}");
+        }
+    }
+}
