@@ -48,11 +48,19 @@ fn main() {
         payload,
         ..RunOptions::default()
     };
-    println!(
-        "| scenario | full | fast | translation full / fast [mm] | rotation full / fast [deg] | \
-         decided at [s] | payload full / fast | wall full / fast [ms] | agree |"
-    );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    if let Some(p) = only {
+        println!(
+            "| scenario | {} | translation [mm] | rotation [deg] | decided at [s] | payload | wall [ms] |",
+            format!("{p:?}").to_lowercase()
+        );
+        println!("|---|---|---|---|---|---|---|");
+    } else {
+        println!(
+            "| scenario | full | fast | translation full / fast [mm] | rotation full / fast [deg] | \
+             decided at [s] | payload full / fast | wall full / fast [ms] | agree |"
+        );
+        println!("|---|---|---|---|---|---|---|---|---|");
+    }
     let mut failed = Vec::new();
     let (mut wall_full, mut wall_fast) = (0.0, 0.0);
     for f in &files {
@@ -142,10 +150,12 @@ fn main() {
             if ok { "yes" } else { "**no**" }
         );
     }
-    println!(
-        "\ncheck wall time in total: full {wall_full:.0} ms, fast {wall_fast:.0} ms ({:.1}x)",
-        wall_full / wall_fast.max(1e-9)
-    );
+    if only.is_none() {
+        println!(
+            "\ncheck wall time in total: full {wall_full:.0} ms, fast {wall_fast:.0} ms ({:.1}x)",
+            wall_full / wall_fast.max(1e-9)
+        );
+    }
     if !failed.is_empty() {
         eprintln!("protocols disagree on: {}", failed.join(", "));
         std::process::exit(1);
