@@ -842,18 +842,37 @@ fn payload_bracket_closed(closed: &Closed, case: &Case) -> (f64, Option<f64>) {
 }
 
 /// Doubling from 2× until `verdict` is not `hold` (or 64× holds), then bisection to 5 %.
-fn search(verdict: impl Fn(f64) -> Verdict) -> (f64, Option<f64>) {
+///
+/// The doubling evaluates two multipliers at once (k and 2k, on rayon's threads) and reads them
+/// in order, as the one-at-a-time search would: 2k is wasted when k fails. `verdict` of a
+/// multiplier does not depend on what else runs, so the bracket is the sequential search's.
+fn search(verdict: impl Fn(f64) -> Verdict + Sync) -> (f64, Option<f64>) {
     let holds = |k: f64| verdict(k) == Verdict::Hold;
     let mut lo = 1.0;
     let mut hi = None;
     let mut k = 2.0;
     while k <= 64.0 {
-        if holds(k) {
-            lo = k;
-            k *= 2.0;
+        let (at_k, at_2k) = if 2.0 * k <= 64.0 {
+            let (a, b) = rayon::join(|| holds(k), || holds(2.0 * k));
+            (a, Some(b))
         } else {
+            (holds(k), None)
+        };
+        if !at_k {
             hi = Some(k);
             break;
+        }
+        lo = k;
+        match at_2k {
+            Some(true) => {
+                lo = 2.0 * k;
+                k *= 4.0;
+            }
+            Some(false) => {
+                hi = Some(2.0 * k);
+                break;
+            }
+            None => k *= 2.0,
         }
     }
     let Some(mut hi) = hi else {
