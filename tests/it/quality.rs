@@ -92,9 +92,9 @@ fn the_summary_gives_epsilon_and_the_json_has_it_per_candidate() {
         .find(|l| l.starts_with("  Quality     "))
         .unwrap_or_else(|| panic!("no quality line in\n{text}"));
     assert!(
-        line.contains("epsilon 0.120 (force closure)")
+        line.contains("epsilon 0.122 (force closure)")
             && line.contains("8 cone edges, mu 0.3")
-            && line.contains("10 contacts at the end of closing"),
+            && line.contains("8 contacts at the end of closing"),
         "{line}"
     );
     // Without it: from the planned contacts (palm and the phalanges of every ALS), for every
