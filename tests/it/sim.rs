@@ -360,6 +360,50 @@ fn the_fast_payload_search_loads_one_closed_grasp() {
 }
 
 #[test]
+fn the_rest_rule_decides_only_a_still_object_well_inside_the_thresholds() {
+    // `EarlyDecision::at_rest` on poses sampled every 1/48 s (the default rule: a 0.2 s window,
+    // twice the motion seen, within 0.8 of the 5 mm / 5° thresholds).
+    use grasp_sim::scenario::SimParams;
+    use grasp_sim::sim::protocol::{RestFrame, SAMPLE_S};
+    use grasp_sim::sim::EarlyDecision;
+    use nalgebra::{UnitQuaternion, Vector3};
+    let params = SimParams::default();
+    let rule = EarlyDecision::from_params(&params);
+    let frame = RestFrame {
+        pc: Vector3::zeros(),
+        qc: UnitQuaternion::identity(),
+        is_revolution: false,
+        sample_dt: SAMPLE_S,
+    };
+    let at = |mm: &dyn Fn(f64) -> f64, n: usize| -> Vec<(Vector3<f64>, UnitQuaternion<f64>)> {
+        (1..=n)
+            .map(|i| {
+                (
+                    Vector3::new(mm(i as f64 * SAMPLE_S), 0.0, 0.0),
+                    UnitQuaternion::identity(),
+                )
+            })
+            .collect()
+    };
+    let remaining = |n: usize| params.duration_s - n as f64 * SAMPLE_S;
+    // At rest 1 mm away: decided once a whole window (10 samples after the first) is seen.
+    let still = |_t: f64| 1.0;
+    assert!(!rule.at_rest(&at(&still, 10), &frame, remaining(10), &params));
+    assert!(rule.at_rest(&at(&still, 11), &frame, remaining(11), &params));
+    // At rest 3.9 mm away: within 0.8 × 5 mm, decided; 4.1 mm, though under the 5 mm
+    // threshold, is too near it: runs to the end.
+    let near = |_t: f64| 3.9;
+    assert!(rule.at_rest(&at(&near, 11), &frame, remaining(11), &params));
+    let nearer = |_t: f64| 4.1;
+    assert!(!rule.at_rest(&at(&nearer, 11), &frame, remaining(11), &params));
+    // Creeping at 0.1 mm/s: 2 × 0.1 × 1.77 s = 0.35 mm more, within the 0.5 mm report tolerance:
+    // decided. At 0.2 mm/s, 0.71 mm more: not.
+    let creep = |v: f64| move |t: f64| 1.0 + v * t;
+    assert!(rule.at_rest(&at(&creep(0.1), 11), &frame, remaining(11), &params));
+    assert!(!rule.at_rest(&at(&creep(0.2), 11), &frame, remaining(11), &params));
+}
+
+#[test]
 fn a_copied_scene_continues_bit_for_bit() {
     // The fast protocol continues every gravity direction from a copy of the closed scene: the
     // copy must go on exactly as the original would, every body's pose and velocity to the bit.
