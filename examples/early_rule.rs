@@ -11,7 +11,10 @@
 //! translation or rotation that moves on by more than the report tolerance (0.5 mm or 10 %,
 //! 0.5° or 10 %) (`numbers`).
 
-use grasp_sim::scenario::{GravityMode, Protocol, Scenario, SimParams};
+#[path = "common/mod.rs"]
+mod common;
+
+use grasp_sim::scenario::{GravityMode, Protocol, SimParams};
 use grasp_sim::sim::protocol::{traced, HoldTrace};
 use grasp_sim::sim::{EarlyDecision, Verdict};
 use grasp_sim::{run, RunOptions};
@@ -68,12 +71,7 @@ fn main() {
     while let Some(a) = args.next() {
         match a.as_str() {
             "--six" => six = true,
-            "--set" => {
-                let kv = args.next().expect("KEY=VALUE");
-                let (k, v) = kv.split_once('=').expect("KEY=VALUE");
-                let v: toml::Table = toml::from_str(&format!("v = {v}")).expect("a TOML value");
-                sets.push((k.to_string(), v["v"].clone()));
-            }
+            "--set" => sets.push(common::parse_set(&args.next().expect("KEY=VALUE"))),
             _ => files.push(a),
         }
     }
@@ -84,22 +82,7 @@ fn main() {
     let mut holds = 0;
     let mut runs = 0;
     for f in &files {
-        let path = std::path::Path::new(f);
-        let mut table: toml::Table =
-            toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-        let sim = table
-            .entry("sim")
-            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-        for (k, v) in &sets {
-            sim.as_table_mut().unwrap().insert(k.clone(), v.clone());
-        }
-        let mut s = match Scenario::parse(&toml::to_string(&table).unwrap(), path) {
-            Ok(s) => s,
-            Err(e) => {
-                eprintln!("{f}: {e}");
-                std::process::exit(2);
-            }
-        };
+        let mut s = common::load_with(f, &sets);
         s.sim.protocol = Protocol::Full;
         if six {
             s.sim.gravity = GravityMode::Six;

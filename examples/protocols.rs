@@ -10,8 +10,11 @@
 //! Exits 1 if a verdict differs, a held object's translation differs by more than 0.5 mm and
 //! 10 %, or a payload margin differs by more than the search's 5 % step.
 
+#[path = "common/mod.rs"]
+mod common;
+
 use grasp_sim::report::SimReport;
-use grasp_sim::scenario::{GravityMode, Protocol, Scenario};
+use grasp_sim::scenario::{GravityMode, Protocol};
 use grasp_sim::{run, RunOptions};
 use std::io::Write;
 
@@ -28,12 +31,7 @@ fn main() {
             "--six" => six = true,
             "--payload" => payload = true,
             "--jsonl" => jsonl = Some(std::fs::File::create(args.next().expect("FILE")).unwrap()),
-            "--set" => {
-                let kv = args.next().expect("KEY=VALUE");
-                let (k, v) = kv.split_once('=').expect("KEY=VALUE");
-                let v: toml::Table = toml::from_str(&format!("v = {v}")).expect("a TOML value");
-                sets.push((k.to_string(), v["v"].clone()));
-            }
+            "--set" => sets.push(common::parse_set(&args.next().expect("KEY=VALUE"))),
             "--only" => {
                 only = Some(match args.next().as_deref() {
                     Some("fast") => Protocol::Fast,
@@ -64,24 +62,7 @@ fn main() {
     let mut failed = Vec::new();
     let (mut wall_full, mut wall_fast) = (0.0, 0.0);
     for f in &files {
-        let path = std::path::Path::new(f);
-        let mut table: toml::Table =
-            toml::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
-        if !sets.is_empty() {
-            let sim = table
-                .entry("sim")
-                .or_insert_with(|| toml::Value::Table(toml::Table::new()));
-            for (k, v) in &sets {
-                sim.as_table_mut().unwrap().insert(k.clone(), v.clone());
-            }
-        }
-        let mut s = match Scenario::parse(&toml::to_string(&table).unwrap(), path) {
-            Ok(s) => s,
-            Err(e) => {
-                eprintln!("{f}: {e}");
-                std::process::exit(2);
-            }
-        };
+        let mut s = common::load_with(f, &sets);
         if six {
             s.sim.gravity = GravityMode::Six;
         }
