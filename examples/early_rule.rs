@@ -52,12 +52,7 @@ fn decide(
         }
         if rule.at_rest(&t.samples[..=i], &t.frame, remaining, params) {
             let (p, q) = t.samples[i];
-            let (full, tilt) = (t.frame.qc.angle_to(&q).to_degrees(), {
-                let z = nalgebra::Vector3::z();
-                (t.frame.qc * z).angle(&(q * z)).to_degrees()
-            });
-            let rot = if t.frame.is_revolution { tilt } else { full };
-            return Some((at, (p - t.frame.pc).norm(), rot));
+            return Some((at, (p - t.frame.pc).norm(), t.frame.judged(&t.frame.qc, &q)));
         }
     }
     None

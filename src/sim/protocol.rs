@@ -173,7 +173,7 @@ pub struct RestFrame {
 
 impl RestFrame {
     /// The judged rotation between two orientations `[deg]`.
-    fn judged(&self, a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
+    pub fn judged(&self, a: &UnitQuaternion<f64>, b: &UnitQuaternion<f64>) -> f64 {
         let (full, tilt) = rotations(a, b);
         if self.is_revolution {
             tilt
@@ -630,6 +630,12 @@ fn hold(
     let judged = |full: f64, tilt: f64| if is_revolution { tilt } else { full };
     let sample_every = ((SAMPLE_S / dt).round() as usize).max(1);
     let tracing = TRACES.with(|t| t.borrow().is_some());
+    let frame = RestFrame {
+        pc,
+        qc,
+        is_revolution,
+        sample_dt: sample_every as f64 * dt,
+    };
     // Samples of the object's pose relative to the palm, for the rest rule.
     let mut samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)> = Vec::new();
     let mut decided: Option<Decision> = None;
@@ -648,12 +654,6 @@ fn hold(
             break;
         }
         let remaining_s = (hold_steps - steps) as f64 * dt;
-        let frame = RestFrame {
-            pc,
-            qc,
-            is_revolution,
-            sample_dt: sample_every as f64 * dt,
-        };
         if rule.at_rest(&samples, &frame, remaining_s, params) {
             decided = Some(Decision::Rest(steps));
             break;
@@ -712,12 +712,7 @@ fn hold(
         TRACES.with(|t| {
             if let Some(v) = t.borrow_mut().as_mut() {
                 v.push(HoldTrace {
-                    frame: RestFrame {
-                        pc,
-                        qc,
-                        is_revolution,
-                        sample_dt: sample_every as f64 * dt,
-                    },
+                    frame,
                     samples,
                     duration_s: hold_steps as f64 * dt,
                     outcome: outcome.clone(),
