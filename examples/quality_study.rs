@@ -43,6 +43,8 @@ struct Row {
     eps_sim: f64,
     vol_sim: f64,
     eps_sim_linf: Option<f64>,
+    vol_sim_linf: Option<f64>,
+    vol_sim_linf_se: Option<f64>,
     contacts_sim: usize,
     eps_plan: f64,
     vol_plan: f64,
@@ -180,6 +182,8 @@ fn study_grasp(p: &Planned, k: usize, six: bool) -> Row {
         eps_sim: q_sim.epsilon,
         vol_sim: q_sim.volume,
         eps_sim_linf: q_sim.linf.map(|m| m.epsilon),
+        vol_sim_linf: q_sim.linf.and_then(|m| m.volume),
+        vol_sim_linf_se: q_sim.linf.and_then(|m| m.volume_rel_se),
         contacts_sim: q_sim.contacts.len(),
         eps_plan: q_plan.epsilon,
         vol_plan: q_plan.volume,
@@ -279,11 +283,14 @@ fn fmt2(x: f64) -> String {
 
 type Score = (&'static str, fn(&Row) -> f64);
 
-const SCORES: [Score; 7] = [
+const SCORES: [Score; 8] = [
     ("epsilon, sim contacts (L1)", |r| r.eps_sim),
     ("volume, sim contacts (L1)", |r| r.vol_sim),
     ("epsilon, sim contacts (L-inf)", |r| {
         r.eps_sim_linf.unwrap_or(f64::NAN)
+    }),
+    ("volume, sim contacts (L-inf)", |r| {
+        r.vol_sim_linf.unwrap_or(f64::NAN)
     }),
     ("epsilon, planned contacts (L1)", |r| r.eps_plan),
     ("volume, planned contacts (L1)", |r| r.vol_plan),
@@ -453,12 +460,12 @@ fn main() {
         .collect();
 
     let mut csv = String::from(
-        "set,scenario,candidate,axis,rules,planner_grade,epsilon_sim,volume_sim,epsilon_linf_sim,contacts_sim,epsilon_planned,volume_planned,payload_margin,down,six,down_ms,six_ms,payload_ms,quality_ms\n",
+        "set,scenario,candidate,axis,rules,planner_grade,epsilon_sim,volume_sim,epsilon_linf_sim,contacts_sim,epsilon_planned,volume_planned,payload_margin,down,six,down_ms,six_ms,payload_ms,quality_ms,volume_linf_sim,volume_linf_sim_rel_se\n",
     );
     for r in &rows {
         let _ = writeln!(
             csv,
-            "{},{},{},{},{},{:.4},{:.5},{:.4e},{},{},{:.5},{:.4e},{:.3},{},{},{:.1},{:.1},{:.1},{:.3}",
+            "{},{},{},{},{},{:.4},{:.5},{:.4e},{},{},{:.5},{:.4e},{:.3},{},{},{:.1},{:.1},{:.1},{:.3},{},{}",
             r.set,
             r.scenario,
             r.candidate,
@@ -477,7 +484,9 @@ fn main() {
             r.ms_down,
             r.ms_six,
             r.ms_payload,
-            r.ms_quality
+            r.ms_quality,
+            r.vol_sim_linf.map_or(String::new(), |v| format!("{v:.4e}")),
+            r.vol_sim_linf_se.map_or(String::new(), |v| format!("{v:.4}"))
         );
     }
     std::fs::write(out.join("quality_study.csv"), &csv).expect("writing the CSV");
@@ -530,6 +539,8 @@ fn parse_csv(csv: &str) -> Vec<Row> {
                 ms_six: f(16),
                 ms_payload: f(17),
                 ms_quality: f(18),
+                vol_sim_linf: c.get(19).and_then(|v| v.parse().ok()),
+                vol_sim_linf_se: c.get(20).and_then(|v| v.parse().ok()),
             }
         })
         .collect()
@@ -581,13 +592,16 @@ fn report(out: &Path, rows: &[Row], note: &str) {
     print!("{md}");
     let _ = writeln!(
         md,
-        "\n| set | object | # | axis | rules | grade | epsilon (sim) | volume (sim) | contacts (sim) | epsilon (planned) | payload | down | six |"
+        "\n| set | object | # | axis | rules | grade | epsilon (sim) | volume (sim) | volume L∞ (sim) | contacts (sim) | epsilon (planned) | payload | down | six |"
     );
-    let _ = writeln!(md, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        md,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for r in rows {
         let _ = writeln!(
             md,
-            "| {} | {} | {} | {} | {} | {:.2} | {:.4} | {:.2e} | {} | {:.4} | {:.1} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {:.2} | {:.4} | {:.2e} | {} | {} | {:.4} | {:.1} | {} | {} |",
             r.set,
             r.scenario,
             r.candidate,
@@ -596,6 +610,7 @@ fn report(out: &Path, rows: &[Row], note: &str) {
             r.grade,
             r.eps_sim,
             r.vol_sim,
+            r.vol_sim_linf.map_or("n/a".to_string(), |v| format!("{v:.2e}")),
             r.contacts_sim,
             r.eps_plan,
             r.payload,

@@ -17,9 +17,11 @@
 //!   `u·x ≤ h(u)` the upper. The search stops when the two agree to [`EPS_REL_TOL`], so epsilon
 //!   is exact up to round-off, not sampled. It ends: each step adds a vertex of `W` not yet in
 //!   `Q`, and `W` has finitely many; [`EPA_MAX_POINTS`] bounds it all the same.
-//! - **Volume** needs the whole hull: the incremental Minkowski sum, pruned to its hull's
-//!   vertices (qhull) after each contact, when the unpruned sum (the product of the contacts'
-//!   edges + 1) is within [`VOLUME_MAX_POINTS`]; `None` beyond.
+//! - **Volume** by rays from the sum's centre, each an exact small linear programme, integrated
+//!   over a fixed set of directions ([`super::rays`]), with its standard error. The whole hull
+//!   ([`minkowski_sum`]: the incremental sum pruned to its hull's vertices by qhull) is exact but
+//!   feasible only up to 3 contacts at 8 cone edges; it is the reference the rays are tested
+//!   against.
 //!
 //! Contacts whose edge wrenches agree (rapier can report one contact twice) are merged first:
 //! `P + P = 2P` exactly for a convex `P`.
@@ -35,14 +37,6 @@ pub const EPS_REL_TOL: f64 = 1e-9;
 /// points to the inner polytope (docs/QUALITY.md: the 179 grasps measured needed at most 84).
 pub const EPA_MAX_POINTS: usize = 1_000;
 
-/// The L∞ volume is computed when the unpruned Minkowski sum has at most this many points (the
-/// product over contacts of edges + 1); `None` beyond. At 8
-/// cone edges that is 3 contacts (the sum of two has 81 points and no volume: two point
-/// contacts cannot resist torque about the line through them): the hull of 729 points took
-/// 0.5–1.2 s (release); 4 contacts need one of about 3000 (8–13 s), and the sum's vertices
-/// grow about fivefold per contact after that.
-pub const VOLUME_MAX_POINTS: usize = 750;
-
 const DIM: usize = 6;
 
 /// The result for one grasp's L∞ wrench space.
@@ -54,8 +48,10 @@ pub struct Linf {
     pub bracket: (f64, f64),
     /// Support points added to the initial polytope.
     pub points_added: usize,
-    /// Volume, `None` beyond [`VOLUME_MAX_POINTS`].
+    /// Volume by rays ([`super::rays`]), `None` when a ray's programme failed (with the note).
     pub volume: Option<f64>,
+    /// The volume's standard error relative to it.
+    pub volume_rel_se: Option<f64>,
     /// Why epsilon is 0 or `None`, or why the volume is `None`.
     pub note: Option<String>,
 }
@@ -537,7 +533,7 @@ fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, String> {
 /// qhull's simplicial facets of `points`: vertex indices, unit normal, offset (`n·x + offset =
 /// 0` on the facet, negative offset when the origin is inside).
 #[allow(clippy::type_complexity)]
-fn qhull_facets(points: &[Wrench]) -> Option<Vec<([u32; DIM], Wrench, f64)>> {
+pub(crate) fn qhull_facets(points: &[Wrench]) -> Option<Vec<([u32; DIM], Wrench, f64)>> {
     let coords: Vec<f64> = points.iter().flatten().copied().collect();
     let n_points = points.len();
     std::panic::catch_unwind(move || {
@@ -627,26 +623,24 @@ pub fn evaluate(per_contact: &[Vec<Wrench>]) -> Linf {
             Some(format!("L-infinity epsilon not computed: {why}")),
         ),
     };
-    // Tried only when the whole sum, unpruned, is within the budget: a hull of the first
-    // three contacts' 729 points costs as much as the check, wasted if a fourth follows.
-    let unpruned = merged
-        .iter()
-        .try_fold(1usize, |n, e| n.checked_mul(e.len() + 1))
-        .unwrap_or(usize::MAX);
-    let volume = (unpruned <= VOLUME_MAX_POINTS)
-        .then(|| minkowski_sum(&merged, VOLUME_MAX_POINTS).map(|(_, v)| v))
-        .flatten();
-    if volume.is_none() && note.is_none() {
-        note = Some(format!(
-            "L-infinity volume not computed: the Minkowski sum of {} contacts has over {VOLUME_MAX_POINTS} points to hull (at most 3 contacts at 8 cone edges)",
-            merged.len()
-        ));
-    }
+    // The volume by rays for any number of contacts (the hull of the whole sum is exact but
+    // costs 0.5–1.2 s at 3 contacts and is out of reach past them: it stays the reference the
+    // rays are tested against).
+    let (volume, volume_rel_se) = match super::rays::volume(&merged, super::rays::VOLUME_RAYS) {
+        Ok(v) => (Some(v.volume), Some(v.rel_se)),
+        Err(why) => {
+            if note.is_none() {
+                note = Some(format!("L-infinity volume not computed: {why}"));
+            }
+            (None, None)
+        }
+    };
     Linf {
         epsilon,
         bracket,
         points_added,
         volume,
+        volume_rel_se,
         note,
     }
 }

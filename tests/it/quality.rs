@@ -113,6 +113,17 @@ fn the_summary_gives_epsilon_and_the_json_has_it_per_candidate() {
     assert_eq!(q["contacts"].as_array().unwrap().len(), 20);
     let eps = q["epsilon"].as_f64().unwrap();
     assert!((eps - 0.1806).abs() < 1e-3, "planned epsilon {eps}");
+    // The L∞ space: epsilon and a volume by rays for its 20 contacts, with the estimate's
+    // standard error; each contact's own unit force makes it larger than the L1 space.
+    let linf = &q["linf"];
+    assert!(linf["epsilon"].as_f64().unwrap() >= eps, "{linf}");
+    let se = linf["volume_rel_se"].as_f64().unwrap();
+    assert!(se > 0.0 && se < 0.06, "{linf}");
+    assert!(
+        linf["volume"].as_f64().unwrap() > q["volume"].as_f64().unwrap(),
+        "{q}"
+    );
+    assert!(q.get("linf_note").is_none(), "{q}");
     let grasps = v["plan"]["grasps"].as_array().unwrap();
     assert_eq!(grasps.len(), 3);
     for g in grasps {
