@@ -66,7 +66,7 @@ impl PreparedObject {
         let mut shapes = self.shapes.lock().unwrap_or_else(|e| e.into_inner());
         shapes
             .entry(a.axis)
-            .or_insert_with(|| ObjectShape::from_mesh(&a.mesh, self.props.volume_mm3))
+            .or_insert_with(|| ObjectShape::cached(&a.mesh, self.props.volume_mm3))
             .clone()
     }
 

@@ -113,7 +113,56 @@ pub struct ObjectShape {
     pub is_revolution: bool,
 }
 
+/// Convex decompositions made in this process, by the digest of their mesh: the same object
+/// in several scenarios of one run (the chapter 4 object and its weak-motor twin, a tuning
+/// set) is decomposed once. At most [`SHAPE_CACHE_LEN`], the oldest dropped first.
+static SHAPE_CACHE: std::sync::Mutex<Vec<([u8; 32], ObjectShape)>> =
+    std::sync::Mutex::new(Vec::new());
+
+/// Convex decompositions kept by [`ObjectShape::cached`].
+pub const SHAPE_CACHE_LEN: usize = 16;
+
+/// The digest of what [`ObjectShape::from_mesh`] reads: vertices, triangles and volume.
+fn shape_key(mesh: &Mesh, volume_mm3: f64) -> [u8; 32] {
+    use sha2::{Digest, Sha256};
+    let mut h = Sha256::new();
+    for p in &mesh.vertices {
+        for v in [p.x, p.y, p.z] {
+            h.update(v.to_bits().to_le_bytes());
+        }
+    }
+    h.update(b"t");
+    for t in &mesh.triangles {
+        for i in t {
+            h.update(i.to_le_bytes());
+        }
+    }
+    h.update(volume_mm3.to_bits().to_le_bytes());
+    h.finalize().into()
+}
+
 impl ObjectShape {
+    /// [`ObjectShape::from_mesh`], with convex decompositions (0.1–0.4 s each) kept for the
+    /// rest of the process: the same mesh gives the same shape, bit for bit, either way.
+    pub fn cached(mesh: &Mesh, volume_mm3: f64) -> ObjectShape {
+        let key = shape_key(mesh, volume_mm3);
+        let lock = || SHAPE_CACHE.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, s)) = lock().iter().find(|(k, _)| *k == key) {
+            return s.clone();
+        }
+        let shape = ObjectShape::from_mesh(mesh, volume_mm3);
+        if shape.kind == ColliderKind::ConvexDecomposition {
+            let mut cache = lock();
+            if !cache.iter().any(|(k, _)| *k == key) {
+                if cache.len() >= SHAPE_CACHE_LEN {
+                    cache.remove(0);
+                }
+                cache.push((key, shape.clone()));
+            }
+        }
+        shape
+    }
+
     /// The convex hull of `mesh` (aligned, millimetres) if the mesh is convex (hull volume within
     /// 2 % of `volume_mm3`), a convex decomposition otherwise.
     pub fn from_mesh(mesh: &Mesh, volume_mm3: f64) -> ObjectShape {
@@ -724,6 +773,35 @@ mod tests {
     fn thesis_hand() -> Hand {
         let (_, text) = crate::hand::bundled("thesis").unwrap();
         Hand::parse(text, Path::new("thesis.toml"), &[]).unwrap()
+    }
+
+    #[test]
+    fn a_convex_decomposition_is_made_once_per_mesh() {
+        let objects = crate::objects::thesis_objects();
+        let mesh = &objects.iter().find(|(n, _)| *n == "chapter4").unwrap().1;
+        let mesh = crate::mesh::align(mesh).mesh;
+        let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
+        let first = ObjectShape::cached(&mesh, volume);
+        assert_eq!(first.kind, ColliderKind::ConvexDecomposition);
+        // The same mesh again: the same shape, not a new decomposition.
+        let again = ObjectShape::cached(&mesh, volume);
+        assert!(std::sync::Arc::ptr_eq(&first.shape.0, &again.shape.0));
+        // Equal to one made afresh, part for part.
+        let fresh = ObjectShape::from_mesh(&mesh, volume);
+        assert_eq!(fresh.parts, first.parts);
+        let aabb = |s: &ObjectShape| s.shape.compute_local_aabb();
+        assert_eq!(aabb(&fresh), aabb(&first));
+        // Another mesh (one vertex moved) is another key.
+        let mut moved = mesh.clone();
+        moved.vertices[0].x += 1e-3;
+        assert_ne!(shape_key(&moved, volume), shape_key(&mesh, volume));
+        // A convex mesh is not kept (its hull is cheap).
+        let prism = crate::objects::prism(40.0, 100.0, 80.0);
+        let v = crate::mesh::mass_properties(&prism).volume_mm3;
+        let a = ObjectShape::cached(&prism, v);
+        let b = ObjectShape::cached(&prism, v);
+        assert_eq!(a.kind, ColliderKind::ConvexHull);
+        assert!(!std::sync::Arc::ptr_eq(&a.shape.0, &b.shape.0));
     }
 
     /// A 40 x 100 x 80 mm box about the z axis, its faces at x = ±20 and y = ±50.
