@@ -14,7 +14,9 @@
 //! - **Whitened**: the rays are drawn uniformly in the frame where `W`'s spread (the covariance
 //!   of a point `Σᵢ vᵢ` with `vᵢ` uniform over `Pᵢ`'s vertices) is the identity, and the volume
 //!   carries the Jacobian `det L` of `Cov = L Lᵀ`, so a body that is thin in some direction is
-//!   not sampled as a needle.
+//!   not sampled as a needle. The programmes are set up in that frame too (`L⁻¹eᵢⱼ`, `L⁻¹c`),
+//!   so their entries are of order 1 whatever the wrenches' units and the simplex's
+//!   tolerances mean the same for every grasp.
 //! - **Antithetic**: the directions come in pairs `±g`; the standard error is that of the pairs'
 //!   means, and is reported with the volume (`volume_rel_se`).
 //! - **Deterministic**: the directions come from a fixed seed, so the same contacts give the same
@@ -133,10 +135,20 @@ impl RayCaster {
         if tab[obj + cols] < -1e-9 * scale {
             return Err("the centre is outside the wrench space".into());
         }
-        // Artificials still basic (at 0) leave the basis where their row allows it.
+        // Artificials still basic (at 0, up to round-off) leave the basis on their row's
+        // largest entry.
         for r in 0..DIM {
             if basis[r] >= col_art {
-                if let Some(j) = (0..col_art).find(|&j| tab[r * width + j].abs() > 1e-9 * scale) {
+                let row = &tab[r * width..r * width + col_art];
+                let (j, a) = row.iter().enumerate().fold((0, 0.0f64), |b, (j, v)| {
+                    if v.abs() > b.1 {
+                        (j, v.abs())
+                    } else {
+                        b
+                    }
+                });
+                if a > 1e-9 * scale {
+                    tab[r * width + cols] = 0.0;
                     pivot(&mut tab, &mut basis, width, rows, r, j);
                 }
             }
@@ -215,7 +227,8 @@ fn pivot(tab: &mut [f64], basis: &mut [usize], width: usize, rows: usize, r: usi
 
 /// The simplex method on the tableau, maximising: the entering column is the one with the most
 /// negative reduced cost among `0..enter_below`, the leaving row the smallest ratio (ties to the
-/// smallest basic index); after 50 pivots that do not improve, Bland's rule, which cannot cycle.
+/// smallest basic index); after 50 pivots in a row that do not improve the objective by more
+/// than the tolerance, Bland's rule to the end, which cannot cycle.
 fn simplex(
     tab: &mut [f64],
     basis: &mut [usize],
@@ -227,8 +240,9 @@ fn simplex(
     let obj = rows * width;
     let rhs = width - 1;
     let mut stalled = 0;
+    let mut bland = false;
     for _ in 0..10_000 {
-        let bland = stalled > 50;
+        bland |= stalled > 50;
         let mut enter = None;
         let mut best = -tol;
         for j in 0..enter_below {
@@ -259,7 +273,8 @@ fn simplex(
         let Some((r, ratio)) = leave else {
             return Err("unbounded ray".into());
         };
-        stalled = if ratio > 0.0 { 0 } else { stalled + 1 };
+        let gain = ratio * -tab[obj + j];
+        stalled = if gain > tol { 0 } else { stalled + 1 };
         pivot(tab, basis, width, rows, r, j);
     }
     Err("the simplex method did not finish in 10000 pivots".into())
@@ -334,12 +349,23 @@ pub fn volume(per_contact: &[Vec<Wrench>], rays: usize) -> Result<RayVolume, Str
         rel_se: 0.0,
         rays: 0,
     };
+    if per_contact
+        .iter()
+        .flatten()
+        .flatten()
+        .any(|v| !v.is_finite())
+    {
+        return Err("a wrench is not finite".into());
+    }
     let cov = spread(per_contact);
+    if cov.iter().any(|v| !v.is_finite()) {
+        return Err("the wrench spread is not finite".into());
+    }
     let eig = cov.symmetric_eigenvalues();
     let (lo, hi) = eig
         .iter()
         .fold((f64::INFINITY, 0.0f64), |(l, h), v| (l.min(*v), h.max(*v)));
-    if hi.is_nan() || hi <= 0.0 || lo <= 1e-12 * hi {
+    if hi <= 0.0 || lo <= 1e-12 * hi {
         return Ok(zero);
     }
     let l = cov
@@ -347,18 +373,22 @@ pub fn volume(per_contact: &[Vec<Wrench>], rays: usize) -> Result<RayVolume, Str
         .ok_or("the wrench spread is not positive definite")?
         .l();
     let jacobian: f64 = (0..DIM).map(|i| l[(i, i)]).product();
-    let caster = RayCaster::new(per_contact, &centre(per_contact))?;
-    let dirs = directions(rays);
-    let radii: Vec<f64> = dirs
-        .par_iter()
-        .map(|g| {
-            let u = l * Vector6::from(*g);
-            let norm = u.norm();
-            let unit: Wrench = (u / norm).into();
-            // The exit along the unit vector, in the whitened frame's length.
-            caster.exit(&unit).map(|t| t / norm)
-        })
-        .collect::<Result<_, _>>()?;
+    // The rays are shot in the whitened frame, `L⁻¹W`, whose spread is the identity: its
+    // entries are of order 1 whatever the wrenches' units, so the simplex's tolerances hold.
+    let whiten = |w: &Wrench| -> Wrench {
+        l.solve_lower_triangular(&Vector6::from(*w))
+            .map_or([f64::NAN; DIM], Into::into)
+    };
+    let whitened: Vec<Vec<Wrench>> = per_contact
+        .iter()
+        .map(|edges| edges.iter().map(whiten).collect())
+        .collect();
+    let caster = RayCaster::new(&whitened, &whiten(&centre(per_contact)))?;
+    // At least two pairs, for a standard error.
+    let dirs = directions(rays.max(4));
+    let exits: Vec<Result<f64, String>> = dirs.par_iter().map(|g| caster.exit(g)).collect();
+    // The first error in the directions' order, so that the message is the same every run.
+    let radii: Vec<f64> = exits.into_iter().collect::<Result<_, _>>()?;
     let pairs: Vec<f64> = radii
         .chunks(2)
         .map(|p| 0.5 * (p[0].powi(6) + p[1].powi(6)))
@@ -446,5 +476,39 @@ mod tests {
         // Five segments span 5 dimensions: no volume.
         let v = volume(&w[..5], VOLUME_RAYS).unwrap();
         assert_eq!(v.volume, 0.0);
+    }
+
+    #[test]
+    fn the_volume_does_not_depend_on_the_wrenches_units() {
+        // Rays are shot in the whitened frame, so scaling the wrenches by 1e5 or 1e-10 scales
+        // the volume by the sixth power and nothing else (no tolerance is crossed).
+        let base = volume(&cube_segments(), VOLUME_RAYS).unwrap();
+        for f in [1e5, 1e-10] {
+            let w: Vec<Vec<Wrench>> = cube_segments()
+                .into_iter()
+                .map(|e| e.into_iter().map(|x| x.map(|v| v * f)).collect())
+                .collect();
+            let v = volume(&w, VOLUME_RAYS).unwrap();
+            let expected = base.volume * f.powi(6);
+            assert!(
+                (v.volume - expected).abs() < 1e-9 * expected,
+                "{v:?} at {f}"
+            );
+            assert!((v.rel_se - base.rel_se).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn a_wrench_that_is_not_finite_is_an_error() {
+        for bad in [f64::NAN, f64::INFINITY, f64::NEG_INFINITY] {
+            let mut w = cube_segments();
+            w[3][0][1] = bad;
+            assert!(volume(&w, VOLUME_RAYS).is_err());
+        }
+        let mut w = cube_segments();
+        w[0][0][0] = 1e200;
+        assert!(volume(&w, VOLUME_RAYS).is_err(), "the spread overflows");
+        // No contacts: no volume.
+        assert_eq!(volume(&[], VOLUME_RAYS).unwrap().volume, 0.0);
     }
 }
