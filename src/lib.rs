@@ -115,14 +115,26 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
     let qualities = qualities(scenario, options, &selection);
     let plan = plan_report(scenario, &selection, &qualities, timings);
     let chosen = selection.chosen();
-    let (sim, sim_poses) = run_sim(
+    let checked_on = chosen.map_or(&object.aligned, |c| &selection.axes[c.axis_plan].aligned);
+    let (sim, sim_poses, ran) = run_sim(
         scenario,
         options,
         &object,
-        chosen.map_or(&object.aligned, |c| &selection.axes[c.axis_plan].aligned),
+        checked_on,
         &selection.axes[0].graded,
         chosen.map(|c| (&c.grasp, c.check.clone())),
     )?;
+    // A check that ran here (not in the candidate search: `override_angles`) closed its own
+    // grip: the quality is that grip's, not the planned contacts'.
+    let quality = match (&ran, options.quality) {
+        (Some(out), true) => Some(quality::of_check(
+            checked_on,
+            out,
+            &scenario.hand,
+            scenario.object.friction,
+        )),
+        _ => selection.chosen.and_then(|i| qualities[i].clone()),
+    };
     let expect = match &scenario.expect {
         Some(e) => ExpectReport::judge(e, &plan, &sim),
         None => ExpectReport::none(),
@@ -135,7 +147,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         plan,
         sim,
         expect,
-        quality: selection.chosen.and_then(|i| qualities[i].clone()),
+        quality,
     };
     if let Some(dir) = &options.report {
         visual::write_report(
@@ -336,7 +348,9 @@ fn rejections(selection: &select::Selection, hand: &hand::Hand) -> BTreeMap<Stri
 }
 
 /// Writes the URDF and MJCF exports asked for, and runs the physics check on the chosen grasp
-/// or on `override_angles` (pose from the thesis axis's `graded` domain).
+/// or on `override_angles` (pose from the thesis axis's `graded` domain). The outcome is
+/// returned too when the check ran here rather than in the candidate search.
+#[allow(clippy::type_complexity)]
 fn run_sim(
     scenario: &Scenario,
     options: &RunOptions,
@@ -344,23 +358,30 @@ fn run_sim(
     aligned: &mesh::AlignedObject,
     graded: &plan::GradedDomain,
     grasp: Option<(&plan::search::Grasp, Option<sim::SimOutcome>)>,
-) -> Result<(SimReport, Option<Vec<sim::BodyPose>>), Error> {
+) -> Result<
+    (
+        SimReport,
+        Option<Vec<sim::BodyPose>>,
+        Option<sim::SimOutcome>,
+    ),
+    Error,
+> {
     if let Some(dir) = &options.export_urdf {
         export::write_urdf(&dir.join(&scenario.name), &scenario.hand, &scenario.sim)?;
     }
     if options.no_sim && options.export_mjcf.is_none() {
-        return Ok((SimReport::not_run("--no-sim"), None));
+        return Ok((SimReport::not_run("--no-sim"), None, None));
     }
     let p = &scenario.sim;
     let (pose, source, done) = match (&p.override_angles, grasp) {
         (Some(angles), _) => {
             match sim::SimHand::from_override(&aligned.mesh, &scenario.hand, graded, p, angles) {
                 Ok(pose) => (pose, GraspSource::OverrideAngles, None),
-                Err(e) => return Ok((SimReport::not_run(&e.to_string()), None)),
+                Err(e) => return Ok((SimReport::not_run(&e.to_string()), None, None)),
             }
         }
         (None, Some((g, done))) => (sim::SimHand::from_grasp(g), GraspSource::Planner, done),
-        (None, None) => return Ok((SimReport::not_run("no feasible grasp to check"), None)),
+        (None, None) => return Ok((SimReport::not_run("no feasible grasp to check"), None, None)),
     };
     let shape = object.shape(aligned);
     let case = object.case(scenario, &pose, &shape);
@@ -373,20 +394,24 @@ fn run_sim(
         export::write_mjcf(&dir.join(&scenario.name), &input)?;
     }
     if options.no_sim {
-        return Ok((SimReport::not_run("--no-sim"), None));
+        return Ok((SimReport::not_run("--no-sim"), None, None));
     }
     // The candidate search already checked the chosen grasp: the same case, the same outcome.
-    let (out, payload) = match done {
+    let (out, payload, ran) = match done {
         Some(out) => {
             let payload = (options.payload && out.verdict == sim::Verdict::Hold)
                 .then(|| sim::payload_bracket(&case));
-            (out, payload)
+            (out, payload, false)
         }
-        None => sim::check_with_payload(&case, options.payload),
+        None => {
+            let (out, payload) = sim::check_with_payload(&case, options.payload);
+            (out, payload, true)
+        }
     };
     let poses = out.final_poses.clone();
+    let ran = ran.then(|| out.clone());
     let report = checked_report(out, payload, &case, &shape, source, options);
-    Ok((report, Some(poses)))
+    Ok((report, Some(poses), ran))
 }
 
 /// The `sim` report of a check that ran on `case` (with the payload bracket when asked for).

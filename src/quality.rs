@@ -444,6 +444,25 @@ pub fn of_grasp(
     }
 }
 
+/// The quality of the grip a physics check closed on `aligned` (its contacts at the end of
+/// closing), whatever the hand's pose came from (a planned grasp or `override_angles`). A
+/// check whose fingers closed on nothing gets no contacts: epsilon 0, not force closure.
+pub fn of_check(
+    aligned: &crate::mesh::AlignedObject,
+    out: &crate::sim::SimOutcome,
+    hand: &crate::hand::Hand,
+    friction: f64,
+) -> Quality {
+    let (centroid_mm, max_radius_mm) = torque_scale(&aligned.mesh);
+    let params = QualityParams {
+        friction,
+        cone_edges: DEFAULT_CONE_EDGES,
+        centroid_mm,
+        max_radius_mm,
+    };
+    evaluate("sim", sim_contacts(&out.grip_contacts, hand), &params)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -173,3 +173,23 @@ fn quality_is_computed_only_when_asked() {
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(!text.contains("Quality     "), "{text}");
 }
+
+#[test]
+fn a_grip_closed_on_nothing_has_no_quality_whatever_the_plan() {
+    // `override_angles` opens the fingers wide: the check runs on that pose, not on a planned
+    // candidate, and the object drops. The quality is the check's grip (no contacts), not the
+    // planned contacts of a grasp that was never simulated (it used to say 20 contacts, force
+    // closure, epsilon 0.13).
+    let s = Scenario::load(&crate::root().join("scenarios/sim_open_fingers.toml")).unwrap();
+    let r = run(&s, &with_quality()).unwrap();
+    assert_eq!(
+        r.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Drop)
+    );
+    let q = r.quality.unwrap();
+    assert_eq!(q.source, "sim");
+    assert!(q.contacts.is_empty(), "{:?}", q.contacts);
+    assert!(!q.force_closure);
+    assert_eq!(q.epsilon, 0.0);
+    assert_eq!(q.note.as_deref(), Some("no contacts"));
+}
