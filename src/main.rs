@@ -19,6 +19,16 @@ fn main() -> ExitCode {
     };
     match real_main(cli) {
         Ok(code) => ExitCode::from(code),
+        // The reader went away (`grasp-sim --json ... | head`): stop quietly, as ripgrep does;
+        // that is not bad input.
+        Err(e)
+            if e.chain().any(|c| {
+                c.downcast_ref::<std::io::Error>()
+                    .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            }) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("grasp-sim: error: {}", format!("{e:#}").replace('\n', " "));
             ExitCode::from(2)

@@ -527,3 +527,29 @@ fn hand_file_errors_name_the_line() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("line ") && err.contains("gap_mm"), "{err}");
 }
+
+#[test]
+fn a_reader_that_goes_away_is_not_bad_input() {
+    // `grasp-sim --json ... | head -c 10`: the pipe closes before the output is written. The
+    // run stops quietly with status 0 (it used to print "Broken pipe" and exit 2, the status of
+    // bad input).
+    let mut child = crate::grasp_sim()
+        .args([
+            "--json",
+            "--no-sim",
+            "scenarios/cup.toml",
+            "scenarios/prism.toml",
+        ])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
