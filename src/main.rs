@@ -131,7 +131,16 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         }) {
             Ok(r) => r,
             Err(e) => {
-                eprintln!("grasp-sim: error: {}", format!("{e:#}").replace('\n', " "));
+                let msg = format!("{e:#}").replace('\n', " ");
+                // A scenario's mesh or hand file that cannot be read names that file; say which
+                // scenario asked for it too.
+                let scenario = path.display().to_string();
+                match item {
+                    grasp_sim::batch::Item::Scenario(_) if !msg.starts_with(&scenario) => {
+                        eprintln!("grasp-sim: error: {scenario}: {msg}")
+                    }
+                    _ => eprintln!("grasp-sim: error: {msg}"),
+                }
                 status = 2;
                 continue;
             }

@@ -148,10 +148,13 @@ fn bad_meshes_get_one_line_and_exit_2() {
 fn missing_mesh_and_directory_get_exit_2() {
     let env = Env::new();
     let s = env.basic_scenario("nowhere.stl", "");
-    assert_bad_input(
-        &env.run(&[s.to_str().unwrap()]),
-        "nowhere.stl",
-        "no such file",
+    let out = env.run(&[s.to_str().unwrap()]);
+    assert_bad_input(&out, "nowhere.stl", "no such file");
+    // The scenario that asked for the mesh is named too, first.
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.starts_with(&format!("grasp-sim: error: {}: ", s.display())),
+        "{err}"
     );
     std::fs::create_dir(env.path("adir.stl")).unwrap();
     let s = env.basic_scenario("adir.stl", "");
