@@ -335,6 +335,16 @@ impl Scenario {
                 key: format!("hand.overrides.\"{key}\""),
                 problem: format!("{problem} ({})", hand.display()),
             },
+            // A value out of range that the scenario's override set: name the scenario.
+            HandError::Invalid {
+                path: hand,
+                key,
+                problem,
+            } if overrides.iter().any(|(k, _)| *k == key) => ScenarioError::Invalid {
+                path: path.to_path_buf(),
+                key: format!("hand.overrides.\"{key}\""),
+                problem: format!("{problem} ({} with this override)", hand.display()),
+            },
             other => other.into(),
         })?;
 
@@ -473,7 +483,7 @@ mod tests {
             (
                 "",
                 "[hand]\noverrides = { \"palm.offset_mm\" = -1.0 }",
-                "palm.offset_mm",
+                "hand.overrides.\"palm.offset_mm\"",
             ),
             (
                 "",
