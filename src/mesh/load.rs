@@ -624,7 +624,8 @@ pub fn parse_stl(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMe
 }
 
 /// The first line of an ASCII STL that breaks its grammar (`solid`, then per facet `facet
-/// normal x y z`, `outer loop`, three `vertex x y z`, `endloop`, `endfacet`, then `endsolid`):
+/// normal x y z`, `outer loop`, three `vertex x y z`, `endloop`, `endfacet`, then `endsolid`;
+/// `x y z` finite numbers, so `nan`, `inf` and `1e999` break it too):
 /// its 1-based number, the line quoted (or "end of file"), and what was expected there. `None`
 /// when every line fits (the parser's complaint is then about something else).
 fn first_bad_ascii_line(text: &str) -> Option<(usize, String, String)> {
@@ -667,7 +668,9 @@ fn first_bad_ascii_line(text: &str) -> Option<(usize, String, String)> {
         };
         let fits = words.len() == kw.len() + numbers
             && words[..kw.len()] == kw[..]
-            && words[kw.len()..].iter().all(|w| w.parse::<f32>().is_ok());
+            && words[kw.len()..]
+                .iter()
+                .all(|w| w.parse::<f32>().is_ok_and(f32::is_finite));
         if !fits {
             return Some((n, quote(l), want()));
         }

@@ -130,6 +130,16 @@ fn bad_meshes_get_one_line_and_exit_2() {
             "malformed ASCII",
         ),
         (
+            "ascii_nan.stl",
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex nan 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid x\n".to_vec(),
+            "line 5 (`vertex nan 0 0`)",
+        ),
+        (
+            "ascii_overflow.stl",
+            b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1e999 0\nendloop\nendfacet\nendsolid x\n".to_vec(),
+            "line 6 (`vertex 0 1e999 0`)",
+        ),
+        (
             "ascii_no_endsolid.stl",
             b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n".to_vec(),
             "malformed ASCII",
