@@ -423,7 +423,7 @@ pub fn sim_contacts(
 }
 
 /// The quality of a planned grasp on `aligned`: from the physics check's contacts at the end
-/// of closing when `check` ran on it, else from the planned contacts.
+/// of closing when `check` ran on it ([`of_check`]), else from the planned contacts.
 pub fn of_grasp(
     grasp: &crate::plan::search::Grasp,
     aligned: &crate::mesh::AlignedObject,
@@ -431,16 +431,13 @@ pub fn of_grasp(
     hand: &crate::hand::Hand,
     friction: f64,
 ) -> Quality {
-    let (centroid_mm, max_radius_mm) = torque_scale(&aligned.mesh);
-    let params = QualityParams {
-        friction,
-        cone_edges: DEFAULT_CONE_EDGES,
-        centroid_mm,
-        max_radius_mm,
-    };
     match check {
-        Some(out) => evaluate("sim", sim_contacts(&out.grip_contacts, hand), &params),
-        None => evaluate("planned", planned_contacts(grasp, hand), &params),
+        Some(out) => of_check(aligned, out, hand, friction),
+        None => evaluate(
+            "planned",
+            planned_contacts(grasp, hand),
+            &params_for(aligned, friction),
+        ),
     }
 }
 
@@ -453,14 +450,20 @@ pub fn of_check(
     hand: &crate::hand::Hand,
     friction: f64,
 ) -> Quality {
+    let contacts = sim_contacts(&out.grip_contacts, hand);
+    evaluate("sim", contacts, &params_for(aligned, friction))
+}
+
+/// The metric's settings for `aligned` at `friction`: 8 cone edges, torque over the object's
+/// largest radius about its centroid.
+fn params_for(aligned: &crate::mesh::AlignedObject, friction: f64) -> QualityParams {
     let (centroid_mm, max_radius_mm) = torque_scale(&aligned.mesh);
-    let params = QualityParams {
+    QualityParams {
         friction,
         cone_edges: DEFAULT_CONE_EDGES,
         centroid_mm,
         max_radius_mm,
-    };
-    evaluate("sim", sim_contacts(&out.grip_contacts, hand), &params)
+    }
 }
 
 #[cfg(test)]
