@@ -31,13 +31,15 @@ const RULES: [(f64, f64); 8] = [
     (0.5, 0.8),
 ];
 
-/// Where the rule with `window_s` and `margin` decides `t`'s hold: (time, translation, rotation) at the
-/// decision, or `None` if it runs to the end.
+/// Where the rule with `window_s` and `margin` decides `t`'s hold: (verdict by motion, time,
+/// translation, rotation) at the decision, or `None` if it runs to the end. The verdict is
+/// `hold` for a rest within the thresholds, `slip` for a rest beyond them (a rest under gravity
+/// is a rest on the hand).
 fn decide(
     t: &HoldTrace,
     params: &SimParams,
     (window_s, margin): (f64, f64),
-) -> Option<(f64, f64, f64)> {
+) -> Option<(Verdict, f64, f64, f64)> {
     let rule = EarlyDecision {
         window_s,
         margin,
@@ -50,10 +52,20 @@ fn decide(
         if remaining <= 1e-9 {
             return None;
         }
-        if rule.at_rest(&t.samples[..=i], &t.frame, remaining, params) {
-            let (p, q) = t.samples[i];
-            return Some((at, (p - t.frame.pc).norm(), t.frame.judged(&t.frame.qc, &q)));
-        }
+        let verdict = if rule.at_rest(&t.samples[..=i], &t.frame, remaining, params) {
+            Verdict::Hold
+        } else if rule.slid_at_rest(&t.samples[..=i], &t.frame, remaining, params) {
+            Verdict::Slip
+        } else {
+            continue;
+        };
+        let (p, q) = t.samples[i];
+        return Some((
+            verdict,
+            at,
+            (p - t.frame.pc).norm(),
+            t.frame.judged(&t.frame.qc, &q),
+        ));
     }
     None
 }
@@ -70,11 +82,13 @@ fn main() {
             _ => files.push(a),
         }
     }
-    // Per window: holds decided early, the sum of their decision times, and the contradictions.
-    let mut decided = [0usize; RULES.len()];
-    let mut at_sum = [0.0f64; RULES.len()];
+    // Per window and verdict by motion (hold, slip): directions decided early, the sum of their
+    // decision times, and the contradictions.
+    let mut decided = [[0usize; 2]; RULES.len()];
+    let mut at_sum = [[0.0f64; 2]; RULES.len()];
     let mut bad: Vec<Vec<String>> = vec![Vec::new(); RULES.len()];
     let mut holds = 0;
+    let mut slips = 0;
     let mut runs = 0;
     for f in &files {
         let mut s = common::load_with(f, &sets);
@@ -94,47 +108,58 @@ fn main() {
         for t in &traces {
             runs += 1;
             let o = &t.outcome;
-            if o.verdict == Verdict::Hold {
-                holds += 1;
+            match o.verdict {
+                Verdict::Hold => holds += 1,
+                Verdict::Slip => slips += 1,
+                _ => {}
             }
             for (w, &window) in RULES.iter().enumerate() {
-                let Some((at, mm, deg)) = decide(t, &s.sim, window) else {
+                let Some((by_motion, at, mm, deg)) = decide(t, &s.sim, window) else {
                     continue;
                 };
-                decided[w] += 1;
-                at_sum[w] += at;
+                let k = usize::from(by_motion == Verdict::Slip);
+                decided[w][k] += 1;
+                at_sum[w][k] += at;
                 let g = o.gravity;
                 let name = format!("{} g=({:.0},{:.0},{:.0})", s.name, g[0], g[1], g[2]);
                 let close = |a: f64, b: f64, abs: f64| {
                     (a - b).abs() <= abs || (a - b).abs() <= 0.1 * a.abs().max(b.abs())
                 };
-                // A rest decision is a `hold` by motion; the full verdict may also be `slip`
-                // for a penetration, which both protocols share.
-                if o.verdict != Verdict::Hold
-                    && o.closing_penetration_mm <= s.sim.max_penetration_mm
+                // A rest within the thresholds is a `hold` by motion, and the full verdict may
+                // also be `slip` for a penetration, which both protocols share.
+                let expected = if by_motion == Verdict::Hold
+                    && o.closing_penetration_mm > s.sim.max_penetration_mm
                 {
+                    Verdict::Slip
+                } else {
+                    by_motion
+                };
+                if o.verdict != expected {
                     bad[w].push(format!(
-                        "wrong: {name}: rest at {at:.2} s ({mm:.2} mm, {deg:.2}°), full {} ({:.2} mm, {:.2}°)",
+                        "wrong: {name}: {by_motion} at rest at {at:.2} s ({mm:.2} mm, {deg:.2}°), full {} ({:.2} mm, {:.2}°)",
                         o.verdict, o.translation_mm, o.rotation_deg
                     ));
                 } else if !close(mm, o.translation_mm, 0.5) || !close(deg, o.rotation_deg, 0.5) {
                     bad[w].push(format!(
-                        "numbers: {name}: rest at {at:.2} s ({mm:.2} mm, {deg:.2}°), full end ({:.2} mm, {:.2}°)",
+                        "numbers: {name}: {by_motion} at rest at {at:.2} s ({mm:.2} mm, {deg:.2}°), full end ({:.2} mm, {:.2}°)",
                         o.translation_mm, o.rotation_deg
                     ));
                 }
             }
         }
     }
-    println!("{runs} holds simulated full-length ({holds} of them `hold`)\n");
-    println!("| window [s] | margin | decided early | mean decision [s] | wrong verdicts | numbers beyond tolerance |");
-    println!("|---|---|---|---|---|---|");
+    println!("{runs} holds simulated full-length ({holds} of them `hold`, {slips} `slip`)\n");
+    println!("| window [s] | margin | decided `hold` at rest | mean decision [s] | decided `slip` at rest | mean decision [s] | wrong verdicts | numbers beyond tolerance |");
+    println!("|---|---|---|---|---|---|---|---|");
     for (w, (window, margin)) in RULES.iter().enumerate() {
         let wrong = bad[w].iter().filter(|b| b.starts_with("wrong")).count();
+        let mean = |k: usize| at_sum[w][k] / decided[w][k].max(1) as f64;
         println!(
-            "| {window} | {margin} | {} | {:.2} | {wrong} | {} |",
-            decided[w],
-            at_sum[w] / decided[w].max(1) as f64,
+            "| {window} | {margin} | {} | {:.2} | {} | {:.2} | {wrong} | {} |",
+            decided[w][0],
+            mean(0),
+            decided[w][1],
+            mean(1),
             bad[w].len() - wrong
         );
     }

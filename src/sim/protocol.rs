@@ -83,8 +83,8 @@ pub struct DirectionOutcome {
     /// direction ran to the end.
     pub decided_at_s: f64,
     /// What decided it: `end` (ran the whole hold), `rest` (at rest relative to the palm, the
-    /// remaining motion cannot cross the thresholds) or `out_of_reach` (left the hand's reach
-    /// for good).
+    /// remaining motion cannot bring it across a threshold: within them, `hold`; slid beyond
+    /// one and resting on the hand, `slip`) or `out_of_reach` (left the hand's reach for good).
     pub decided_by: &'static str,
     /// Object translation relative to the palm at the decision `[mm]`. For `out_of_reach`,
     /// `translation_mm` is this continued in free flight to the end of the hold.
@@ -183,22 +183,30 @@ impl RestFrame {
     }
 }
 
+/// What the rest rule measures over its window: where the object is now and how much further
+/// it may go by the end of the hold.
+#[derive(Debug, Clone, Copy)]
+struct Settling {
+    /// Translation and judged rotation relative to the pose after closing, now `[mm]`, `[deg]`.
+    now_mm: f64,
+    now_deg: f64,
+    /// `safety` × (drift × time left + spread) `[mm]`, `[deg]`.
+    more_mm: f64,
+    more_deg: f64,
+}
+
 impl EarlyDecision {
-    /// The rest rule: true when the motion of the last `window_s` of `samples` (the poses
-    /// relative to the palm so far, one every `frame.sample_dt`), its mean drift and its
-    /// spread, at `safety` times their size and continued for `remaining_s`, keeps the object
-    /// within the hold thresholds and the numbers reported now within what they may differ from
-    /// the full protocol's.
-    pub fn at_rest(
+    /// The last `window_s` of `samples` measured: `None` while the hold is shorter than the
+    /// window.
+    fn settling(
         &self,
         samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
         frame: &RestFrame,
         remaining_s: f64,
-        params: &SimParams,
-    ) -> bool {
+    ) -> Option<Settling> {
         let window = ((self.window_s / frame.sample_dt).round() as usize).max(1);
         if samples.len() <= window {
-            return false;
+            return None;
         }
         let recent = &samples[samples.len() - window - 1..];
         let window_s = window as f64 * frame.sample_dt;
@@ -213,14 +221,60 @@ impl EarlyDecision {
         }
         let drift_mm = (last.0 - first.0).norm() / window_s;
         let drift_deg = frame.judged(&first.1, &last.1) / window_s;
-        let now_mm = (last.0 - frame.pc).norm();
-        let now_deg = frame.judged(&frame.qc, &last.1);
-        let more_mm = self.safety * (drift_mm * remaining_s + spread_mm);
-        let more_deg = self.safety * (drift_deg * remaining_s + spread_deg);
-        now_mm + more_mm <= self.margin * params.hold_translation_mm
-            && now_deg + more_deg <= self.margin * params.hold_rotation_deg
-            && more_mm <= self.report_mm.max(self.report_fraction * now_mm)
-            && more_deg <= self.report_deg.max(self.report_fraction * now_deg)
+        Some(Settling {
+            now_mm: (last.0 - frame.pc).norm(),
+            now_deg: frame.judged(&frame.qc, &last.1),
+            more_mm: self.safety * (drift_mm * remaining_s + spread_mm),
+            more_deg: self.safety * (drift_deg * remaining_s + spread_deg),
+        })
+    }
+
+    /// True when the further motion bound is within what the numbers reported now may differ
+    /// from the full protocol's.
+    fn reportable(&self, s: &Settling) -> bool {
+        s.more_mm <= self.report_mm.max(self.report_fraction * s.now_mm)
+            && s.more_deg <= self.report_deg.max(self.report_fraction * s.now_deg)
+    }
+
+    /// The rest rule: true when the motion of the last `window_s` of `samples` (the poses
+    /// relative to the palm so far, one every `frame.sample_dt`), its mean drift and its
+    /// spread, at `safety` times their size and continued for `remaining_s`, keeps the object
+    /// within the hold thresholds and the numbers reported now within what they may differ from
+    /// the full protocol's.
+    pub fn at_rest(
+        &self,
+        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
+        frame: &RestFrame,
+        remaining_s: f64,
+        params: &SimParams,
+    ) -> bool {
+        let Some(s) = self.settling(samples, frame, remaining_s) else {
+            return false;
+        };
+        s.now_mm + s.more_mm <= self.margin * params.hold_translation_mm
+            && s.now_deg + s.more_deg <= self.margin * params.hold_rotation_deg
+            && self.reportable(&s)
+    }
+
+    /// The rest rule for a slid object: true when, measured as [`EarlyDecision::at_rest`]
+    /// measures it, the object has come to rest beyond a hold threshold and its further motion
+    /// cannot bring it back within `1 / margin` of that threshold: its translation now minus the
+    /// bound, or its rotation now minus the bound, is beyond the threshold divided by the
+    /// margin. (The distance to the pose after closing moves by no more than the object does,
+    /// and so does the judged rotation.) The reported numbers must be settled as for a hold.
+    pub fn slid_at_rest(
+        &self,
+        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
+        frame: &RestFrame,
+        remaining_s: f64,
+        params: &SimParams,
+    ) -> bool {
+        let Some(s) = self.settling(samples, frame, remaining_s) else {
+            return false;
+        };
+        (s.now_mm - s.more_mm >= params.hold_translation_mm / self.margin
+            || s.now_deg - s.more_deg >= params.hold_rotation_deg / self.margin)
+            && self.reportable(&s)
     }
 }
 
@@ -654,7 +708,9 @@ fn hold(
             break;
         }
         let remaining_s = (hold_steps - steps) as f64 * dt;
-        if rule.at_rest(&samples, &frame, remaining_s, params) {
+        if rule.at_rest(&samples, &frame, remaining_s, params)
+            || (rule.slid_at_rest(&samples, &frame, remaining_s, params) && touches_hand(scene))
+        {
             decided = Some(Decision::Rest(steps));
             break;
         }
