@@ -37,11 +37,13 @@ pub(crate) fn toml_message(e: &toml::de::Error, text: &str) -> String {
             return format!("missing section `[{field}]`");
         }
     }
+    let message = plain_types(&message);
     match e.span() {
         Some(span) => {
             let start = span.start.min(text.len());
             let line_no = text[..start].matches('\n').count() + 1;
             let line = text.lines().nth(line_no - 1).unwrap_or("").trim();
+            let message = unknown_section(line, &e.message().replace('\n', " ")).unwrap_or(message);
             if line.is_empty() {
                 format!("line {line_no}: {message}")
             } else {
@@ -50,6 +52,39 @@ pub(crate) fn toml_message(e: &toml::de::Error, text: &str) -> String {
         }
         None => message,
     }
+}
+
+/// serde's Rust type names in a message (`expected f64`) in the words of a TOML file.
+fn plain_types(message: &str) -> String {
+    let mut m = message.to_string();
+    for (rust, plain) in [
+        ("expected f64", "expected a number"),
+        ("expected f32", "expected a number"),
+        ("expected usize", "expected a whole number"),
+        ("expected u64", "expected a whole number"),
+        ("expected u32", "expected a whole number"),
+        ("expected i64", "expected a whole number"),
+        ("wanted string or table", "expected a name in quotes"),
+    ] {
+        m = m.replace(rust, plain);
+    }
+    m
+}
+
+/// For a section header such as `[simm]` that names no section: "unknown section `[simm]`"
+/// and the nearest known key as a section (or, with none near, the keys serde expected).
+/// `None` for anything else.
+fn unknown_section(line: &str, message: &str) -> Option<String> {
+    let header = line.strip_prefix('[')?.split(']').next()?.trim();
+    let (unknown, expected) = message.strip_prefix("unknown field `")?.split_once('`')?;
+    if header != unknown || header.contains('.') {
+        return None;
+    }
+    let known: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
+    Some(match did_you_mean(unknown, known) {
+        Some(k) => format!("unknown section `[{unknown}]`; did you mean `[{k}]`?"),
+        None => format!("unknown section `[{unknown}]`{expected}"),
+    })
 }
 
 /// `message` with "; did you mean `key`?" appended when it is serde's "unknown field `x`,

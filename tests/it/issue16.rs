@@ -177,7 +177,23 @@ fn a_mistyped_key_gets_a_did_you_mean() {
         err(&p)
     );
     let p = write("b.toml", format!("[object]\nmesh = \"{mesh}\"\n[planer]\n"));
-    assert!(err(&p).contains("did you mean `planner`?"), "{}", err(&p));
+    assert!(
+        err(&p).contains("unknown section `[planer]`")
+            && err(&p).contains("did you mean `[planner]`?"),
+        "{}",
+        err(&p)
+    );
+    // A value of the wrong type is named in the file's words, not Rust's.
+    let p = write(
+        "t.toml",
+        format!("[object]\nmesh = \"{mesh}\"\n[sim]\nduration_s = \"2\"\n"),
+    );
+    assert!(err(&p).contains("expected a number"), "{}", err(&p));
+    let p = write(
+        "g.toml",
+        format!("[object]\nmesh = \"{mesh}\"\n[sim]\ngravity = 6\n"),
+    );
+    assert!(err(&p).contains("expected a name in quotes"), "{}", err(&p));
     let hand = std::fs::read_to_string(crate::root().join("assets/hands/thesis.toml")).unwrap();
     write(
         "h.toml",
