@@ -36,13 +36,15 @@ pub struct SimParams {
     /// `fast` (default) or `full`, the reference protocol the fast one is compared with.
     pub protocol: Protocol,
     /// `fast` protocol: the window over which the object's motion relative to the palm is
-    /// measured before a direction can be decided `hold` early, and the least hold time `[s]`.
+    /// measured before a direction can be decided `hold` or `slip` at rest, and the least hold
+    /// time `[s]`.
     pub rest_window_s: f64,
     /// `fast` protocol: the fastest motion of that window is projected to the end of the hold
     /// at this many times its speed.
     pub rest_safety: f64,
     /// `fast` protocol: a `hold` is decided early only if the object stays within this
-    /// fraction of `hold_translation_mm` and `hold_rotation_deg`, the projected motion included.
+    /// fraction of `hold_translation_mm` and `hold_rotation_deg`, the projected motion included;
+    /// a `slip` only if it stays beyond one of them divided by this.
     pub rest_margin: f64,
     /// Hold time per gravity direction `[s]`.
     pub duration_s: f64,
