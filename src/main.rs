@@ -135,11 +135,21 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
                 // A scenario's mesh or hand file that cannot be read names that file; say which
                 // scenario asked for it too.
                 let scenario = path.display().to_string();
+                // A file that is neither a `.toml` scenario nor a mesh by its extension (a
+                // `.dae`, a `.txt`) was read as a scenario: say what is read.
+                let hint = match item {
+                    grasp_sim::batch::Item::Scenario(_)
+                        if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
+                    {
+                        " (read as a scenario: grasp-sim reads scenarios from .toml files and meshes from .stl, .obj and .ply)"
+                    }
+                    _ => "",
+                };
                 match item {
                     grasp_sim::batch::Item::Scenario(_) if !msg.starts_with(&scenario) => {
-                        eprintln!("grasp-sim: error: {scenario}: {msg}")
+                        eprintln!("grasp-sim: error: {scenario}: {msg}{hint}")
                     }
-                    _ => eprintln!("grasp-sim: error: {msg}"),
+                    _ => eprintln!("grasp-sim: error: {msg}{hint}"),
                 }
                 status = 2;
                 continue;

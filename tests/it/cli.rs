@@ -205,6 +205,21 @@ fn bad_scenarios_name_the_file_and_key() {
     }
 }
 
+#[test]
+fn a_file_that_is_neither_scenario_nor_mesh_says_what_is_read() {
+    // A `.dae` (a mesh format grasp-sim does not read) or a `.txt` is read as a scenario; the
+    // error says so, and which formats are read. A `.toml` gets no such hint.
+    let env = Env::new();
+    for (name, body) in [("part.dae", "<COLLADA/>\n"), ("notes.txt", "hello world\n")] {
+        let p = env.scenario(name, body);
+        let out = env.run(&[p.to_str().unwrap()]);
+        assert_bad_input(&out, name, "meshes from .stl, .obj and .ply");
+    }
+    let p = env.scenario("bad.toml", "hello world\n");
+    let out = env.run(&[p.to_str().unwrap()]);
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("meshes from"));
+}
+
 /// Issue 16 item 3: one bad input does not sink the others; the worst status wins.
 #[test]
 fn a_bad_input_among_good_ones_is_reported_and_the_rest_run() {
