@@ -704,11 +704,23 @@ impl RunReport {
             a[0], a[1], a[2]
         );
         let p = &self.plan;
+        // Under the extended rules the range is the whole object widened so that an outer
+        // finger may overhang its ends: not the thesis's Effective Elevation, so not called so.
+        let range_name = match p.grasp.as_ref().map(|g| g.rules) {
+            Some(crate::plan::RuleSet::Thesis) | None => "Effective elevation",
+            Some(_) => "Search elevation (extended rules: outer fingers may overhang the ends)",
+        };
+        let [lo, hi] = p.effective_elevation_mm;
+        // An object shorter than the two finger offsets has no Effective Elevation: its range
+        // would print inverted.
+        let range = if hi >= lo {
+            format!("{lo:.1}..{hi:.1} mm")
+        } else {
+            "none (the object is shorter than the finger width)".to_string()
+        };
         let _ = writeln!(
             s,
-            "  Effective elevation {:.1}..{:.1} mm, {} indexed elevations; graspable diameter {:.1}..{:.1} mm ({}; thesis 9x rule {:.1})",
-            p.effective_elevation_mm[0],
-            p.effective_elevation_mm[1],
+            "  {range_name} {range}, {} indexed elevations; graspable diameter {:.1}..{:.1} mm ({}; thesis 9x rule {:.1})",
             p.indexed_elevations,
             p.graspable_diameter_mm[0],
             p.graspable_diameter_mm[1],

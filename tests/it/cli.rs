@@ -581,3 +581,31 @@ fn a_reader_that_goes_away_is_not_bad_input() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+#[test]
+fn the_summary_names_the_elevation_range_it_searched() {
+    // The thesis's Effective Elevation lies inside the object; under the extended rules the
+    // range searched overhangs its ends, and the summary says so rather than calling it the
+    // Effective Elevation. An object shorter than the fingers has none (not an inverted range).
+    let env = Env::new();
+    let cup = crate::root().join("scenarios/cup.toml");
+    let out = run_in(env.dir.path(), &["--no-sim", cup.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Effective elevation 7.0..103.0 mm"), "{text}");
+    let ball = crate::root().join("assets/real/scenarios/adroit_ball.toml");
+    let out = run_in(env.dir.path(), &["--no-sim", ball.to_str().unwrap()]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains(
+            "Search elevation (extended rules: outer fingers may overhang the ends) -5.0.."
+        ),
+        "{text}"
+    );
+    env.write(
+        "tiny.stl",
+        grasp_sim::objects::cylinder(0.04, 0.124).to_binary_stl(),
+    );
+    let out = env.run(&["--no-sim", "tiny.stl"]);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("Effective elevation none"), "{text}");
+}
