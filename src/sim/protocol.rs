@@ -84,7 +84,8 @@ pub struct DirectionOutcome {
     pub decided_at_s: f64,
     /// What decided it: `end` (ran the whole hold), `rest` (at rest relative to the palm, the
     /// remaining motion cannot bring it across a threshold: within them, `hold`; slid beyond
-    /// one and resting on the hand, `slip`) or `out_of_reach` (left the hand's reach for good).
+    /// one and resting on the hand, `slip`), `out_of_reach` (left the hand's reach for good) or
+    /// `clear_of_hand` (flies clear of the resting hand for good): both `drop`.
     pub decided_by: &'static str,
     /// Object translation relative to the palm at the decision `[mm]`. For `out_of_reach`,
     /// `translation_mm` is this continued in free flight to the end of the hold.
@@ -693,6 +694,7 @@ fn hold(
     // Samples of the object's pose relative to the palm, for the rest rule.
     let mut samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)> = Vec::new();
     let mut decided: Option<Decision> = None;
+    let mut hand_was_still = false;
     let mut steps = 0;
     while steps < hold_steps {
         scene.world.step();
@@ -707,6 +709,18 @@ fn hold(
             decided = Some(Decision::OutOfReach(steps, p_end));
             break;
         }
+        // Drop: the hand has come to rest, nothing touches it, and the object's free flight
+        // never meets it again.
+        let hand_still = hand_speed(scene) < HAND_REST_M_S;
+        if hand_still && hand_was_still {
+            if let Some(p_end) = clear_of_hand(scene, g, params, hold_steps - steps) {
+                if (p_end - pc).norm() > params.hold_translation_mm / rule.margin {
+                    decided = Some(Decision::ClearOfHand(steps, p_end));
+                    break;
+                }
+            }
+        }
+        hand_was_still = hand_still;
         let remaining_s = (hold_steps - steps) as f64 * dt;
         if rule.at_rest(&samples, &frame, remaining_s, params)
             || (rule.slid_at_rest(&samples, &frame, remaining_s, params) && touches_hand(scene))
@@ -725,6 +739,10 @@ fn hold(
             translation_mm = (p_end - pc).norm();
             (n as f64 * dt, "out_of_reach")
         }
+        Some(Decision::ClearOfHand(n, p_end)) => {
+            translation_mm = (p_end - pc).norm();
+            (n as f64 * dt, "clear_of_hand")
+        }
         Some(Decision::Rest(n)) => {
             in_contact = touches_hand(scene);
             (n as f64 * dt, "rest")
@@ -735,7 +753,7 @@ fn hold(
         }
     };
     let judged_rotation = judged(rotation_deg, tilt_deg);
-    let verdict = if decided_by == "out_of_reach" {
+    let verdict = if decided_by == "out_of_reach" || decided_by == "clear_of_hand" {
         Verdict::Drop
     } else if translation_mm <= params.hold_translation_mm
         && judged_rotation <= params.hold_rotation_deg
@@ -784,6 +802,9 @@ enum Decision {
     /// Left the hand's reach for good at this step; where its free flight ends (palm frame)
     /// `[mm]`.
     OutOfReach(usize, Vector3<f64>),
+    /// Flies clear of the resting hand for good from this step; where its free flight ends
+    /// (palm frame) `[mm]`.
+    ClearOfHand(usize, Vector3<f64>),
     /// At rest relative to the palm at this step.
     Rest(usize),
 }
@@ -842,6 +863,149 @@ fn out_of_reach(
             (body_end.x - palm_at.x) as f32,
             (body_end.y - palm_at.y) as f32,
             (body_end.z - palm_at.z) as f32,
+        );
+    Some(convert::vector_mm(rel))
+}
+
+/// The hand counts as at rest when no point of any hand collider moves faster than this
+/// `[m/s]` (1 mm/s), at two samples running.
+const HAND_REST_M_S: f64 = 1e-3;
+
+/// The fastest any point of a hand collider moves `[m/s]`: per collider, its body's speed plus
+/// its angular speed times the farthest its collider reaches from the body's centre of mass.
+fn hand_speed(scene: &Scene) -> f64 {
+    let w = &scene.world;
+    scene
+        .hand_colliders
+        .iter()
+        .filter_map(|&h| {
+            let c = &w.colliders[h];
+            let b = &w.bodies[c.parent()?];
+            let sphere = c.shape().compute_bounding_sphere(c.position());
+            let lever = (sphere.center() - b.center_of_mass()).length() + sphere.radius();
+            Some(f64::from(b.linvel().length()) + f64::from(b.angvel().length() * lever))
+        })
+        .fold(0.0, f64::max)
+}
+
+/// If the object flies clear of the hand for the remaining `steps` under `g` `[m/s²]`, its
+/// translation relative to the palm at the end of that flight (palm frame) `[mm]`; `None`
+/// otherwise (docs/SIM.md, "Deciding early").
+///
+/// Called only when the hand has been at rest at two samples running ([`HAND_REST_M_S`]):
+/// untouched, under constant gravity and motor targets, it stays where it is, and every hand
+/// collider is taken where it is now, widened by the distance the rest speed would carry it to
+/// the end of the hold, twice over. Nothing else is in the scene, so while it touches nothing the
+/// object flies freely: its centre of mass as rapier integrates it (see [`out_of_reach`]), its
+/// orientation unknown but turning no faster than its angular momentum and kinetic energy allow
+/// (`|ω| ≤ min(|L|, √(2E·I_min)) / I_min`, both kept in free flight; rapier's implicit
+/// gyroscopic step only loses energy). The distance to the hand is bounded below at times along
+/// the flight by the larger of (a) the distance from the object, at its present orientation and
+/// carried with its centre of mass, less the most its rotation since now can move a point of it,
+/// and (b) the distance from its centre of mass less the radius of the sphere that holds it; from
+/// each such time the flight is advanced by as long as its speed bound (speed now plus gravity,
+/// plus rotation) cannot close that distance (conservative advancement). If the bound stays
+/// positive to the end of the hold, the object never touches the hand again.
+fn clear_of_hand(
+    scene: &Scene,
+    g: Vector3<f64>,
+    params: &SimParams,
+    steps: usize,
+) -> Option<Vector3<f64>> {
+    if touches_hand(scene) {
+        return None;
+    }
+    let w = &scene.world;
+    let obj = &w.bodies[scene.object];
+    let obj_collider = &w.colliders[scene.object_collider];
+    let v3 = |v: Vector| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z));
+    let ip = &w.integration_parameters;
+    let substeps = params.solver_iterations.max(1);
+    let h = params.timestep_s / substeps as f64;
+    let total = steps * substeps;
+    let remaining_s = total as f64 * h;
+    let margin = 2.0 * HAND_REST_M_S * remaining_s + f64::from(ip.prediction_distance());
+    let v_max = f64::from(ip.max_linear_velocity());
+    // The bound on the object's angular speed in free flight.
+    let mprops = &obj.mass_properties().local_mprops;
+    let inertia = v3(mprops.principal_inertia());
+    let frame = obj.position().rotation * mprops.principal_inertia_local_frame;
+    let w_local = v3(frame.inverse() * obj.angvel());
+    let i_min = inertia.min().max(f64::MIN_POSITIVE);
+    let l = inertia.component_mul(&w_local).norm();
+    let e2 = w_local.dot(&inertia.component_mul(&w_local));
+    let omega = 1.1 * l.min((e2 * i_min).sqrt()) / i_min;
+    let r_obj = scene.object_radius_m;
+    let com0 = v3(obj.center_of_mass());
+    let pose0 = *obj_collider.position();
+    let hand: Vec<(&Collider, Pose)> = scene
+        .hand_colliders
+        .iter()
+        .map(|&h| (&w.colliders[h], *w.colliders[h].position()))
+        .collect();
+    let g_norm = g.norm();
+    let mut x = com0;
+    let mut v = v3(obj.linvel());
+    let mut k = 0usize;
+    for _ in 0..10_000 {
+        // (a) and (b) at substep k.
+        let shift = x - com0;
+        let mut at = pose0;
+        at.translation += Vector::new(shift.x as f32, shift.y as f32, shift.z as f32);
+        let turned = omega * k as f64 * h * r_obj;
+        let centre = Vector::new(x.x as f32, x.y as f32, x.z as f32);
+        let mut lower = f64::INFINITY;
+        for (c, pose) in &hand {
+            let d_sphere = f64::from(c.shape().distance_to_point(pose, centre, true)) - r_obj;
+            let d_shape = if turned < r_obj {
+                let d =
+                    rapier3d::parry::query::distance(&at, obj_collider.shape(), pose, c.shape())
+                        .ok()?;
+                f64::from(d.distance) - turned
+            } else {
+                f64::NEG_INFINITY
+            };
+            lower = lower.min(d_sphere.max(d_shape));
+        }
+        let gap = lower - margin;
+        if gap <= 0.0 {
+            return None;
+        }
+        if k >= total {
+            break;
+        }
+        // The longest advance over which speed (now plus gravity) and rotation cannot close
+        // the gap: ½·g·Δ² + (|v| + ω·r)·Δ = gap.
+        let b = v.norm() + omega * r_obj;
+        let dt_safe = if g_norm > 0.0 {
+            (-b + (b * b + 2.0 * g_norm * gap).sqrt()) / g_norm
+        } else {
+            gap / b.max(f64::MIN_POSITIVE)
+        };
+        let n = ((dt_safe / h).floor() as usize).min(total - k);
+        if n == 0 {
+            return None;
+        }
+        for _ in 0..n {
+            v += g * h;
+            let speed = v.norm();
+            if speed > v_max {
+                v *= v_max / speed;
+            }
+            x += v * h;
+        }
+        k += n;
+    }
+    if k < total {
+        return None;
+    }
+    let palm = w.bodies[scene.palm].position();
+    let body_end = v3(obj.position().translation) + (x - com0);
+    let rel = palm.rotation.inverse()
+        * rapier3d::math::Vector::new(
+            (body_end.x - f64::from(palm.translation.x)) as f32,
+            (body_end.y - f64::from(palm.translation.y)) as f32,
+            (body_end.z - f64::from(palm.translation.z)) as f32,
         );
     Some(convert::vector_mm(rel))
 }

@@ -65,6 +65,15 @@ fn open_fingers_drop_the_object() {
     assert_eq!(v["sim"]["grasp_source"], "override_angles");
     assert_eq!(v["expect"]["met"], true);
     assert!(v["sim"]["translation_mm"].as_f64().unwrap() > 100.0);
+    // The open fingers are still from the start of the hold: the drop is decided once the
+    // falling object's flight provably misses them, before it has fallen past the hand's
+    // reach sphere (about 0.23 s, 260 mm, from this grasp).
+    let d = &v["sim"]["directions"][0];
+    assert_eq!(d["decided_by"], "clear_of_hand");
+    let at = d["decided_at_s"].as_f64().unwrap();
+    assert!(at > 0.1 && at < 0.2, "decided at {at} s");
+    let fallen = d["translation_at_decision_mm"].as_f64().unwrap();
+    assert!(fallen > 50.0 && fallen < 200.0, "{fallen} mm");
 }
 
 #[test]
@@ -548,6 +557,39 @@ fn fast_and_full_protocols_agree_on_the_bundled_scenarios() {
         compared += 1;
     }
     assert!(compared >= 10, "only {compared} scenarios checked");
+}
+
+#[test]
+fn a_drop_clear_of_the_hand_is_the_full_protocols_drop() {
+    // The open fingers in six directions: the object falls away from the still hand in some
+    // (decided `clear_of_hand`), onto the palm or a finger in others (not decided so). Every
+    // direction's verdict is the full-length hold's, and a flight continued to the end of the
+    // hold ends where the full protocol's object does, within 1 %.
+    use grasp_sim::scenario::{GravityMode, Protocol};
+    let mut s = Scenario::load(&crate::root().join("scenarios/sim_open_fingers.toml")).unwrap();
+    s.sim.gravity = GravityMode::Six;
+    let mut by = |p| {
+        s.sim.protocol = p;
+        run(&s, &with_sim()).unwrap().sim
+    };
+    let (full, fast) = (by(Protocol::Full), by(Protocol::Fast));
+    let mut clear = 0;
+    for (a, b) in full.directions.iter().zip(&fast.directions) {
+        assert_eq!(a.verdict, b.verdict, "gravity {:?}", a.gravity);
+        if b.decided_by == "clear_of_hand" {
+            clear += 1;
+            let d = (a.translation_mm - b.translation_mm).abs();
+            assert!(
+                d <= 0.01 * a.translation_mm,
+                "{} mm (full) against {} mm",
+                a.translation_mm,
+                b.translation_mm
+            );
+            assert!(b.decided_at_s < a.decided_at_s);
+        }
+    }
+    assert!(clear >= 1, "no direction decided clear of the hand");
+    assert!(clear < 6, "every direction decided clear of the hand");
 }
 
 #[test]
