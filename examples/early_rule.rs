@@ -33,8 +33,9 @@ const RULES: [(f64, f64); 8] = [
 
 /// Where the rule with `window_s` and `margin` decides `t`'s hold: (verdict by motion, time,
 /// translation, rotation) at the decision, or `None` if it runs to the end. The verdict is
-/// `hold` for a rest within the thresholds, `slip` for a rest beyond them (a rest under gravity
-/// is a rest on the hand).
+/// `hold` for a rest within the thresholds, `slip` for a rest beyond them, or anywhere for a
+/// grasp whose closing ended deeper than `max_penetration_mm` in the object (a rest under
+/// gravity is a rest on the hand).
 fn decide(
     t: &HoldTrace,
     params: &SimParams,
@@ -52,9 +53,12 @@ fn decide(
         if remaining <= 1e-9 {
             return None;
         }
+        let penetrated = t.outcome.closing_penetration_mm > params.max_penetration_mm;
         let verdict = if rule.at_rest(&t.samples[..=i], &t.frame, remaining, params) {
             Verdict::Hold
-        } else if rule.slid_at_rest(&t.samples[..=i], &t.frame, remaining, params) {
+        } else if rule.slid_at_rest(&t.samples[..=i], &t.frame, remaining, params)
+            || (penetrated && rule.settled(&t.samples[..=i], &t.frame, remaining))
+        {
             Verdict::Slip
         } else {
             continue;

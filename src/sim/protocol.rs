@@ -257,6 +257,21 @@ impl EarlyDecision {
             && self.reportable(&s)
     }
 
+    /// True when the further motion bound of the last `window_s` of `samples` is within what
+    /// the numbers reported now may differ from the full protocol's, wherever the object is:
+    /// condition (b) of the rest rules alone. For a grasp whose closing left a finger deeper
+    /// than `max_penetration_mm` inside the object, which is `slip` whatever it does so long as
+    /// it stays on the hand.
+    pub fn settled(
+        &self,
+        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
+        frame: &RestFrame,
+        remaining_s: f64,
+    ) -> bool {
+        self.settling(samples, frame, remaining_s)
+            .is_some_and(|s| self.reportable(&s))
+    }
+
     /// The rest rule for a slid object: true when, measured as [`EarlyDecision::at_rest`]
     /// measures it, the object has come to rest beyond a hold threshold and its further motion
     /// cannot bring it back within `1 / margin` of that threshold: its translation now minus the
@@ -722,7 +737,11 @@ fn hold(
         }
         hand_was_still = hand_still;
         let remaining_s = (hold_steps - steps) as f64 * dt;
+        // A grasp the closing left too deep in the object is `slip` wherever the object rests
+        // on the hand.
+        let penetrated = closing.penetration_mm > params.max_penetration_mm;
         if rule.at_rest(&samples, &frame, remaining_s, params)
+            || (penetrated && rule.settled(&samples, &frame, remaining_s) && touches_hand(scene))
             || (rule.slid_at_rest(&samples, &frame, remaining_s, params) && touches_hand(scene))
         {
             decided = Some(Decision::Rest(steps));

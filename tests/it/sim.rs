@@ -447,6 +447,13 @@ fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
         })
         .collect();
     assert!(rule.slid_at_rest(&tilted, &frame, remaining(11), &params));
+    // `settled` (for a grasp the closing left too deep in the object, `slip` wherever it
+    // rests): the report tolerance alone, near a threshold or not; not while sliding on.
+    for f in [&still as &dyn Fn(f64) -> f64, &nearer, &barely, &slid] {
+        assert!(rule.settled(&at(f, 11), &frame, remaining(11)));
+    }
+    assert!(!rule.settled(&at(&still, 10), &frame, remaining(10)));
+    assert!(!rule.settled(&at(&sliding(1.0), 11), &frame, remaining(11)));
 }
 
 #[test]
