@@ -710,6 +710,7 @@ fn hold(
     let mut samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)> = Vec::new();
     let mut decided: Option<Decision> = None;
     let mut hand_was_still = false;
+    let holds_itself = hand_holds_itself(scene, params);
     let mut steps = 0;
     while steps < hold_steps {
         scene.world.step();
@@ -726,10 +727,10 @@ fn hold(
         }
         // Drop: the hand has come to rest, nothing touches it, and the object's free flight
         // never meets it again.
-        let hand_still = hand_speed(scene) < HAND_REST_M_S;
+        let hand_still = holds_itself && hand_speed(scene) < HAND_REST_M_S;
         if hand_still && hand_was_still {
-            if let Some(p_end) = clear_of_hand(scene, g, params, hold_steps - steps) {
-                if (p_end - pc).norm() > params.hold_translation_mm / rule.margin {
+            if let Some((p_end, err_mm)) = clear_of_hand(scene, g, params, hold_steps - steps) {
+                if (p_end - pc).norm() - err_mm > params.hold_translation_mm / rule.margin {
                     decided = Some(Decision::ClearOfHand(steps, p_end));
                     break;
                 }
@@ -916,21 +917,23 @@ fn hand_speed(scene: &Scene) -> f64 {
 /// collider is taken where it is now, widened by the distance the rest speed would carry it to
 /// the end of the hold, twice over. Nothing else is in the scene, so while it touches nothing the
 /// object flies freely: its centre of mass as rapier integrates it (see [`out_of_reach`]), its
-/// orientation unknown but turning no faster than its angular momentum and kinetic energy allow
-/// (`|ω| ≤ min(|L|, √(2E·I_min)) / I_min`, both kept in free flight; rapier's implicit
-/// gyroscopic step only loses energy). The distance to the hand is bounded below at times along
+/// orientation unknown but turning no faster than its angular momentum allows (`|ω| ≤ |L| /
+/// I_min`: rapier's gyroscopic step keeps `|L|`, though not the energy). The distance to the
+/// hand is bounded below at times along
 /// the flight by the larger of (a) the distance from the object, at its present orientation and
 /// carried with its centre of mass, less the most its rotation since now can move a point of it,
 /// and (b) the distance from its centre of mass less the radius of the sphere that holds it; from
 /// each such time the flight is advanced by as long as its speed bound (speed now plus gravity,
-/// plus rotation) cannot close that distance (conservative advancement). If the bound stays
-/// positive to the end of the hold, the object never touches the hand again.
+/// plus rotation, plus the lead of rapier's velocity-first update) cannot close that distance
+/// (conservative advancement). If the bound stays positive to the end of the hold, the object
+/// never touches the hand again. Also returned: how far the reported end may be from the true
+/// one `[mm]`, since the body frame is carried with the centre of mass without its turn.
 fn clear_of_hand(
     scene: &Scene,
     g: Vector3<f64>,
     params: &SimParams,
     steps: usize,
-) -> Option<Vector3<f64>> {
+) -> Option<(Vector3<f64>, f64)> {
     if touches_hand(scene) {
         return None;
     }
@@ -951,9 +954,11 @@ fn clear_of_hand(
     let frame = obj.position().rotation * mprops.principal_inertia_local_frame;
     let w_local = v3(frame.inverse() * obj.angvel());
     let i_min = inertia.min().max(f64::MIN_POSITIVE);
+    // rapier's gyroscopic step keeps |L| (it rescales the angular momentum to its length before
+    // the step) but not the energy, which grows for a spin near the largest axis: the bound is
+    // |L| / I_min, with 1 % for f32 rounding.
     let l = inertia.component_mul(&w_local).norm();
-    let e2 = w_local.dot(&inertia.component_mul(&w_local));
-    let omega = 1.1 * l.min((e2 * i_min).sqrt()) / i_min;
+    let omega = 1.01 * l / i_min;
     let r_obj = scene.object_radius_m;
     let com0 = v3(obj.center_of_mass());
     let pose0 = *obj_collider.position();
@@ -980,7 +985,8 @@ fn clear_of_hand(
                 let d =
                     rapier3d::parry::query::distance(&at, obj_collider.shape(), pose, c.shape())
                         .ok()?;
-                f64::from(d.distance) - turned
+                // parry's convex distance stops within about 1.1e-3 of the true one, from above.
+                f64::from(d.distance) * (1.0 - 2e-3) - turned
             } else {
                 f64::NEG_INFINITY
             };
@@ -994,8 +1000,10 @@ fn clear_of_hand(
             break;
         }
         // The longest advance over which speed (now plus gravity) and rotation cannot close
-        // the gap: ½·g·Δ² + (|v| + ω·r)·Δ = gap.
-        let b = v.norm() + omega * r_obj;
+        // the gap: ½·g·Δ² + (|v| + ω·r + ½·g·h)·Δ = gap.
+        // rapier updates the velocity before the position: over n substeps that leads the
+        // continuous motion by up to ½·g·h·Δ.
+        let b = v.norm() + omega * r_obj + 0.5 * g_norm * h;
         let dt_safe = if g_norm > 0.0 {
             (-b + (b * b + 2.0 * g_norm * gap).sqrt()) / g_norm
         } else {
@@ -1018,6 +1026,11 @@ fn clear_of_hand(
     if k < total {
         return None;
     }
+    // The body frame is carried with the centre of mass, its rotation at the decision kept:
+    // its origin may end elsewhere by the turn since then (at most half a turn) times its
+    // distance from the centre of mass.
+    let origin_off = (v3(obj.position().translation) - com0).norm();
+    let err_mm = (omega * remaining_s).min(2.0) * origin_off / convert::M_PER_MM;
     let palm = w.bodies[scene.palm].position();
     let body_end = v3(obj.position().translation) + (x - com0);
     let rel = palm.rotation.inverse()
@@ -1026,7 +1039,37 @@ fn clear_of_hand(
             (body_end.y - f64::from(palm.translation.y)) as f32,
             (body_end.z - f64::from(palm.translation.z)) as f32,
         );
-    Some(convert::vector_mm(rel))
+    Some((convert::vector_mm(rel), err_mm))
+}
+
+/// True if every finger's motors hold its phalanges against gravity with four times the torque
+/// to spare: joint 2's torque limit against phalanx 2, joint 1's lock against both. Then a
+/// finger at rest and untouched sits where its motor's spring and gravity balance, or against a
+/// contact it is pressed onto, and stays there; a motor barely stronger than gravity could
+/// instead let a finger creep from rest, so [`clear_of_hand`] is not used for such a hand.
+/// The lever of each phalanx about its joint is bounded by twice the farthest its colliders
+/// reach from its centre of mass.
+fn hand_holds_itself(scene: &Scene, params: &SimParams) -> bool {
+    let w = &scene.world;
+    let reach = |h: RigidBodyHandle| -> (f64, f64) {
+        let b = &w.bodies[h];
+        let lever = b
+            .colliders()
+            .iter()
+            .map(|&c| {
+                let c = &w.colliders[c];
+                let sphere = c.shape().compute_bounding_sphere(c.position());
+                f64::from((sphere.center() - b.center_of_mass()).length() + sphere.radius())
+            })
+            .fold(0.0, f64::max);
+        (f64::from(b.mass()), 2.0 * lever)
+    };
+    scene.fingers.iter().all(|f| {
+        let (m1, l1) = reach(f.phalanx1);
+        let (m2, l2) = reach(f.phalanx2);
+        params.torque_limit_nm >= 4.0 * m2 * G * l2
+            && params.joint1_lock_torque_nm >= 4.0 * (m1 + m2) * G * (l1 + l2)
+    })
 }
 
 /// Per finger, each joint's bend minus its planned bend `[deg]`.
