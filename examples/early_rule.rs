@@ -54,13 +54,8 @@ fn decide(
             return None;
         }
         let penetrated = t.outcome.closing_penetration_mm > params.max_penetration_mm;
-        let verdict = if rule.at_rest(&t.samples[..=i], &t.frame, remaining, params) {
-            Verdict::Hold
-        } else if rule.slid_at_rest(&t.samples[..=i], &t.frame, remaining, params)
-            || (penetrated && rule.settled(&t.samples[..=i], &t.frame, remaining))
-        {
-            Verdict::Slip
-        } else {
+        let Some(verdict) = rule.decide(&t.samples[..=i], &t.frame, remaining, params, penetrated)
+        else {
             continue;
         };
         let (p, q) = t.samples[i];

@@ -237,11 +237,43 @@ impl EarlyDecision {
             && s.more_deg <= self.report_deg.max(self.report_fraction * s.now_deg)
     }
 
-    /// The rest rule: true when the motion of the last `window_s` of `samples` (the poses
-    /// relative to the palm so far, one every `frame.sample_dt`), its mean drift and its
-    /// spread, at `safety` times their size and continued for `remaining_s`, keeps the object
-    /// within the hold thresholds and the numbers reported now within what they may differ from
-    /// the full protocol's.
+    /// The rest rules (docs/SIM.md, "Deciding early"): what the motion of the last `window_s`
+    /// of `samples` (the poses relative to the palm so far, one every `frame.sample_dt`), its
+    /// mean drift and its spread at `safety` times their size continued for `remaining_s`,
+    /// decides now, provided it keeps the numbers reported now within what they may differ from
+    /// the full protocol's:
+    /// - `Hold` when the object stays within `margin` of the hold thresholds (a hold by motion;
+    ///   the verdict is `slip` all the same if the closing left a finger too deep);
+    /// - `Slip` when it cannot come back within `1 / margin` of a threshold (the distance to the
+    ///   pose after closing moves by no more than the object does, and so does the judged
+    ///   rotation), or, for a grasp the closing left too deep in the object (`penetrated`),
+    ///   wherever it is: such a grasp is `slip` whatever it does while on the hand;
+    /// - `None` otherwise.
+    ///
+    /// A `Slip` holds only for an object on the hand, which the caller checks.
+    pub fn decide(
+        &self,
+        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
+        frame: &RestFrame,
+        remaining_s: f64,
+        params: &SimParams,
+        penetrated: bool,
+    ) -> Option<Verdict> {
+        let s = self.settling(samples, frame, remaining_s)?;
+        if !self.reportable(&s) {
+            return None;
+        }
+        if s.now_mm + s.more_mm <= self.margin * params.hold_translation_mm
+            && s.now_deg + s.more_deg <= self.margin * params.hold_rotation_deg
+        {
+            return Some(Verdict::Hold);
+        }
+        let beyond = s.now_mm - s.more_mm >= params.hold_translation_mm / self.margin
+            || s.now_deg - s.more_deg >= params.hold_rotation_deg / self.margin;
+        (beyond || penetrated).then_some(Verdict::Slip)
+    }
+
+    /// True when [`EarlyDecision::decide`] decides a hold by motion.
     pub fn at_rest(
         &self,
         samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
@@ -249,35 +281,11 @@ impl EarlyDecision {
         remaining_s: f64,
         params: &SimParams,
     ) -> bool {
-        let Some(s) = self.settling(samples, frame, remaining_s) else {
-            return false;
-        };
-        s.now_mm + s.more_mm <= self.margin * params.hold_translation_mm
-            && s.now_deg + s.more_deg <= self.margin * params.hold_rotation_deg
-            && self.reportable(&s)
+        self.decide(samples, frame, remaining_s, params, false) == Some(Verdict::Hold)
     }
 
-    /// True when the further motion bound of the last `window_s` of `samples` is within what
-    /// the numbers reported now may differ from the full protocol's, wherever the object is:
-    /// condition (b) of the rest rules alone. For a grasp whose closing left a finger deeper
-    /// than `max_penetration_mm` inside the object, which is `slip` whatever it does so long as
-    /// it stays on the hand.
-    pub fn settled(
-        &self,
-        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
-        frame: &RestFrame,
-        remaining_s: f64,
-    ) -> bool {
-        self.settling(samples, frame, remaining_s)
-            .is_some_and(|s| self.reportable(&s))
-    }
-
-    /// The rest rule for a slid object: true when, measured as [`EarlyDecision::at_rest`]
-    /// measures it, the object has come to rest beyond a hold threshold and its further motion
-    /// cannot bring it back within `1 / margin` of that threshold: its translation now minus the
-    /// bound, or its rotation now minus the bound, is beyond the threshold divided by the
-    /// margin. (The distance to the pose after closing moves by no more than the object does,
-    /// and so does the judged rotation.) The reported numbers must be settled as for a hold.
+    /// True when [`EarlyDecision::decide`] decides a slip by motion alone (the object at rest
+    /// beyond a threshold).
     pub fn slid_at_rest(
         &self,
         samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
@@ -285,12 +293,7 @@ impl EarlyDecision {
         remaining_s: f64,
         params: &SimParams,
     ) -> bool {
-        let Some(s) = self.settling(samples, frame, remaining_s) else {
-            return false;
-        };
-        (s.now_mm - s.more_mm >= params.hold_translation_mm / self.margin
-            || s.now_deg - s.more_deg >= params.hold_rotation_deg / self.margin)
-            && self.reportable(&s)
+        self.decide(samples, frame, remaining_s, params, false) == Some(Verdict::Slip)
     }
 }
 
@@ -738,16 +741,14 @@ fn hold(
         }
         hand_was_still = hand_still;
         let remaining_s = (hold_steps - steps) as f64 * dt;
-        // A grasp the closing left too deep in the object is `slip` wherever the object rests
-        // on the hand.
         let penetrated = closing.penetration_mm > params.max_penetration_mm;
-        if rule.at_rest(&samples, &frame, remaining_s, params)
-            || (penetrated && rule.settled(&samples, &frame, remaining_s) && touches_hand(scene))
-            || (rule.slid_at_rest(&samples, &frame, remaining_s, params) && touches_hand(scene))
-        {
-            decided = Some(Decision::Rest(steps));
-            break;
+        match rule.decide(&samples, &frame, remaining_s, params, penetrated) {
+            Some(Verdict::Hold) => {}
+            Some(_) if touches_hand(scene) => {}
+            _ => continue,
         }
+        decided = Some(Decision::Rest(steps));
+        break;
     }
     let (pe, qe) = relative(scene);
     let (rotation_deg, tilt_deg) = rotations(&qc, &qe);

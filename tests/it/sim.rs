@@ -447,13 +447,19 @@ fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
         })
         .collect();
     assert!(rule.slid_at_rest(&tilted, &frame, remaining(11), &params));
-    // `settled` (for a grasp the closing left too deep in the object, `slip` wherever it
-    // rests): the report tolerance alone, near a threshold or not; not while sliding on.
-    for f in [&still as &dyn Fn(f64) -> f64, &nearer, &barely, &slid] {
-        assert!(rule.settled(&at(f, 11), &frame, remaining(11)));
+    // A grasp the closing left too deep in the object is `slip` wherever it rests: the report
+    // tolerance alone decides, near a threshold or not; not while it slides on. (At rest well
+    // inside the thresholds it is a hold by motion; the verdict turns it into a slip.)
+    use grasp_sim::sim::Verdict;
+    let deep = |f: &dyn Fn(f64) -> f64, n: usize| {
+        rule.decide(&at(f, n), &frame, remaining(n), &params, true)
+    };
+    for f in [&nearer as &dyn Fn(f64) -> f64, &barely, &slid] {
+        assert_eq!(deep(f, 11), Some(Verdict::Slip));
     }
-    assert!(!rule.settled(&at(&still, 10), &frame, remaining(10)));
-    assert!(!rule.settled(&at(&sliding(1.0), 11), &frame, remaining(11)));
+    assert_eq!(deep(&still, 11), Some(Verdict::Hold));
+    assert_eq!(deep(&still, 10), None);
+    assert_eq!(deep(&sliding(1.0), 11), None);
 }
 
 #[test]
