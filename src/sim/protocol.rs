@@ -867,25 +867,47 @@ fn out_of_reach(
     let mut v = v3(obj.linvel());
     let mut x = com0;
     for _ in 0..steps * substeps {
-        v += g * h;
-        let speed = v.norm();
-        if speed > v_max {
-            v *= v_max / speed;
-        }
-        x += v * h;
+        let speed = flight_substep(&mut x, &mut v, g, h, v_max);
         if (x - palm_at).norm() <= clearance + v_max.min(speed) * h {
             return None;
         }
     }
-    // The body frame moves with the centre of mass (its rotation at the decision is kept).
-    let body_end = v3(obj.position().translation) + (x - com0);
+    Some(flight_end_mm(scene, x - com0))
+}
+
+/// One substep of free flight as rapier integrates a free body: velocity plus `g`·`h`, capped at
+/// `v_max`, then position plus velocity·`h`. Returns the speed before the cap.
+fn flight_substep(
+    x: &mut Vector3<f64>,
+    v: &mut Vector3<f64>,
+    g: Vector3<f64>,
+    h: f64,
+    v_max: f64,
+) -> f64 {
+    *v += g * h;
+    let speed = v.norm();
+    if speed > v_max {
+        *v *= v_max / speed;
+    }
+    *x += *v * h;
+    speed
+}
+
+/// The object's translation relative to the palm (palm frame) `[mm]` once its centre of mass
+/// has moved by `shift` `[m]` in free flight: the body frame is carried with the centre of mass,
+/// its rotation now kept.
+fn flight_end_mm(scene: &Scene, shift: Vector3<f64>) -> Vector3<f64> {
+    let bodies = &scene.world.bodies;
+    let palm = bodies[scene.palm].position();
+    let origin = bodies[scene.object].position().translation;
+    let end = |o: f32, p: f32, d: f64| (f64::from(o) + d - f64::from(p)) as f32;
     let rel = palm.rotation.inverse()
         * rapier3d::math::Vector::new(
-            (body_end.x - palm_at.x) as f32,
-            (body_end.y - palm_at.y) as f32,
-            (body_end.z - palm_at.z) as f32,
+            end(origin.x, palm.translation.x, shift.x),
+            end(origin.y, palm.translation.y, shift.y),
+            end(origin.z, palm.translation.z, shift.z),
         );
-    Some(convert::vector_mm(rel))
+    convert::vector_mm(rel)
 }
 
 /// The hand counts as at rest when no point of any hand collider moves faster than this
@@ -1015,12 +1037,7 @@ fn clear_of_hand(
             return None;
         }
         for _ in 0..n {
-            v += g * h;
-            let speed = v.norm();
-            if speed > v_max {
-                v *= v_max / speed;
-            }
-            x += v * h;
+            flight_substep(&mut x, &mut v, g, h, v_max);
         }
         k += n;
     }
@@ -1032,15 +1049,7 @@ fn clear_of_hand(
     // distance from the centre of mass.
     let origin_off = (v3(obj.position().translation) - com0).norm();
     let err_mm = (omega * remaining_s).min(2.0) * origin_off / convert::M_PER_MM;
-    let palm = w.bodies[scene.palm].position();
-    let body_end = v3(obj.position().translation) + (x - com0);
-    let rel = palm.rotation.inverse()
-        * rapier3d::math::Vector::new(
-            (body_end.x - f64::from(palm.translation.x)) as f32,
-            (body_end.y - f64::from(palm.translation.y)) as f32,
-            (body_end.z - f64::from(palm.translation.z)) as f32,
-        );
-    Some((convert::vector_mm(rel), err_mm))
+    Some((flight_end_mm(scene, x - com0), err_mm))
 }
 
 /// True if every finger's motors hold its phalanges against gravity with four times the torque
