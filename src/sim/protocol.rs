@@ -272,29 +272,6 @@ impl EarlyDecision {
             || s.now_deg - s.more_deg >= params.hold_rotation_deg / self.margin;
         (beyond || penetrated).then_some(Verdict::Slip)
     }
-
-    /// True when [`EarlyDecision::decide`] decides a hold by motion.
-    pub fn at_rest(
-        &self,
-        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
-        frame: &RestFrame,
-        remaining_s: f64,
-        params: &SimParams,
-    ) -> bool {
-        self.decide(samples, frame, remaining_s, params, false) == Some(Verdict::Hold)
-    }
-
-    /// True when [`EarlyDecision::decide`] decides a slip by motion alone (the object at rest
-    /// beyond a threshold).
-    pub fn slid_at_rest(
-        &self,
-        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
-        frame: &RestFrame,
-        remaining_s: f64,
-        params: &SimParams,
-    ) -> bool {
-        self.decide(samples, frame, remaining_s, params, false) == Some(Verdict::Slip)
-    }
 }
 
 /// A full-length hold's samples (one every [`SAMPLE_S`]) and outcome, collected by [`traced`]

@@ -376,11 +376,12 @@ fn the_fast_payload_search_loads_one_closed_grasp() {
 
 #[test]
 fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
-    // `EarlyDecision::at_rest` on poses sampled every 1/48 s (the default rule: a 0.2 s window,
-    // twice the motion seen, within 0.8 of the 5 mm / 5° thresholds).
+    // `EarlyDecision::decide` on poses sampled every 1/48 s (the default rule: a 0.2 s window,
+    // twice the motion seen, within 0.8 of the 5 mm / 5° thresholds for a hold, beyond
+    // 1 / 0.8 of one for a slip).
     use grasp_sim::scenario::SimParams;
     use grasp_sim::sim::protocol::{RestFrame, SAMPLE_S};
-    use grasp_sim::sim::EarlyDecision;
+    use grasp_sim::sim::{EarlyDecision, Verdict};
     use nalgebra::{UnitQuaternion, Vector3};
     let params = SimParams::default();
     let rule = EarlyDecision::from_params(&params);
@@ -401,41 +402,43 @@ fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
             .collect()
     };
     let remaining = |n: usize| params.duration_s - n as f64 * SAMPLE_S;
+    // The verdict by motion after `n` samples, for a grasp the closing left clear (`deep`:
+    // deeper than `max_penetration_mm`).
+    let by = |samples: &[(Vector3<f64>, UnitQuaternion<f64>)], n: usize, deep: bool| {
+        rule.decide(samples, &frame, remaining(n), &params, deep)
+    };
+    let decide = |f: &dyn Fn(f64) -> f64, n: usize| by(&at(f, n), n, false);
+    let (hold, slip) = (Some(Verdict::Hold), Some(Verdict::Slip));
     // At rest 1 mm away: decided once a whole window (10 samples after the first) is seen.
     let still = |_t: f64| 1.0;
-    assert!(!rule.at_rest(&at(&still, 10), &frame, remaining(10), &params));
-    assert!(rule.at_rest(&at(&still, 11), &frame, remaining(11), &params));
+    assert_eq!(decide(&still, 10), None);
+    assert_eq!(decide(&still, 11), hold);
     // At rest 3.9 mm away: within 0.8 × 5 mm, decided; 4.1 mm, though under the 5 mm
-    // threshold, is too near it: runs to the end.
+    // threshold, is too near it, and far from beyond it: runs to the end.
     let near = |_t: f64| 3.9;
-    assert!(rule.at_rest(&at(&near, 11), &frame, remaining(11), &params));
+    assert_eq!(decide(&near, 11), hold);
     let nearer = |_t: f64| 4.1;
-    assert!(!rule.at_rest(&at(&nearer, 11), &frame, remaining(11), &params));
+    assert_eq!(decide(&nearer, 11), None);
     // Creeping at 0.1 mm/s: 2 × 0.1 × 1.77 s = 0.35 mm more, within the 0.5 mm report tolerance:
     // decided. At 0.2 mm/s, 0.71 mm more: not.
     let creep = |v: f64| move |t: f64| 1.0 + v * t;
-    assert!(rule.at_rest(&at(&creep(0.1), 11), &frame, remaining(11), &params));
-    assert!(!rule.at_rest(&at(&creep(0.2), 11), &frame, remaining(11), &params));
-    // `slid_at_rest`, the other side: none of the above is beyond a threshold.
-    for f in [&still as &dyn Fn(f64) -> f64, &near, &nearer] {
-        assert!(!rule.slid_at_rest(&at(f, 11), &frame, remaining(11), &params));
-    }
+    assert_eq!(decide(&creep(0.1), 11), hold);
+    assert_eq!(decide(&creep(0.2), 11), None);
     // At rest 16 mm away: a slip, decided after a whole window, as a hold is.
     let slid = |_t: f64| 16.0;
-    assert!(!rule.slid_at_rest(&at(&slid, 10), &frame, remaining(10), &params));
-    assert!(rule.slid_at_rest(&at(&slid, 11), &frame, remaining(11), &params));
-    assert!(!rule.at_rest(&at(&slid, 11), &frame, remaining(11), &params));
+    assert_eq!(decide(&slid, 10), None);
+    assert_eq!(decide(&slid, 11), slip);
     // At rest 6 mm away: beyond 5 mm, but within 5 / 0.8 = 6.25 mm, too near to come back
     // from: runs to the end; 6.3 mm is decided.
     let barely = |_t: f64| 6.0;
-    assert!(!rule.slid_at_rest(&at(&barely, 11), &frame, remaining(11), &params));
+    assert_eq!(decide(&barely, 11), None);
     let past = |_t: f64| 6.3;
-    assert!(rule.slid_at_rest(&at(&past, 11), &frame, remaining(11), &params));
+    assert_eq!(decide(&past, 11), slip);
     // Sliding on at 1 mm/s at 16 mm: 2 × 1 × 1.77 s = 3.5 mm more, beyond 10 % of 16 mm: not
     // settled. At 0.3 mm/s, 1.06 mm more, within 1.6 mm: decided.
     let sliding = |v: f64| move |t: f64| 16.0 + v * t;
-    assert!(!rule.slid_at_rest(&at(&sliding(1.0), 11), &frame, remaining(11), &params));
-    assert!(rule.slid_at_rest(&at(&sliding(0.3), 11), &frame, remaining(11), &params));
+    assert_eq!(decide(&sliding(1.0), 11), None);
+    assert_eq!(decide(&sliding(0.3), 11), slip);
     // Tilted 8° and still, 1 mm away: beyond the 5° threshold by rotation alone.
     let tilted: Vec<_> = at(&still, 11)
         .into_iter()
@@ -446,20 +449,16 @@ fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
             )
         })
         .collect();
-    assert!(rule.slid_at_rest(&tilted, &frame, remaining(11), &params));
+    assert_eq!(by(&tilted, 11, false), slip);
     // A grasp the closing left too deep in the object is `slip` wherever it rests: the report
     // tolerance alone decides, near a threshold or not; not while it slides on. (At rest well
     // inside the thresholds it is a hold by motion; the verdict turns it into a slip.)
-    use grasp_sim::sim::Verdict;
-    let deep = |f: &dyn Fn(f64) -> f64, n: usize| {
-        rule.decide(&at(f, n), &frame, remaining(n), &params, true)
-    };
     for f in [&nearer as &dyn Fn(f64) -> f64, &barely, &slid] {
-        assert_eq!(deep(f, 11), Some(Verdict::Slip));
+        assert_eq!(by(&at(f, 11), 11, true), slip);
     }
-    assert_eq!(deep(&still, 11), Some(Verdict::Hold));
-    assert_eq!(deep(&still, 10), None);
-    assert_eq!(deep(&sliding(1.0), 11), None);
+    assert_eq!(by(&at(&still, 11), 11, true), hold);
+    assert_eq!(by(&at(&still, 10), 10, true), None);
+    assert_eq!(by(&at(&sliding(1.0), 11), 11, true), None);
 }
 
 #[test]
