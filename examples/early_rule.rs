@@ -10,6 +10,10 @@
 //! decision that the full-length hold contradicts: a verdict that changes later (`wrong`), or a
 //! translation or rotation that moves on by more than the report tolerance (0.5 mm or 10 %,
 //! 0.5° or 10 %) (`numbers`).
+//!
+//! `--dump FILE` also writes every hold as a JSON line, sampled four times finer than the rule
+//! samples (1/192 s), with how near the hand's contacts were to sliding at each sample: the input
+//! of `scripts/rest_rule_friction.py`, which replays rules with shorter windows on it.
 
 #[path = "common/mod.rs"]
 mod common;
@@ -73,10 +77,14 @@ fn main() {
     let mut six = false;
     let mut sets: Vec<(String, toml::Value)> = Vec::new();
     let mut files = Vec::new();
+    let mut dump: Option<std::fs::File> = None;
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
             "--six" => six = true,
+            "--dump" => {
+                dump = Some(std::fs::File::create(args.next().expect("FILE")).expect("--dump FILE"))
+            }
             "--set" => sets.push(common::parse_set(&args.next().expect("KEY=VALUE"))),
             _ => files.push(a),
         }
@@ -107,6 +115,26 @@ fn main() {
         for t in &traces {
             runs += 1;
             let o = &t.outcome;
+            if let Some(d) = dump.as_mut() {
+                use std::io::Write;
+                let q = |q: &nalgebra::UnitQuaternion<f64>| [q.w, q.i, q.j, q.k];
+                let line = serde_json::json!({
+                    "name": s.name, "gravity": o.gravity, "verdict": o.verdict.as_str(),
+                    "translation_mm": o.translation_mm, "rotation_deg": o.rotation_deg,
+                    "penetrated": o.closing_penetration_mm > s.sim.max_penetration_mm,
+                    "duration_s": t.duration_s, "sample_dt": t.fine_dt,
+                    "thresholds": [s.sim.hold_translation_mm, s.sim.hold_rotation_deg],
+                    "safety": s.sim.rest_safety,
+                    "pc": [t.frame.pc.x, t.frame.pc.y, t.frame.pc.z], "qc": q(&t.frame.qc),
+                    "revolution": t.frame.is_revolution,
+                    "p": t.fine.iter().map(|s| [s.0.x, s.0.y, s.0.z]).collect::<Vec<_>>(),
+                    "q": t.fine.iter().map(|s| q(&s.1)).collect::<Vec<_>>(),
+                    "fmax": t.fine.iter().map(|f| f.2.max_ratio).collect::<Vec<_>>(),
+                    "fslide": t.fine.iter().map(|f| f.2.sliding_share).collect::<Vec<_>>(),
+                    "fpoints": t.fine.iter().map(|f| f.2.points).collect::<Vec<_>>(),
+                });
+                writeln!(d, "{line}").expect("write --dump");
+            }
             match o.verdict {
                 Verdict::Hold => holds += 1,
                 Verdict::Slip => slips += 1,

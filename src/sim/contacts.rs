@@ -97,3 +97,61 @@ pub fn grip_contacts(scene: &Scene) -> Vec<GripContact> {
     out.sort_by_key(|c| (c.finger.map_or(0, |i| i + 1), c.phalanx));
     out
 }
+
+/// How close the hand's contacts on the object are to sliding, at the last substep.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct FrictionUse {
+    /// The largest `|tangent impulse| / (μ × normal impulse)` over the contact points that
+    /// carry at least 2 % of the total normal impulse (1 = at the edge of the friction cone).
+    pub max_ratio: f64,
+    /// The share of the total normal impulse carried by points at 98 % of the cone or more.
+    pub sliding_share: f64,
+    /// The number of contact points carrying a normal impulse.
+    pub points: usize,
+}
+
+/// The friction the solver used at the last substep on the contacts between the hand and the
+/// object, against what Coulomb's cone allows (the solver caps each point's tangent impulse at
+/// μ times its normal impulse).
+pub fn friction_use(scene: &Scene) -> FrictionUse {
+    let world = &scene.world;
+    let mut pts: Vec<(f64, f64)> = Vec::new();
+    for pair in world.narrow_phase.contact_pairs_with(scene.object_collider) {
+        let hand = if pair.collider1 == scene.object_collider {
+            pair.collider2
+        } else {
+            pair.collider1
+        };
+        if !scene.hand_colliders.contains(&hand) {
+            continue;
+        }
+        for m in pair.solver_manifolds() {
+            let mu = f64::from(m.data.friction);
+            for sc in &m.data.solver_contacts {
+                let id = (sc.contact_id[0] & !NEW_CONTACT_BIT) as usize;
+                let Some(p) = m.points.get(id) else { continue };
+                let n = f64::from(p.data.warmstart_impulse);
+                if n <= 0.0 {
+                    continue;
+                }
+                let t = f64::from(p.data.warmstart_tangent_impulse.norm());
+                let ratio = if mu > 0.0 { t / (mu * n) } else { 1.0 };
+                pts.push((n, ratio));
+            }
+        }
+    }
+    let total: f64 = pts.iter().map(|p| p.0).sum();
+    let mut out = FrictionUse {
+        points: pts.len(),
+        ..FrictionUse::default()
+    };
+    for (n, ratio) in pts {
+        if n >= 0.02 * total {
+            out.max_ratio = out.max_ratio.max(ratio);
+        }
+        if ratio >= 0.98 {
+            out.sliding_share += n / total;
+        }
+    }
+    out
+}

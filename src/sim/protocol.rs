@@ -282,6 +282,15 @@ pub struct HoldTrace {
     pub frame: RestFrame,
     /// The object's pose relative to the palm, one per sample.
     pub samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)>,
+    /// Four times finer ([`HoldTrace::fine_dt`]): the pose relative to the palm and how near
+    /// the hand's contacts were to sliding, for the study of other rules.
+    pub fine: Vec<(
+        Vector3<f64>,
+        UnitQuaternion<f64>,
+        super::contacts::FrictionUse,
+    )>,
+    /// Time between fine samples `[s]`.
+    pub fine_dt: f64,
     /// The hold's length `[s]`.
     pub duration_s: f64,
     /// Its outcome.
@@ -688,6 +697,8 @@ fn hold(
     };
     // Samples of the object's pose relative to the palm, for the rest rule.
     let mut samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)> = Vec::new();
+    let mut fine = Vec::new();
+    let fine_every = (sample_every / 4).max(1);
     let mut decided: Option<Decision> = None;
     let mut hand_was_still = false;
     let holds_itself = hand_holds_itself(scene, params);
@@ -695,6 +706,10 @@ fn hold(
     while steps < hold_steps {
         scene.world.step();
         steps += 1;
+        if tracing && early.is_none() && steps % fine_every == 0 {
+            let (p, q) = relative(scene);
+            fine.push((p, q, super::contacts::friction_use(scene)));
+        }
         if steps % sample_every != 0 || (early.is_none() && !tracing) {
             continue;
         }
@@ -786,6 +801,8 @@ fn hold(
                 v.push(HoldTrace {
                     frame,
                     samples,
+                    fine,
+                    fine_dt: fine_every as f64 * dt,
                     duration_s: hold_steps as f64 * dt,
                     outcome: outcome.clone(),
                 });

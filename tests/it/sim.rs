@@ -678,3 +678,43 @@ fn the_hand_starts_clear_of_the_collider() {
     assert!(margins.iter().any(|&m| m > 20.0), "{start}");
     assert!(margins.contains(&20.0), "{start}");
 }
+
+#[test]
+fn friction_use_tells_a_sticking_grip_from_a_sliding_one() {
+    // `contacts::friction_use` reads the solver's last substep: no point beyond Coulomb's cap,
+    // and under gravity along the cylinder's axis a grip with μ 0.3 holds with most of its load
+    // inside the cone (D40: a quarter at the edge, 4 µm moved), while with μ 0.002 the object
+    // slides (6 mm in 50 steps) with all of it at the edge. (The motors squeeze hard enough that
+    // μ 0.02 still holds.)
+    use grasp_sim::sim::contacts::friction_use;
+    use grasp_sim::sim::scene::build;
+    d40_case(Default::default(), |case| {
+        let measured = |friction: f64| {
+            let case = grasp_sim::sim::Case { friction, ..*case };
+            let mut scene = build(&case);
+            for i in 0..300 {
+                if i == 240 {
+                    scene.release_joint2();
+                }
+                scene.world.step();
+            }
+            scene.world.gravity = rapier3d::math::Vector::new(0.0, 0.0, -9.81);
+            let z0 = scene.world.bodies[scene.object].translation().z;
+            for _ in 0..50 {
+                scene.world.step();
+            }
+            let fell_mm = (z0 - scene.world.bodies[scene.object].translation().z) * 1000.0;
+            (friction_use(&scene), fell_mm)
+        };
+        let (held, held_mm) = measured(0.3);
+        let (sliding, sliding_mm) = measured(0.002);
+        for f in [&held, &sliding] {
+            assert!(f.points >= 3, "{f:?}");
+            assert!(f.max_ratio <= 1.0 + 1e-3, "beyond Coulomb's cap: {f:?}");
+        }
+        assert!(held_mm.abs() < 0.01, "μ 0.3 moved {held_mm} mm");
+        assert!(held.sliding_share < 0.5, "{held:?}");
+        assert!(sliding_mm > 0.5, "μ 0.002 moved only {sliding_mm} mm");
+        assert!(sliding.sliding_share > 0.9, "{sliding:?}");
+    });
+}
