@@ -13,7 +13,16 @@ use super::{GradedDomain, Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
 use crate::slice::Slice;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::OnceLock;
+
+/// The search tries this many candidates one at a time before it tries them in blocks on
+/// rayon's threads (most objects with a grasp find it sooner, and a block would be wasted work).
+const SEARCH_SEQUENTIAL: usize = 64;
+
+/// The largest block of candidates the search tries at once on rayon's threads.
+const SEARCH_BLOCK: usize = 32;
 
 /// A kinematically feasible enveloping grasp: the thesis's Grasp Parameter Set.
 #[derive(Debug, Clone, PartialEq)]
@@ -144,20 +153,42 @@ pub fn search_with(
     ];
     let angles = approach_angles_deg(graded, params);
     // The palm's vertical slice depends on the approach angle only: cut once per angle, when
-    // the search first needs it.
-    let mut vslices: Vec<Option<Slice>> = vec![None; angles.len()];
-    for &index in &graded.sorted_indices {
-        let z1 = graded.domain.elevations[index - 1];
-        for (&approach_deg, vslice) in angles.iter().zip(&mut vslices) {
+    // the search first needs it (by whichever thread gets there first).
+    let vslices: Vec<OnceLock<Slice>> = angles.iter().map(|_| OnceLock::new()).collect();
+    let candidates: Vec<(usize, usize)> = graded
+        .sorted_indices
+        .iter()
+        .flat_map(|&index| (0..angles.len()).map(move |a| (index, a)))
+        .collect();
+    let evaluate = |&(index, a): &(usize, usize)| {
+        let approach_deg = angles[a];
+        let vslice =
+            vslices[a].get_or_init(|| vertical_slice(mesh, hand, approach_deg.to_radians()));
+        let candidate = Candidate {
+            z1: graded.domain.elevations[index - 1],
+            approach_deg,
+            vslice,
+        };
+        try_candidate(mesh, hand, &candidate, params, deviation, rules)
+    };
+    // Candidates are tried in blocks on rayon's threads, each block's results then taken in
+    // search order: the grasps, the count tried and the rejections are the sequential search's
+    // (a candidate's outcome depends on nothing but the candidate). The first SEARCH_SEQUENTIAL
+    // go one at a time, so a grasp found early (a thesis object's within a few dozen) costs no
+    // more than before; then the blocks double from 2 up to SEARCH_BLOCK, and a long search
+    // wastes at most one block beyond its last grasp.
+    let mut start = 0;
+    let mut block = 2;
+    while start < candidates.len() {
+        let end = (start + if start < SEARCH_SEQUENTIAL { 1 } else { block }).min(candidates.len());
+        let results: Vec<_> = if end - start == 1 {
+            vec![evaluate(&candidates[start])]
+        } else {
+            candidates[start..end].par_iter().map(evaluate).collect()
+        };
+        for (&(index, a), result) in candidates[start..end].iter().zip(results) {
             tried += 1;
-            let vslice =
-                vslice.get_or_insert_with(|| vertical_slice(mesh, hand, approach_deg.to_radians()));
-            let candidate = Candidate {
-                z1,
-                approach_deg,
-                vslice,
-            };
-            match try_candidate(mesh, hand, &candidate, params, deviation, rules) {
+            match result {
                 Ok((palm, fingers)) => {
                     let mut relaxations: Vec<Relaxation> = fingers
                         .iter()
@@ -178,8 +209,8 @@ pub fn search_with(
                     relaxations.dedup();
                     let go_on = on_grasp(Grasp {
                         elevation_index: index,
-                        elevation_mm: z1,
-                        approach_angle_deg: approach_deg,
+                        elevation_mm: graded.domain.elevations[index - 1],
+                        approach_angle_deg: angles[a],
                         palm,
                         fingers,
                         rules,
@@ -192,6 +223,10 @@ pub fn search_with(
                 Err(r) => *rejections.entry(r).or_insert(0) += 1,
             }
         }
+        if start >= SEARCH_SEQUENTIAL {
+            block = (2 * block).min(SEARCH_BLOCK);
+        }
+        start = end;
     }
     (tried, rejections)
 }

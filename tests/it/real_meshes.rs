@@ -516,3 +516,29 @@ fn a_slot_too_wide_to_close_is_reported_open() {
         r.warnings
     );
 }
+
+#[test]
+fn the_search_on_two_threads_finds_what_it_finds_on_one() {
+    // The search tries its candidates in blocks on rayon's threads once it has tried 64 one at
+    // a time. A flat box finds its grasp only under the last rule set, after every axis under
+    // the others: on one thread and on two, the same grasp, the same candidates tried, the
+    // same rejections.
+    let soup = cuboid([0.0, 0.0, 75.0], [100.0, 30.0, 150.0]);
+    let plan_on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let r = pool.install(|| run_soup(&soup, false));
+        let mut plan = serde_json::to_value(&r.plan).unwrap();
+        plan.as_object_mut().unwrap().remove("timings_ms");
+        // The most candidates one search (one axis, one rule set) tried.
+        let most = r.plan.axes.iter().map(|a| a.candidates_tried).max();
+        (most.unwrap_or(0), plan)
+    };
+    let (most, one) = plan_on(1);
+    let (_, two) = plan_on(2);
+    assert!(most > 64, "at most {most} candidates a search: no blocks");
+    assert!(one["grasp"].is_object(), "no grasp: {one}");
+    assert_eq!(one, two);
+}
