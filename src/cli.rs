@@ -22,7 +22,7 @@ pub struct Cli {
 
     /// Length unit of bare meshes given on the command line (scenarios say theirs in
     /// `[object] units`).
-    #[arg(long, value_name = "UNIT", default_value = "mm", value_parser = ["mm", "m", "inch"])]
+    #[arg(long, value_name = "UNIT", default_value = "mm", value_parser = ["mm", "cm", "m", "inch"])]
     pub units: String,
 
     /// Print one JSON object per scenario (JSON Lines) instead of the summary.
@@ -110,7 +110,7 @@ pub enum Command {
         #[arg(long)]
         template: Option<PathBuf>,
         /// As `batch --units`.
-        #[arg(long)]
+        #[arg(long, value_parser = ["mm", "cm", "m", "inch"])]
         units: Option<String>,
         /// As `batch --no-sim`.
         #[arg(long)]
@@ -169,7 +169,7 @@ pub struct BatchArgs {
     #[arg(long, value_name = "SCENARIO")]
     pub template: Option<PathBuf>,
     /// Length unit of bare meshes (overrides the template's).
-    #[arg(long, value_name = "UNIT", value_parser = ["mm", "m", "inch"])]
+    #[arg(long, value_name = "UNIT", value_parser = ["mm", "cm", "m", "inch"])]
     pub units: Option<String>,
     /// Write the JSON lines to this file instead of stdout (written whole, or not at all;
     /// with --resume, appended as objects finish).

@@ -346,6 +346,7 @@ fn parse_units(s: &str) -> grasp_sim::mesh::LengthUnit {
     use grasp_sim::mesh::LengthUnit;
     match s {
         "m" => LengthUnit::M,
+        "cm" => LengthUnit::Cm,
         "inch" => LengthUnit::Inch,
         _ => LengthUnit::Mm,
     }

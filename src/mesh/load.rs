@@ -27,16 +27,29 @@ pub enum LengthUnit {
     Mm,
     /// Metres.
     M,
+    /// Centimetres.
+    Cm,
     /// Inches (25.4 mm).
     Inch,
 }
 
 impl LengthUnit {
+    /// The unit as scenarios and `--units` name it.
+    pub fn name(self) -> &'static str {
+        match self {
+            LengthUnit::Mm => "mm",
+            LengthUnit::Cm => "cm",
+            LengthUnit::M => "m",
+            LengthUnit::Inch => "inch",
+        }
+    }
+
     /// Millimetres per unit.
     pub fn to_mm(self) -> f64 {
         match self {
             LengthUnit::Mm => 1.0,
             LengthUnit::M => 1000.0,
+            LengthUnit::Cm => 10.0,
             LengthUnit::Inch => 25.4,
         }
     }
@@ -476,48 +489,53 @@ impl LoadedMesh {
     }
 
     /// A warning when the object's size is implausible for a hand (under 5 mm or over 2 m along
-    /// its largest extent), naming the unit it was read in and the likely one.
+    /// its largest extent), naming the unit it was read in and the likely one: of the other
+    /// units, the one that makes it plausible and nearest 100 mm (a hand-sized object).
     pub fn units_warning(&self) -> Option<String> {
         let (lo, hi) = self.mesh.bounds();
         let size = (hi - lo).max();
-        let read = match self.unit {
-            LengthUnit::Mm => "mm",
-            LengthUnit::M => "m",
-            LengthUnit::Inch => "inch",
-        };
-        let in_unit = size / self.unit.to_mm();
-        let likely = |unit: &str, factor: f64| {
-            format!(
-                "the object is {} {read} across as read (units = \"{read}\"): implausible for a \
-                 hand; if the file is in {unit} (the object then {} mm across), set units = \
-                 \"{unit}\" in [object], or --units {unit} for a bare mesh",
-                fmt_size(in_unit),
-                fmt_size(size * factor)
-            )
-        };
-        if size < PLAUSIBLE_MIN_MM {
-            // Too small: the file is probably in metres.
-            match self.unit {
-                LengthUnit::Mm => Some(likely("m", 1000.0)),
-                LengthUnit::Inch => Some(likely("m", 1000.0 / 25.4)),
-                LengthUnit::M => Some(format!(
-                    "the object is {} across: implausibly small for a hand",
-                    fmt_mm(size)
-                )),
-            }
-        } else if size > PLAUSIBLE_MAX_MM {
-            // Too large: the file is probably in millimetres.
-            match self.unit {
-                LengthUnit::M => Some(likely("mm", 1.0 / 1000.0)),
-                LengthUnit::Inch => Some(likely("mm", 1.0 / 25.4)),
-                LengthUnit::Mm => Some(format!(
-                    "the object is {} across: implausibly large for a hand",
-                    fmt_mm(size)
-                )),
-            }
-        } else {
-            None
+        if (PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(&size) {
+            return None;
         }
+        let read = self.unit.name();
+        let in_unit = size / self.unit.to_mm();
+        let likely = [
+            LengthUnit::Mm,
+            LengthUnit::Cm,
+            LengthUnit::M,
+            LengthUnit::Inch,
+        ]
+        .into_iter()
+        .filter(|&u| u != self.unit)
+        .map(|u| (u, in_unit * u.to_mm()))
+        .filter(|(_, mm)| (PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(mm))
+        .min_by(|a, b| {
+            (a.1 / 100.0)
+                .ln()
+                .abs()
+                .total_cmp(&(b.1 / 100.0).ln().abs())
+        });
+        Some(match likely {
+            Some((unit, mm)) => {
+                let unit = unit.name();
+                format!(
+                    "the object is {} {read} across as read (units = \"{read}\"): implausible for \
+                     a hand; if the file is in {unit} (the object then {} mm across), set units = \
+                     \"{unit}\" in [object], or --units {unit} for a bare mesh",
+                    fmt_size(in_unit),
+                    fmt_size(mm)
+                )
+            }
+            None => format!(
+                "the object is {} across: implausibly {} for a hand",
+                fmt_mm(size),
+                if size < PLAUSIBLE_MIN_MM {
+                    "small"
+                } else {
+                    "large"
+                }
+            ),
+        })
     }
 }
 

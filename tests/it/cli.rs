@@ -529,6 +529,23 @@ fn implausible_sizes_warn_with_the_likely_unit() {
     // A plausible object says nothing of units.
     let out = env.run(&["--no-sim", "cyl.stl"]);
     assert!(!String::from_utf8_lossy(&out.stderr).contains("implausible"));
+    // A file in centimetres read as metres: centimetres is the unit that makes it hand-sized
+    // (12.4 cm; millimetres would make it 12.4 mm), and `--units cm` reads it so.
+    let mut m = grasp_sim::objects::cylinder(40.0, 124.0);
+    m.map_vertices(|p| p / 10.0);
+    env.write("in_cm.stl", m.to_binary_stl());
+    let out = env.run(&["--no-sim", "--units", "m", "in_cm.stl"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("12.4 m across as read") && err.contains("--units cm"),
+        "{err}"
+    );
+    let out = env.run(&["--json", "--no-sim", "--units", "cm", "in_cm.stl"]);
+    crate::assert_success(&out);
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let height = r["object"]["height_mm"].as_f64().unwrap();
+    assert!((height - 124.0).abs() < 1e-3, "{height}"); // STL keeps f32
+    assert!(!String::from_utf8_lossy(&out.stderr).contains("implausible"));
 }
 
 /// Issue 16 item 10: `gen-assets` outside the repository writes scenarios that run there (they
