@@ -125,6 +125,8 @@ fn main() {
                     "duration_s": t.duration_s, "sample_dt": t.fine_dt,
                     "thresholds": [s.sim.hold_translation_mm, s.sim.hold_rotation_deg],
                     "safety": s.sim.rest_safety,
+                    "margin": s.sim.rest_margin, "window_s": s.sim.rest_window_s,
+                    "rule_every": (t.frame.sample_dt / t.fine_dt).round() as usize,
                     "pc": [t.frame.pc.x, t.frame.pc.y, t.frame.pc.z], "qc": q(&t.frame.qc),
                     "revolution": t.frame.is_revolution,
                     "p": t.fine.iter().map(|s| [s.0.x, s.0.y, s.0.z]).collect::<Vec<_>>(),

@@ -10,8 +10,8 @@ palm and, from the solver's last substep, how near the hand's contacts were to t
 friction cone (`fmax`: the largest |tangent| / (mu x normal) impulse over the points carrying 2 %
 of the load; `fslide`: the share of the normal load at 98 % of the cone or more).
 
-First the default rule (0.2 s window, margin 0.8, sampled every 1/48 s) is replayed as
-`EarlyDecision::decide` computes it: its counts must be the Rust study's default row. Then, beside
+First the default rule (the scenario's window and margin, sampled as the protocol samples, every
+1/48 s) is replayed as `EarlyDecision::decide` computes it: its counts must be the Rust study's default row. Then, beside
 it, a hold may also be decided over a shorter window (sampled every 1/96 s) when the contacts
 carried at most a given share of their load at the cone's edge throughout that window. A
 decision is wrong when the full hold ends with another verdict; its numbers are off when the
@@ -22,7 +22,7 @@ import sys
 
 import numpy as np
 
-REPORT_ABS, REPORT_FRACTION, MARGIN, WINDOW_S = 0.5, 0.1, 0.8, 0.2
+REPORT_ABS, REPORT_FRACTION = 0.5, 0.1
 
 
 def z_axes(q):
@@ -80,9 +80,10 @@ def decide(h, i, window_s, every):
     ):
         return None
     th_mm, th_deg = h["thresholds"]
-    if now_mm + more_mm <= MARGIN * th_mm and now_deg + more_deg <= MARGIN * th_deg:
+    margin = h.get("margin", 0.8)
+    if now_mm + more_mm <= margin * th_mm and now_deg + more_deg <= margin * th_deg:
         return "hold"
-    if now_mm - more_mm >= th_mm / MARGIN or now_deg - more_deg >= th_deg / MARGIN:
+    if now_mm - more_mm >= th_mm / margin or now_deg - more_deg >= th_deg / margin:
         return "slip"
     return "slip" if h["penetrated"] else None
 
@@ -92,14 +93,17 @@ def rule(short_s=None, max_share=None):
     of the load was at the cone's edge at every fine sample of it."""
 
     def at(h, i):
-        if (i + 1) % 4 == 0:
-            v = decide(h, i, WINDOW_S, 4)
+        # The default rule on its own samples (every `rule_every` fine samples, 1/48 s).
+        every = h.get("rule_every", 4)
+        if (i + 1) % every == 0:
+            v = decide(h, i, h.get("window_s", 0.2), every)
             if v:
                 return v
+        # The short window on every other fine sample; the gate over the same samples.
         if short_s is not None and (i + 1) % 2 == 0:
-            j = i - round(short_s / h["sample_dt"])
+            j = i - max(1, round(short_s / (h["sample_dt"] * 2))) * 2
             if j >= 0 and (h["fpoints"][j : i + 1] > 0).all():
-                if h["fslide"][j : i + 1].max() <= max_share and decide(h, i, short_s, 2) == "hold":
+                if h["fslide"][j : i + 1].max() <= max_share + 1e-9 and decide(h, i, short_s, 2) == "hold":
                     return "hold"
         return None
 

@@ -143,6 +143,21 @@ pub fn search_with(
     graded: &GradedDomain,
     params: &PlannerParams,
     rules: RuleSet,
+    on_grasp: impl FnMut(Grasp) -> bool,
+) -> (usize, BTreeMap<Rejection, usize>) {
+    let schedule = (SEARCH_SEQUENTIAL, SEARCH_BLOCK);
+    search_scheduled(mesh, hand, graded, params, rules, schedule, on_grasp)
+}
+
+/// [`search_with`], trying the first `sequential` candidates one at a time and then blocks
+/// doubling from 2 up to `max_block` (the tests compare schedules).
+fn search_scheduled(
+    mesh: &Mesh,
+    hand: &Hand,
+    graded: &GradedDomain,
+    params: &PlannerParams,
+    rules: RuleSet,
+    (sequential, max_block): (usize, usize),
     mut on_grasp: impl FnMut(Grasp) -> bool,
 ) -> (usize, BTreeMap<Rejection, usize>) {
     let mut tried = 0;
@@ -178,9 +193,9 @@ pub fn search_with(
     // more than before; then the blocks double from 2 up to SEARCH_BLOCK, and a long search
     // wastes at most one block beyond its last grasp.
     let mut start = 0;
-    let mut block = 2;
+    let mut block = 2.min(max_block.max(1));
     while start < candidates.len() {
-        let end = (start + if start < SEARCH_SEQUENTIAL { 1 } else { block }).min(candidates.len());
+        let end = (start + if start < sequential { 1 } else { block }).min(candidates.len());
         let results: Vec<_> = if end - start == 1 {
             vec![evaluate(&candidates[start])]
         } else {
@@ -223,8 +238,8 @@ pub fn search_with(
                 Err(r) => *rejections.entry(r).or_insert(0) += 1,
             }
         }
-        if start >= SEARCH_SEQUENTIAL {
-            block = (2 * block).min(SEARCH_BLOCK);
+        if start >= sequential {
+            block = (2 * block).min(max_block);
         }
         start = end;
     }
@@ -321,4 +336,68 @@ fn palm_backoff_in_finger_planes(mesh: &Mesh, hand: &Hand, palm: &PalmPlacement)
         }
     }
     depth
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::report::StageTimings;
+
+    #[test]
+    fn every_schedule_gives_the_one_at_a_time_search() {
+        // A flat box under the pinch rules: 96 candidates, 24 grasps. One at a time (the
+        // reference) against blocks from the first candidate, odd blocks, and the default, each
+        // run to the end and stopped after the first few grasps (a stop inside a block): the
+        // same grasps, the same count tried, the same rejections.
+        let hand = Hand::load(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/hands/thesis.toml"),
+            &[],
+        )
+        .unwrap();
+        let aligned = crate::mesh::align(&crate::objects::prism(100.0, 30.0, 150.0));
+        // A coarse grid keeps the test short: some 200 candidates.
+        let params = PlannerParams {
+            angular_step_deg: 45.0,
+            height_step_mm: 10.0,
+            ..PlannerParams::default()
+        };
+        let rules = RuleSet::Pinch;
+        let mut t = StageTimings::default();
+        let graded =
+            super::super::grade_domain_with(&aligned.mesh, &hand, &params, 0.3, rules, &mut t);
+        let run = |schedule: (usize, usize), stop_after: usize| {
+            let mut grasps = Vec::new();
+            let (tried, rejections) = search_scheduled(
+                &aligned.mesh,
+                &hand,
+                &graded,
+                &params,
+                rules,
+                schedule,
+                |g| {
+                    grasps.push(g);
+                    grasps.len() < stop_after
+                },
+            );
+            (tried, rejections, grasps)
+        };
+        let whole = run((usize::MAX, 1), usize::MAX);
+        assert!(whole.0 > 64, "{} candidates", whole.0);
+        assert!(whole.2.len() >= 3, "{} grasps", whole.2.len());
+        // Stops early, and late (past the 64 tried one at a time by default).
+        for stop_after in [usize::MAX, 1, 2, 3, whole.2.len() - 2] {
+            let reference = if stop_after == usize::MAX {
+                whole.clone()
+            } else {
+                run((usize::MAX, 1), stop_after)
+            };
+            for schedule in [(0, 3), (0, 32), (5, 7), (SEARCH_SEQUENTIAL, SEARCH_BLOCK)] {
+                assert_eq!(
+                    run(schedule, stop_after),
+                    reference,
+                    "schedule {schedule:?}, stopped after {stop_after} grasps"
+                );
+            }
+        }
+    }
 }

@@ -683,7 +683,8 @@ fn the_hand_starts_clear_of_the_collider() {
 fn friction_use_tells_a_sticking_grip_from_a_sliding_one() {
     // `contacts::friction_use` reads the solver's last substep: no point beyond Coulomb's cap,
     // and under gravity along the cylinder's axis a grip with μ 0.3 holds with most of its load
-    // inside the cone (D40: a quarter at the edge, 4 µm moved), while with μ 0.002 the object
+    // inside the cone (D40 after this fixed closing: a quarter at the edge, 4 µm moved; the
+    // study's closings leave 10–16 %), while with μ 0.002 the object
     // slides (6 mm in 50 steps) with all of it at the edge. (The motors squeeze hard enough that
     // μ 0.02 still holds.)
     use grasp_sim::sim::contacts::friction_use;
