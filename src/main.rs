@@ -344,12 +344,8 @@ fn tune(
 
 fn parse_units(s: &str) -> grasp_sim::mesh::LengthUnit {
     use grasp_sim::mesh::LengthUnit;
-    match s {
-        "m" => LengthUnit::M,
-        "cm" => LengthUnit::Cm,
-        "inch" => LengthUnit::Inch,
-        _ => LengthUnit::Mm,
-    }
+    // clap has checked the name against the same list.
+    LengthUnit::from_name(s).unwrap_or_default()
 }
 
 fn default_jobs() -> usize {

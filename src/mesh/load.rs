@@ -34,6 +34,19 @@ pub enum LengthUnit {
 }
 
 impl LengthUnit {
+    /// Every unit, smallest first.
+    pub const ALL: [LengthUnit; 4] = [
+        LengthUnit::Mm,
+        LengthUnit::Cm,
+        LengthUnit::Inch,
+        LengthUnit::M,
+    ];
+
+    /// The unit named `name` as scenarios and `--units` name it.
+    pub fn from_name(name: &str) -> Option<LengthUnit> {
+        LengthUnit::ALL.into_iter().find(|u| u.name() == name)
+    }
+
     /// The unit as scenarios and `--units` name it.
     pub fn name(self) -> &'static str {
         match self {
@@ -499,22 +512,17 @@ impl LoadedMesh {
         }
         let read = self.unit.name();
         let in_unit = size / self.unit.to_mm();
-        let likely = [
-            LengthUnit::Mm,
-            LengthUnit::Cm,
-            LengthUnit::M,
-            LengthUnit::Inch,
-        ]
-        .into_iter()
-        .filter(|&u| u != self.unit)
-        .map(|u| (u, in_unit * u.to_mm()))
-        .filter(|(_, mm)| (PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(mm))
-        .min_by(|a, b| {
-            (a.1 / 100.0)
-                .ln()
-                .abs()
-                .total_cmp(&(b.1 / 100.0).ln().abs())
-        });
+        let likely = LengthUnit::ALL
+            .into_iter()
+            .filter(|&u| u != self.unit)
+            .map(|u| (u, in_unit * u.to_mm()))
+            .filter(|(_, mm)| (PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(mm))
+            .min_by(|a, b| {
+                (a.1 / 100.0)
+                    .ln()
+                    .abs()
+                    .total_cmp(&(b.1 / 100.0).ln().abs())
+            });
         Some(match likely {
             Some((unit, mm)) => {
                 let unit = unit.name();
