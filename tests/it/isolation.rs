@@ -68,8 +68,24 @@ fn a_crash_costs_one_error_line() {
 
 #[test]
 fn an_object_past_the_time_limit_is_stopped() {
-    // A real slow input: the cup's payload search takes several seconds (about 9 in a debug
-    // build); the D10 cylinder is ungraspable in milliseconds.
+    // A real slow input: the cup's payload search under the full-length reference protocol in
+    // six directions closes the hand again for every direction and multiplier and holds each
+    // for 2 s (about 20 s in a release build, longer in the test build); the D10 cylinder is
+    // ungraspable in milliseconds. (The fast protocol's payload search, 1.3 s in the test
+    // build on CI's machine, is no longer slow enough.)
+    let dir = tempfile::tempdir().unwrap();
+    let slow = dir.path().join("cup_full_six.toml");
+    let mesh = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/objects/cup.stl");
+    std::fs::write(
+        &slow,
+        format!(
+            "name = \"cup, full protocol\"\n[object]\nmesh = {:?}\n\
+             [hand]\nfile = {:?}\n[sim]\nprotocol = \"full\"\ngravity = \"six\"\n",
+            mesh,
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/hands/thesis.toml"),
+        ),
+    )
+    .unwrap();
     let t0 = std::time::Instant::now();
     let out = crate::grasp_sim()
         .args([
@@ -79,9 +95,9 @@ fn an_object_past_the_time_limit_is_stopped() {
             "1.5",
             "--jobs",
             "2",
-            "scenarios/cylinder_d10.toml",
-            "scenarios/cup.toml",
         ])
+        .arg("scenarios/cylinder_d10.toml")
+        .arg(&slow)
         .output()
         .unwrap();
     let elapsed = t0.elapsed().as_secs_f64();
