@@ -143,7 +143,13 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
     let report = RunReport {
         scenario: scenario.name.clone(),
         object: object_report(scenario, &object),
-        warnings: warnings(scenario, &object, &shown.graded, plan.open_slices),
+        warnings: warnings(
+            scenario,
+            &object,
+            &shown.graded,
+            plan.open_slices,
+            plan.status == PlanStatus::Ungraspable,
+        ),
         plan,
         sim,
         expect,
@@ -238,17 +244,24 @@ fn object_report(scenario: &Scenario, object: &PreparedObject) -> ObjectReport {
     }
 }
 
-/// The input's warnings: the loader's, and open vertical slices of the axis reported.
+/// The input's warnings: the loader's, open vertical slices of the axis reported and, for an
+/// ungraspable object small for the hand, the unit that would make it hand-sized.
 fn warnings(
     scenario: &Scenario,
     object: &PreparedObject,
     graded: &plan::GradedDomain,
     open_slices: usize,
+    ungraspable: bool,
 ) -> Vec<String> {
     object
         .loaded
         .warnings()
         .into_iter()
+        .chain(
+            ungraspable
+                .then(|| object.loaded.small_object_hint(graded.range.min_mm))
+                .flatten(),
+        )
         .chain((open_slices > 0).then(|| {
             format!(
                 "{open_slices} of {} vertical slices stay open after joining their ends: \

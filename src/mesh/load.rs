@@ -501,6 +501,42 @@ impl LoadedMesh {
         w
     }
 
+    /// For an object the planner found ungraspable: a hint when it is plausibly sized but
+    /// smaller than twice the smallest diameter the hand grasps (`smallest_grasp_mm`), and a
+    /// larger unit makes it hand-sized, as a file in centimetres read as millimetres does. Of
+    /// the larger units, the one that puts its largest extent nearest 100 mm is named. `None`
+    /// when [`Self::units_warning`] already speaks of the size.
+    pub fn small_object_hint(&self, smallest_grasp_mm: f64) -> Option<String> {
+        let (lo, hi) = self.mesh.bounds();
+        let size = (hi - lo).max();
+        if !(PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(&size) || size >= 2.0 * smallest_grasp_mm
+        {
+            return None;
+        }
+        let read = self.unit.name();
+        let in_unit = size / self.unit.to_mm();
+        let (unit, mm) = LengthUnit::ALL
+            .into_iter()
+            .filter(|&u| u.to_mm() > self.unit.to_mm())
+            .map(|u| (u, in_unit * u.to_mm()))
+            .filter(|&(_, mm)| mm >= 2.0 * smallest_grasp_mm && mm <= PLAUSIBLE_MAX_MM)
+            .min_by(|a, b| {
+                (a.1 / 100.0)
+                    .ln()
+                    .abs()
+                    .total_cmp(&(b.1 / 100.0).ln().abs())
+            })?;
+        let unit = unit.name();
+        Some(format!(
+            "the object is {} across as read (units = \"{read}\"), small for a hand that grasps \
+             {} and more; if the file is in {unit} (the object then {} mm across), set units = \
+             \"{unit}\" in [object], or --units {unit} for a bare mesh",
+            fmt_mm(size),
+            fmt_mm(smallest_grasp_mm),
+            fmt_size(mm)
+        ))
+    }
+
     /// A warning when the object's size is implausible for a hand (under 5 mm or over 2 m along
     /// its largest extent), naming the unit it was read in and the likely one: of the other
     /// units, the one that makes it plausible and nearest 100 mm (a hand-sized object).

@@ -546,6 +546,24 @@ fn implausible_sizes_warn_with_the_likely_unit() {
     let height = r["object"]["height_mm"].as_f64().unwrap();
     assert!((height - 124.0).abs() < 1e-3, "{height}"); // STL keeps f32
     assert!(!String::from_utf8_lossy(&out.stderr).contains("implausible"));
+    // The same file read as millimetres is 12.4 mm: plausible in size, but smaller than twice
+    // the thesis hand's smallest grasp (17.4 mm) and ungraspable, so the hint names
+    // centimetres (124 mm; inches would give 315 mm). Planned, it says nothing.
+    let out = env.run(&["--json", "--no-sim", "in_cm.stl"]);
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["plan"]["status"], "ungraspable");
+    let hint = "in_cm.stl: the object is 12.4 mm across as read (units = \"mm\"), small for a \
+                hand that grasps 17.4 mm and more; if the file is in cm (the object then 124 mm \
+                across), set units = \"cm\" in [object], or --units cm for a bare mesh";
+    assert_eq!(
+        r["warnings"],
+        serde_json::json!([hint]),
+        "{}",
+        r["warnings"]
+    );
+    let out = env.run(&["--json", "--no-sim", "cyl.stl"]);
+    let r: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(r["warnings"], serde_json::json!([]), "{}", r["warnings"]);
 }
 
 /// Issue 16 item 10: `gen-assets` outside the repository writes scenarios that run there (they
