@@ -24,7 +24,7 @@
 //! table) and `OUT_DIR/quality_epsilon_payload.svg`, and prints the statistics.
 //! `quality_study OUT_DIR --report-only` writes the last two again from the first two.
 
-use grasp_sim::scenario::{GravityMode, MassSpec, Scenario};
+use grasp_sim::scenario::{GravityMode, Scenario};
 use grasp_sim::{mesh, plan, quality, select, sim};
 use plotters::prelude::*;
 use rayon::prelude::*;
@@ -83,10 +83,7 @@ fn plan_one(path: &Path, collect: usize) -> Result<Planned, String> {
     let loaded = mesh::load_mesh(&sc.object.mesh, sc.object.units).map_err(|e| e.to_string())?;
     let props = mesh::mass_properties(&loaded.mesh);
     let volume = props.volume_mm3;
-    let mass_kg = match sc.object.mass {
-        MassSpec::Mass(m) => m,
-        MassSpec::Density(d) => d * volume * 1e-9,
-    };
+    let mass_kg = sc.object.mass.mass_kg(volume, loaded.mass_kg);
     let no_check = |_: &mesh::AlignedObject, _: &plan::search::Grasp| -> sim::SimOutcome {
         unreachable!("max_checked is None")
     };

@@ -15,8 +15,8 @@ use std::path::PathBuf;
     subcommand_negates_reqs = true
 )]
 pub struct Cli {
-    /// Scenario files (TOML) or bare meshes (STL, OBJ, PLY) to run, in order. A bare mesh runs
-    /// with the bundled thesis hand and the defaults, and judges nothing.
+    /// Scenario files (TOML) or bare meshes (STL, OBJ, PLY, or an object's URDF) to run, in
+    /// order. A bare mesh runs with the bundled thesis hand and the defaults, and judges nothing.
     #[arg(required = true, value_name = "SCENARIO | MESH")]
     pub scenarios: Vec<PathBuf>,
 
@@ -126,7 +126,7 @@ pub enum Command {
     /// rate, then mean payload margin, then mean translation); writes tune.csv, tune.json and
     /// score_<param>.svg into --out.
     Tune {
-        /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
+        /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply, .urdf).
         #[arg(required = true, value_name = "DIR | SCENARIO")]
         inputs: Vec<PathBuf>,
         // Help: NAME=START:END:STEP, repeatable, and the names of tune::TunedParam.
@@ -162,7 +162,7 @@ pub enum Command {
 /// `grasp-sim batch` flags.
 #[derive(Debug, clap::Args)]
 pub struct BatchArgs {
-    /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply).
+    /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply, .urdf).
     #[arg(required = true, value_name = "DIR | SCENARIO")]
     pub inputs: Vec<PathBuf>,
     /// Scenario used for bare meshes (default: the thesis hand and defaults).

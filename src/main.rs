@@ -141,7 +141,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
                     grasp_sim::batch::Item::Scenario(_)
                         if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
                     {
-                        " (read as a scenario: grasp-sim reads scenarios from .toml files and meshes from .stl, .obj and .ply)"
+                        " (read as a scenario: grasp-sim reads scenarios from .toml files and meshes from .stl, .obj, .ply and .urdf)"
                     }
                     _ => "",
                 };
@@ -662,7 +662,7 @@ fn batch_worker(
     let template = batch_template(template, units)?;
     let item = batch::classify(path.to_path_buf()).ok_or_else(|| {
         anyhow::anyhow!(
-            "{}: neither a scenario (.toml) nor a mesh (.stl, .obj, .ply)",
+            "{}: neither a scenario (.toml) nor a mesh (.stl, .obj, .ply, .urdf)",
             path.display()
         )
     })?;

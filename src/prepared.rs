@@ -41,7 +41,7 @@ impl PreparedObject {
         let props = mesh::mass_properties(&loaded.mesh);
         let aligned = mesh::align_with(&loaded.mesh, &props, GraspAxis::THESIS);
         timings.align = ms(t1);
-        let mass_kg = object.mass.mass_kg(props.volume_mm3);
+        let mass_kg = object.mass.mass_kg(props.volume_mm3, loaded.mass_kg);
         Ok(PreparedObject {
             loaded,
             props,

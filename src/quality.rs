@@ -1092,10 +1092,7 @@ mod tests {
                 continue;
             };
             let props = crate::mesh::mass_properties(&loaded.mesh);
-            let mass_kg = match sc.object.mass {
-                crate::scenario::MassSpec::Mass(m) => m,
-                crate::scenario::MassSpec::Density(d) => d * props.volume_mm3 * 1e-9,
-            };
+            let mass_kg = sc.object.mass.mass_kg(props.volume_mm3, loaded.mass_kg);
             let no_check =
                 |_: &crate::mesh::AlignedObject,
                  _: &crate::plan::search::Grasp|

@@ -92,7 +92,7 @@ impl ObjectSpec {
         ObjectSpec {
             mesh,
             units: LengthUnit::default(),
-            mass: MassSpec::Density(DEFAULT_DENSITY_KG_M3),
+            mass: MassSpec::Default,
             friction: DEFAULT_FRICTION,
         }
     }
@@ -105,14 +105,19 @@ pub enum MassSpec {
     Density(f64),
     /// Total mass `[kg]`.
     Mass(f64),
+    /// Neither given: the object file's own mass (a URDF's links' `<inertial>` masses) when it
+    /// has one, else [`DEFAULT_DENSITY_KG_M3`].
+    Default,
 }
 
 impl MassSpec {
-    /// The mass `[kg]` of an object of `volume_mm3` `[mm³]`.
-    pub fn mass_kg(self, volume_mm3: f64) -> f64 {
+    /// The mass `[kg]` of an object of `volume_mm3` `[mm³]` whose file gives `file_mass_kg`
+    /// (a URDF's inertial masses), used only when the scenario gives neither mass nor density.
+    pub fn mass_kg(self, volume_mm3: f64, file_mass_kg: Option<f64>) -> f64 {
         match self {
             MassSpec::Mass(m) => m,
             MassSpec::Density(d) => d * volume_mm3 * 1e-9,
+            MassSpec::Default => file_mass_kg.unwrap_or(DEFAULT_DENSITY_KG_M3 * volume_mm3 * 1e-9),
         }
     }
 }
@@ -281,7 +286,7 @@ impl Scenario {
             }
             (Some(d), None) => MassSpec::Density(d),
             (None, Some(m)) => MassSpec::Mass(m),
-            (None, None) => MassSpec::Density(DEFAULT_DENSITY_KG_M3),
+            (None, None) => MassSpec::Default,
         };
         match mass {
             MassSpec::Density(d) if !(d.is_finite() && d > 0.0) => {
@@ -416,7 +421,7 @@ mod tests {
         let s = parse("", "").unwrap();
         assert_eq!(s.name, "cup_test");
         assert_eq!(s.object.mesh, PathBuf::from("/nowhere/cup.stl"));
-        assert_eq!(s.object.mass, MassSpec::Density(DEFAULT_DENSITY_KG_M3));
+        assert_eq!(s.object.mass, MassSpec::Default);
         assert_eq!(s.object.friction, 0.3);
         assert_eq!(s.hand.name, "thesis");
         assert_eq!(s.hand_file, PathBuf::from("<bundled hand thesis>"));

@@ -92,7 +92,8 @@ impl Item {
 }
 
 /// Expands inputs into items, in a deterministic order. A folder gives its scenarios (`*.toml`)
-/// when it has any (they name their own meshes), its meshes (`*.stl`, `*.obj`, `*.ply`) otherwise.
+/// when it has any (they name their own meshes), else its URDFs (`*.urdf`, which name theirs),
+/// else its meshes (`*.stl`, `*.obj`, `*.ply`).
 ///
 /// # Errors
 /// [`ScenarioError::Io`] for an input that does not exist or is neither a folder, a `.toml` nor
@@ -113,13 +114,16 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
                 .collect();
             if found.iter().any(|i| matches!(i, Item::Scenario(_))) {
                 found.retain(|i| matches!(i, Item::Scenario(_)));
+            } else if found.iter().any(|i| is_urdf(i.path())) {
+                found.retain(|i| is_urdf(i.path()));
             }
             found.sort_by(|a, b| a.path().cmp(b.path()));
             items.extend(found);
         } else if input.is_file() {
             items.push(classify(input.clone()).ok_or_else(|| ScenarioError::Io {
                 path: input.clone(),
-                message: "neither a scenario (.toml) nor a mesh (.stl, .obj, .ply)".to_string(),
+                message:
+                    "neither a scenario (.toml) nor a mesh (.stl, .obj, .ply, .urdf)".to_string(),
             })?);
         } else {
             return Err(ScenarioError::Io {
@@ -129,6 +133,12 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
         }
     }
     Ok(items)
+}
+
+/// Returns true if and only if `path` names a URDF (by its extension).
+fn is_urdf(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("urdf"))
 }
 
 /// Returns true if and only if `path` is a TOML file that reads as a hand file (it has a
@@ -142,11 +152,12 @@ fn is_hand_file(path: &Path) -> bool {
             .is_some_and(|t| t.contains_key("palm") && t.contains_key("finger"))
 }
 
-/// The item a file is by its extension: `.toml` a scenario, `.stl`, `.obj`, `.ply` a mesh.
+/// The item a file is by its extension: `.toml` a scenario, `.stl`, `.obj`, `.ply`, `.urdf` a
+/// mesh.
 pub fn classify(p: PathBuf) -> Option<Item> {
     match p.extension()?.to_str()?.to_ascii_lowercase().as_str() {
         "toml" => Some(Item::Scenario(p)),
-        "stl" | "obj" | "ply" => Some(Item::Mesh(p)),
+        "stl" | "obj" | "ply" | "urdf" => Some(Item::Mesh(p)),
         _ => None,
     }
 }

@@ -173,6 +173,17 @@ pub fn input_hash(item: &Item, template: &Scenario, options: &RunOptions) -> Str
                 Ok(bytes) => part("mesh", &bytes),
                 Err(e) => part("mesh unreadable", e.to_string().as_bytes()),
             }
+            // A URDF's object is its meshes too.
+            if crate::mesh::MeshFormat::from_path(&s.object.mesh)
+                == Some(crate::mesh::MeshFormat::Urdf)
+            {
+                for f in crate::mesh::urdf::referenced_files(&s.object.mesh) {
+                    match std::fs::read(&f) {
+                        Ok(bytes) => part("urdf mesh", &bytes),
+                        Err(e) => part("urdf mesh unreadable", e.to_string().as_bytes()),
+                    }
+                }
+            }
         }
         Err(e) => part("scenario error", format!("{e:#}").as_bytes()),
     }

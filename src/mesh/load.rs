@@ -90,6 +90,11 @@ pub struct LoadedMesh {
     pub format: MeshFormat,
     /// The unit the file was read in.
     pub unit: LengthUnit,
+    /// What reading the file chose that a user should know (a URDF link whose collision
+    /// geometry stood in for its visual one), as warnings.
+    pub notes: Vec<String>,
+    /// The mass the file gives `[kg]` (a URDF's links' `<inertial>` masses, summed), if any.
+    pub mass_kg: Option<f64>,
 }
 
 /// A hole in the surface whose boundary spans at most this is closed at load time `[mm]`: the
@@ -111,6 +116,8 @@ pub enum MeshFormat {
     Obj,
     /// PLY (Stanford polygon format), ASCII or binary.
     Ply,
+    /// URDF: the meshes and shapes of its links, placed (`mesh::urdf`).
+    Urdf,
 }
 
 impl MeshFormat {
@@ -120,6 +127,7 @@ impl MeshFormat {
             "stl" => Some(MeshFormat::Stl),
             "obj" => Some(MeshFormat::Obj),
             "ply" => Some(MeshFormat::Ply),
+            "urdf" => Some(MeshFormat::Urdf),
             _ => None,
         }
     }
@@ -130,12 +138,13 @@ impl MeshFormat {
             MeshFormat::Stl => "stl",
             MeshFormat::Obj => "obj",
             MeshFormat::Ply => "ply",
+            MeshFormat::Urdf => "urdf",
         }
     }
 }
 
 /// Reads and validates a mesh file (STL, OBJ or PLY, by extension), scaling its coordinates to
-/// millimetres.
+/// millimetres; or the object a URDF describes (its lengths in metres, whatever `unit` says).
 ///
 /// # Errors
 /// Every [`MeshError`] names `path`: an unknown extension, content of another format, and the
@@ -149,6 +158,9 @@ pub fn load_mesh(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError>
     let format = MeshFormat::from_path(path).ok_or_else(|| MeshError::UnknownFormat {
         path: path.to_path_buf(),
     })?;
+    if format == MeshFormat::Urdf {
+        return super::urdf::load_urdf(path);
+    }
     let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
         message: crate::messages::io_message(&e),
@@ -166,6 +178,48 @@ pub fn parse_mesh(
     format: MeshFormat,
     unit: LengthUnit,
 ) -> Result<LoadedMesh, MeshError> {
+    let (raw, is_binary) = parse_raw(bytes, path, format)?;
+    build(raw, path, unit, is_binary, format)
+}
+
+/// A mesh file's triangles as it has them (no unit, welding or repair), its format chosen by
+/// the extension and checked against the content: what a URDF's meshes are read with before
+/// they are scaled and placed.
+///
+/// # Errors
+/// As [`load_mesh`], but for the validation of the mesh as a whole.
+pub(super) fn load_raw(path: &Path) -> Result<Raw, MeshError> {
+    if path.is_dir() {
+        return Err(MeshError::IsDirectory {
+            path: path.to_path_buf(),
+        });
+    }
+    let format = MeshFormat::from_path(path).ok_or_else(|| MeshError::UnknownFormat {
+        path: path.to_path_buf(),
+    })?;
+    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
+        path: path.to_path_buf(),
+        message: crate::messages::io_message(&e),
+    })?;
+    let (raw, is_binary) = parse_raw(&bytes, path, format)?;
+    if let Some(i) = raw
+        .iter()
+        .position(|t| t.iter().flatten().any(|c| !c.is_finite()))
+    {
+        return Err(MeshError::NonFinite {
+            path: path.to_path_buf(),
+            triangle: i,
+        });
+    }
+    if raw.is_empty() {
+        return Err(MeshError::NoTriangles {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok((raw, is_binary))
+}
+
+fn parse_raw(bytes: &[u8], path: &Path, format: MeshFormat) -> Result<Raw, MeshError> {
     if bytes.is_empty() {
         return Err(MeshError::Empty {
             path: path.to_path_buf(),
@@ -178,9 +232,13 @@ pub fn parse_mesh(
         found: found.to_string(),
     };
     match (format, looks) {
-        (MeshFormat::Stl, Some(MeshFormat::Stl) | None) => parse_stl(bytes, path, unit),
-        (MeshFormat::Obj, Some(MeshFormat::Obj) | None) => parse_obj(bytes, path, unit),
-        (MeshFormat::Ply, Some(MeshFormat::Ply)) => parse_ply(bytes, path, unit),
+        (MeshFormat::Stl, Some(MeshFormat::Stl) | None) => stl_raw(bytes, path),
+        (MeshFormat::Obj, Some(MeshFormat::Obj) | None) => obj_raw(bytes, path),
+        (MeshFormat::Ply, Some(MeshFormat::Ply)) => ply_raw(bytes, path),
+        (MeshFormat::Urdf, _) => Err(MeshError::Urdf {
+            path: path.to_path_buf(),
+            detail: "a URDF is read from its file, beside the meshes it names".to_string(),
+        }),
         (MeshFormat::Ply, _) => Err(MeshError::Ply {
             path: path.to_path_buf(),
             detail: "does not begin with the `ply` line every PLY file starts with".to_string(),
@@ -189,6 +247,7 @@ pub fn parse_mesh(
             MeshFormat::Stl => "STL",
             MeshFormat::Obj => "OBJ",
             MeshFormat::Ply => "PLY",
+            MeshFormat::Urdf => "URDF",
         })),
     }
 }
@@ -285,7 +344,10 @@ fn check_obj_lines(text: &str, path: &Path) -> Result<(), MeshError> {
     Ok(())
 }
 
-fn parse_obj(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> {
+/// Triangles as a file has them, and whether it was binary.
+pub(super) type Raw = (Vec<[[f32; 3]; 3]>, bool);
+
+fn obj_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     let text = std::str::from_utf8(bytes).map_err(|e| MeshError::Obj {
         path: path.to_path_buf(),
         line: Some(
@@ -330,10 +392,10 @@ fn parse_obj(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMesh, 
             raw.push(corners);
         }
     }
-    build(raw, path, unit, false, MeshFormat::Obj)
+    Ok((raw, false))
 }
 
-fn parse_ply(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> {
+fn ply_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     use ply_rs_bw::parser::Parser;
     use ply_rs_bw::ply::{DefaultElement, Encoding, Property};
     let err = |detail: String| MeshError::Ply {
@@ -456,13 +518,13 @@ fn parse_ply(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMesh, 
             ]);
         }
     }
-    build(raw, path, unit, is_binary, MeshFormat::Ply)
+    Ok((raw, is_binary))
 }
 
 impl LoadedMesh {
     /// One-line warnings (without the file name) about what was repaired or is suspect.
     pub fn warnings(&self) -> Vec<String> {
-        let mut w = Vec::new();
+        let mut w = self.notes.clone();
         if self.degenerate_dropped > 0 {
             w.push(format!(
                 "dropped {} degenerate (zero-area) triangles of {}",
@@ -509,7 +571,9 @@ impl LoadedMesh {
     pub fn small_object_hint(&self, smallest_grasp_mm: f64) -> Option<String> {
         let (lo, hi) = self.mesh.bounds();
         let size = (hi - lo).max();
-        if !(PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(&size) || size >= 2.0 * smallest_grasp_mm
+        if !(PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(&size)
+            || size >= 2.0 * smallest_grasp_mm
+            || self.format == MeshFormat::Urdf
         {
             return None;
         }
@@ -548,9 +612,10 @@ impl LoadedMesh {
         }
         let read = self.unit.name();
         let in_unit = size / self.unit.to_mm();
+        // A URDF's unit is fixed (metres): no other unit to suggest.
         let likely = LengthUnit::ALL
             .into_iter()
-            .filter(|&u| u != self.unit)
+            .filter(|&u| u != self.unit && self.format != MeshFormat::Urdf)
             .map(|u| (u, in_unit * u.to_mm()))
             .filter(|(_, mm)| (PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(mm))
             .min_by(|a, b| {
@@ -607,6 +672,11 @@ pub fn load_stl(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> 
 /// # Errors
 /// As [`load_stl`].
 pub fn parse_stl(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> {
+    let (raw, is_binary) = stl_raw(bytes, path)?;
+    build(raw, path, unit, is_binary, MeshFormat::Stl)
+}
+
+fn stl_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     let p = || path.to_path_buf();
     if bytes.is_empty() {
         return Err(MeshError::Empty { path: p() });
@@ -682,7 +752,7 @@ pub fn parse_stl(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMe
         });
     };
 
-    build(triangles, path, unit, is_binary, MeshFormat::Stl)
+    Ok((triangles, is_binary))
 }
 
 /// The first line of an ASCII STL that breaks its grammar (`solid`, then per facet `facet
@@ -774,7 +844,7 @@ fn read_triangles(
     Ok(out)
 }
 
-fn build(
+pub(super) fn build(
     raw: Vec<[[f32; 3]; 3]>,
     path: &Path,
     unit: LengthUnit,
@@ -868,6 +938,8 @@ fn build(
         is_binary,
         format,
         unit,
+        notes: Vec::new(),
+        mass_kg: None,
     })
 }
 

@@ -1,4 +1,5 @@
-//! Triangle meshes: loading and validating STL, OBJ and PLY, mass properties, alignment with the
+//! Triangle meshes: loading and validating STL, OBJ and PLY (and the objects URDF files
+//! describe), mass properties, alignment with the
 //! principal axis.
 //!
 //! Input: a mesh file (STL binary or ASCII, Wavefront OBJ, PLY ASCII or binary) in some length
@@ -14,6 +15,7 @@
 mod align;
 mod load;
 mod mass;
+pub mod urdf;
 
 pub use align::{align, align_about, align_with, AlignedObject, GraspAxis};
 pub use load::{load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh, MeshFormat};
@@ -79,7 +81,7 @@ pub enum MeshError {
         extra: u64,
     },
     /// The file name's extension is none of the formats grasp-sim reads.
-    #[error("{path}: unknown mesh format: the name must end in .stl, .obj or .ply")]
+    #[error("{path}: unknown mesh format: the name must end in .stl, .obj, .ply or .urdf")]
     UnknownFormat {
         /// The file.
         path: PathBuf,
@@ -165,6 +167,15 @@ pub enum MeshError {
         path: PathBuf,
         /// How many triangles were read.
         count: usize,
+    },
+    /// A URDF that is not well-formed, names a mesh that cannot be found, or has no geometry
+    /// grasp-sim reads.
+    #[error("{path}: URDF: {detail}")]
+    Urdf {
+        /// The URDF file.
+        path: PathBuf,
+        /// What is wrong.
+        detail: String,
     },
     /// The surface encloses no volume, so it has no mass properties or principal axis.
     #[error("{path}: the surface encloses no volume ({volume_mm3:.3e} mm^3): not a closed solid")]

@@ -213,7 +213,7 @@ fn a_file_that_is_neither_scenario_nor_mesh_says_what_is_read() {
     for (name, body) in [("part.dae", "<COLLADA/>\n"), ("notes.txt", "hello world\n")] {
         let p = env.scenario(name, body);
         let out = env.run(&[p.to_str().unwrap()]);
-        assert_bad_input(&out, name, "meshes from .stl, .obj and .ply");
+        assert_bad_input(&out, name, "meshes from .stl, .obj, .ply and .urdf");
     }
     let p = env.scenario("bad.toml", "hello world\n");
     let out = env.run(&[p.to_str().unwrap()]);

@@ -209,7 +209,7 @@ fn unknown_extension_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let p = write_temp(&dir, "box.off", BOX_OBJ.as_bytes());
     let e = load_mesh(&p, LengthUnit::Mm).unwrap_err().to_string();
-    assert!(e.contains(".stl, .obj or .ply"), "{e}");
+    assert!(e.contains(".stl, .obj, .ply or .urdf"), "{e}");
 }
 
 /// A scenario naming a bad OBJ exits 2 with one line naming the file.

@@ -16,6 +16,7 @@ mod sim;
 mod summarize;
 mod thesis_table;
 mod tune;
+mod urdf;
 mod visual;
 
 use std::path::PathBuf;

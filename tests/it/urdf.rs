@@ -1,0 +1,258 @@
+//! Objects given as URDF (`mesh::urdf`): the links' meshes and shapes, placed by their origins
+//! and joints, in metres.
+
+use grasp_sim::mesh::surface_mass_properties;
+use nalgebra::{Rotation3, Vector3};
+use std::path::Path;
+use std::process::Output;
+
+fn json(out: &Output) -> serde_json::Value {
+    crate::assert_success(out);
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> std::path::PathBuf {
+    let p = dir.join(name);
+    std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+    std::fs::write(&p, bytes).unwrap();
+    p
+}
+
+fn run(args: &[&str], file: &Path) -> Output {
+    crate::grasp_sim().args(args).arg(file).output().unwrap()
+}
+
+/// The cup of thesis 5.3, in millimetres in its STL, given by a URDF that scales it to metres
+/// and turns and moves it (roll 0.3, pitch −0.2, yaw 1.0 rad), its mesh named by a `package://`
+/// URI: the same object, planned as the cup's scenario plans it, and held; its mass is the
+/// URDF's.
+#[test]
+fn a_urdf_cup_plans_as_the_cup_scenario() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("meshes")).unwrap();
+    std::fs::copy(
+        crate::root().join("assets/objects/cup.stl"),
+        dir.path().join("meshes/cup.stl"),
+    )
+    .unwrap();
+    let urdf = write(
+        dir.path(),
+        "cup.urdf",
+        r#"<?xml version="1.0"?>
+<robot name="cup">
+  <link name="base">
+    <inertial><mass value="0.1"/></inertial>
+    <visual>
+      <origin xyz="0.1 -0.2 0.05" rpy="0.3 -0.2 1.0"/>
+      <geometry><mesh filename="package://cups/meshes/cup.stl" scale="0.001 0.001 0.001"/></geometry>
+    </visual>
+  </link>
+</robot>
+"#,
+    );
+    let u = json(&run(&["--json"], &urdf));
+    let s = json(&crate::succeed(
+        crate::grasp_sim().args(["--json", "scenarios/cup.toml"]),
+    ));
+    let num = |v: &serde_json::Value| v.as_f64().unwrap();
+    let (vu, vs) = (
+        num(&u["object"]["volume_mm3"]),
+        num(&s["object"]["volume_mm3"]),
+    );
+    assert!((vu / vs - 1.0).abs() < 1e-6, "{vu} against {vs}");
+    assert!((num(&u["object"]["height_mm"]) - 110.0).abs() < 1e-3);
+    // The URDF's inertial mass, not the default density's 0.2 kg.
+    assert_eq!(num(&u["object"]["mass_kg"]), 0.1);
+    assert!((num(&s["object"]["mass_kg"]) - 500.0 * vs * 1e-9).abs() < 1e-12);
+    // The principal axis is the cup's Z turned by R = Rz(yaw)·Ry(pitch)·Rx(roll).
+    let axis = Rotation3::from_euler_angles(0.3, -0.2, 1.0) * Vector3::z();
+    let a = &u["object"]["principal_axis"];
+    let got = Vector3::new(num(&a[0]), num(&a[1]), num(&a[2]));
+    assert!(got.dot(&axis).abs() > 1.0 - 1e-9, "{got} against {axis}");
+    assert_eq!(u["warnings"], serde_json::json!([]));
+    let (gu, gs) = (&u["plan"]["grasp"], &s["plan"]["grasp"]);
+    assert_eq!(gu["elevation_index"], gs["elevation_index"]);
+    for (fu, fs) in gu["fingers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(gs["fingers"].as_array().unwrap())
+    {
+        for k in ["theta1_deg", "theta2_deg"] {
+            assert!(
+                (num(&fu[k]) - num(&fs[k])).abs() < 0.01,
+                "{fu} against {fs}"
+            );
+        }
+    }
+    assert_eq!(u["sim"]["verdict"], "hold");
+}
+
+/// Three links on fixed joints, each placed by its joint: a cylinder (Ø40 × 100 mm) from Z = 0,
+/// a 30 × 30 × 20 mm box on it, and a knob whose visual mesh is a `.dae` grasp-sim does not read,
+/// so its collision sphere (Ø20 mm) stands in, with a warning naming the link. The object is
+/// 140 mm high and its volume is the three solids'.
+#[test]
+fn links_joints_and_shapes_are_placed_and_joined() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = write(
+        dir.path(),
+        "stack.urdf",
+        r#"<robot name="stack">
+  <link name="body">
+    <visual><origin xyz="0 0 0.05"/><geometry><cylinder radius="0.02" length="0.1"/></geometry></visual>
+  </link>
+  <joint name="lid_joint" type="fixed">
+    <parent link="body"/><child link="lid"/><origin xyz="0 0 0.1"/>
+  </joint>
+  <link name="lid">
+    <visual><origin xyz="0 0 0.01"/><geometry><box size="0.03 0.03 0.02"/></geometry></visual>
+  </link>
+  <joint name="knob_joint" type="revolute">
+    <parent link="lid"/><child link="knob"/><origin xyz="0 0 0.03"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+  <link name="knob">
+    <visual><geometry><mesh filename="knob.dae"/></geometry></visual>
+    <collision><geometry><sphere radius="0.01"/></geometry></collision>
+  </link>
+</robot>
+"#,
+    );
+    let u = json(&run(&["--json", "--no-sim"], &urdf));
+    let num = |v: &serde_json::Value| v.as_f64().unwrap();
+    assert!(
+        (num(&u["object"]["height_mm"]) - 140.0).abs() < 1e-3,
+        "{}",
+        u["object"]
+    );
+    let volume = surface_mass_properties(&grasp_sim::objects::cylinder(40.0, 100.0)).volume_mm3
+        + 30.0 * 30.0 * 20.0
+        + surface_mass_properties(&grasp_sim::objects::uv_sphere(10.0, 48)).volume_mm3;
+    let v = num(&u["object"]["volume_mm3"]);
+    assert!((v / volume - 1.0).abs() < 0.005, "{v} against {volume}");
+    // No inertial mass: the default density's.
+    assert!((num(&u["object"]["mass_kg"]) - 500.0 * v * 1e-9).abs() < 1e-12);
+    let w = u["warnings"].to_string();
+    assert!(
+        w.contains("link `knob`: its visual mesh knob.dae is not a format grasp-sim reads")
+            && w.contains("its collision geometry is used"),
+        "{w}"
+    );
+}
+
+/// Each broken URDF is one line on stderr naming the file and the problem, exit status 2, and
+/// the good input run beside it still prints its result.
+#[test]
+fn a_broken_urdf_is_one_line_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let link = |geometry: &str| {
+        format!("<robot name=\"r\"><link name=\"a\"><visual>{geometry}</visual></link></robot>")
+    };
+    let cases = [
+        (
+            "unclosed.urdf",
+            "<robot><link name=\"a\">".to_string(),
+            "not well-formed XML",
+        ),
+        (
+            "sdf.urdf",
+            "<sdf/>".to_string(),
+            "the root element is <sdf>, not <robot>",
+        ),
+        (
+            "missing.urdf",
+            link("<geometry><mesh filename=\"package://p/gone.stl\"/></geometry>"),
+            "mesh package://p/gone.stl not found beside the URDF or above it",
+        ),
+        (
+            "nan.urdf",
+            link("<origin xyz=\"0 nan 0\"/><geometry><sphere radius=\"0.1\"/></geometry>"),
+            "line 1: <origin xyz=\"0 nan 0\"> needs 3 finite numbers",
+        ),
+        (
+            "empty.urdf",
+            "<robot name=\"r\"><link name=\"a\"><inertial/></link></robot>".to_string(),
+            "no geometry grasp-sim can read",
+        ),
+        (
+            "mass.urdf",
+            "<robot name=\"r\"><link name=\"a\"><inertial><mass value=\"-1\"/></inertial>\
+             <visual><geometry><sphere radius=\"0.05\"/></geometry></visual></link></robot>"
+                .to_string(),
+            "link `a` has a negative mass (-1 kg)",
+        ),
+        (
+            "zero.urdf",
+            link("<geometry><box size=\"0.1 0 0.1\"/></geometry>"),
+            "<box> needs a size of three positive lengths",
+        ),
+    ];
+    for (name, text, expect) in cases {
+        let p = write(dir.path(), name, text);
+        let out = crate::grasp_sim()
+            .args(["--no-sim"])
+            .arg(&p)
+            .arg("scenarios/cup.toml")
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        let lines: Vec<&str> = err.lines().filter(|l| l.contains(name)).collect();
+        assert_eq!(lines.len(), 1, "{name}: {err}");
+        assert!(lines[0].contains(expect), "{name}: {err}");
+        assert!(
+            String::from_utf8_lossy(&out.stdout).contains("Plan        feasible"),
+            "{name}: the cup's result is missing"
+        );
+    }
+    // A mesh the URDF names that is itself broken is named.
+    write(dir.path(), "bad.stl", b"solid x\nfacet normal 0 0 1\n");
+    let p = write(
+        dir.path(),
+        "badmesh.urdf",
+        link("<geometry><mesh filename=\"bad.stl\"/></geometry>"),
+    );
+    let out = run(&["--no-sim"], &p);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("bad.stl: malformed ASCII STL"), "{err}");
+}
+
+/// A folder of URDFs and the meshes they name is a folder of URDF objects: the meshes are not
+/// objects of their own.
+#[test]
+fn a_folder_of_urdfs_runs_the_urdfs() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "d40.stl",
+        grasp_sim::objects::cylinder(40.0, 100.0).to_binary_stl(),
+    );
+    for name in ["a.urdf", "b.urdf"] {
+        write(
+            dir.path(),
+            name,
+            "<robot name=\"r\"><link name=\"a\"><visual><geometry>\
+             <mesh filename=\"d40.stl\" scale=\"0.001 0.001 0.001\"/></geometry></visual>\
+             </link></robot>",
+        );
+    }
+    let out = crate::grasp_sim()
+        .args(["batch", "--no-sim"])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    crate::assert_success(&out);
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(lines.len(), 2, "{lines:?}");
+    for (l, name) in lines.iter().zip(["a.urdf", "b.urdf"]) {
+        assert!(l["batch"]["input"].as_str().unwrap().ends_with(name), "{l}");
+        assert_eq!(l["plan"]["status"], "feasible", "{l}");
+        let h = l["object"]["height_mm"].as_f64().unwrap();
+        assert!((h - 100.0).abs() < 1e-3, "{h}");
+    }
+}
