@@ -256,3 +256,35 @@ fn a_folder_of_urdfs_runs_the_urdfs() {
         assert!((h - 100.0).abs() < 1e-3, "{h}");
     }
 }
+
+/// A URDF's object is its meshes too: `batch --resume` runs it again when a mesh it names is
+/// edited, and not when nothing changed.
+#[test]
+fn resume_sees_an_edited_urdf_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = |d: f64| grasp_sim::objects::cylinder(d, 100.0).to_binary_stl();
+    write(dir.path(), "m.stl", mesh(40.0));
+    let urdf = write(
+        dir.path(),
+        "a.urdf",
+        "<robot name=\"r\"><link name=\"a\"><visual><geometry>\
+         <mesh filename=\"m.stl\" scale=\"0.001 0.001 0.001\"/></geometry></visual></link></robot>",
+    );
+    let out = dir.path().join("out.jsonl");
+    let resume = || {
+        let o = crate::grasp_sim()
+            .args(["batch", "--no-sim", "--resume", "--out"])
+            .arg(&out)
+            .arg(&urdf)
+            .output()
+            .unwrap();
+        crate::assert_success(&o);
+        String::from_utf8_lossy(&o.stderr).into_owned()
+    };
+    resume();
+    let err = resume();
+    assert!(err.contains("1 of 1 object already in"), "{err}");
+    write(dir.path(), "m.stl", mesh(50.0));
+    let err = resume();
+    assert!(err.contains("0 of 1 object already in"), "{err}");
+}
