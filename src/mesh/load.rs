@@ -150,22 +150,31 @@ impl MeshFormat {
 /// Every [`MeshError`] names `path`: an unknown extension, content of another format, and the
 /// errors of [`load_stl`] and [`parse_mesh`].
 pub fn load_mesh(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> {
+    let format = file_format(path)?;
+    if format == MeshFormat::Urdf {
+        return super::urdf::load_urdf(path);
+    }
+    parse_mesh(&read_bytes(path)?, path, format, unit)
+}
+
+/// The format of the mesh file at `path`, by its extension; an error for a folder or an
+/// extension grasp-sim does not read.
+fn file_format(path: &Path) -> Result<MeshFormat, MeshError> {
     if path.is_dir() {
         return Err(MeshError::IsDirectory {
             path: path.to_path_buf(),
         });
     }
-    let format = MeshFormat::from_path(path).ok_or_else(|| MeshError::UnknownFormat {
+    MeshFormat::from_path(path).ok_or_else(|| MeshError::UnknownFormat {
         path: path.to_path_buf(),
-    })?;
-    if format == MeshFormat::Urdf {
-        return super::urdf::load_urdf(path);
-    }
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
+    })
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
+    std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
         message: crate::messages::io_message(&e),
-    })?;
-    parse_mesh(&bytes, path, format, unit)
+    })
 }
 
 /// Parses mesh bytes of the given format; `path` is only used in messages.
@@ -189,19 +198,8 @@ pub fn parse_mesh(
 /// # Errors
 /// As [`load_mesh`], but for the validation of the mesh as a whole.
 pub(super) fn load_raw(path: &Path) -> Result<Raw, MeshError> {
-    if path.is_dir() {
-        return Err(MeshError::IsDirectory {
-            path: path.to_path_buf(),
-        });
-    }
-    let format = MeshFormat::from_path(path).ok_or_else(|| MeshError::UnknownFormat {
-        path: path.to_path_buf(),
-    })?;
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
-        path: path.to_path_buf(),
-        message: crate::messages::io_message(&e),
-    })?;
-    let (raw, is_binary) = parse_raw(&bytes, path, format)?;
+    let format = file_format(path)?;
+    let (raw, is_binary) = parse_raw(&read_bytes(path)?, path, format)?;
     if let Some(i) = raw
         .iter()
         .position(|t| t.iter().flatten().any(|c| !c.is_finite()))

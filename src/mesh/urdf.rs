@@ -125,8 +125,23 @@ fn geometry(path: &Path, element: roxmltree::Node) -> Result<Result<Placed, Stri
     else {
         return Ok(Err("no <geometry>".to_string()));
     };
-    let positive = |v: &[f64]| v.iter().all(|&x| x > 0.0);
     let line = g.document().text_pos_at(g.range().start).row;
+    // A shape's attributes, each of `n` lengths, all given and positive.
+    let lengths = |attrs: &[(&str, usize)], want: &str| -> Result<Vec<f64>, MeshError> {
+        let mut v = Vec::new();
+        for &(attr, n) in attrs {
+            v.extend(numbers(path, g, attr, n)?.unwrap_or_default());
+        }
+        let count: usize = attrs.iter().map(|a| a.1).sum();
+        if v.len() == count && v.iter().all(|&x| x > 0.0) {
+            Ok(v)
+        } else {
+            Err(urdf_err(
+                path,
+                format!("line {line}: <{}> needs {want}", g.tag_name().name()),
+            ))
+        }
+    };
     let shape = match g.tag_name().name() {
         "mesh" => {
             let Some(name) = g.attribute("filename") else {
@@ -163,36 +178,17 @@ fn geometry(path: &Path, element: roxmltree::Node) -> Result<Result<Placed, Stri
             Shape::Mesh(file, scale)
         }
         "box" => {
-            let s = numbers(path, g, "size", 3)?.unwrap_or_default();
-            if s.len() != 3 || !positive(&s) {
-                return Err(urdf_err(
-                    path,
-                    format!("line {line}: <box> needs a size of three positive lengths"),
-                ));
-            }
+            let s = lengths(&[("size", 3)], "a size of three positive lengths")?;
             Shape::Box(Vector3::new(s[0], s[1], s[2]))
         }
         "cylinder" => {
-            let r = numbers(path, g, "radius", 1)?.unwrap_or_default();
-            let l = numbers(path, g, "length", 1)?.unwrap_or_default();
-            if r.len() != 1 || l.len() != 1 || !positive(&[r[0], l[0]]) {
-                return Err(urdf_err(
-                    path,
-                    format!("line {line}: <cylinder> needs a positive radius and length"),
-                ));
-            }
-            Shape::Cylinder(r[0], l[0])
+            let rl = lengths(
+                &[("radius", 1), ("length", 1)],
+                "a positive radius and length",
+            )?;
+            Shape::Cylinder(rl[0], rl[1])
         }
-        "sphere" => {
-            let r = numbers(path, g, "radius", 1)?.unwrap_or_default();
-            if r.len() != 1 || !positive(&r) {
-                return Err(urdf_err(
-                    path,
-                    format!("line {line}: <sphere> needs a positive radius"),
-                ));
-            }
-            Shape::Sphere(r[0])
-        }
+        "sphere" => Shape::Sphere(lengths(&[("radius", 1)], "a positive radius")?[0]),
         other => return Ok(Err(format!("<{other}> is not a geometry grasp-sim reads"))),
     };
     Ok(Ok(Placed { shape, pose }))
