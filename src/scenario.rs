@@ -214,8 +214,7 @@ struct RawScenario {
 #[serde(deny_unknown_fields)]
 struct RawObject {
     mesh: PathBuf,
-    #[serde(default)]
-    units: LengthUnit,
+    units: Option<LengthUnit>,
     density_kg_m3: Option<f64>,
     mass_kg: Option<f64>,
     #[serde(default = "default_friction")]
@@ -303,6 +302,19 @@ impl Scenario {
             }
             _ => {}
         }
+        // A URDF's lengths are metres by its format: another unit would be silently ignored.
+        let is_urdf =
+            crate::mesh::MeshFormat::from_path(&o.mesh) == Some(crate::mesh::MeshFormat::Urdf);
+        if let (true, Some(u)) = (is_urdf, o.units.filter(|&u| u != LengthUnit::M)) {
+            return Err(invalid(
+                "object.units",
+                format!(
+                    "is \"{}\", but a URDF's lengths are metres (its meshes' `scale` gives their \
+                     unit); remove `units` or set it to \"m\"",
+                    u.name()
+                ),
+            ));
+        }
         // Coulomb friction between a hand and an object: 0 is frictionless; rubber on rubber
         // rarely exceeds ~1.5, so 2 bounds any plausible value.
         if !(o.friction.is_finite() && o.friction > 0.0 && o.friction <= 2.0) {
@@ -380,7 +392,7 @@ impl Scenario {
             name,
             object: ObjectSpec {
                 mesh: dir.join(o.mesh),
-                units: o.units,
+                units: o.units.unwrap_or_default(),
                 mass,
                 friction: o.friction,
             },

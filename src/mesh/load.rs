@@ -152,7 +152,16 @@ impl MeshFormat {
 pub fn load_mesh(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> {
     let format = file_format(path)?;
     if format == MeshFormat::Urdf {
-        return super::urdf::load_urdf(path);
+        let mut loaded = super::urdf::load_urdf(path)?;
+        // Millimetres is the default, so only another unit was asked for (`--units`).
+        if unit != LengthUnit::Mm && unit != LengthUnit::M {
+            loaded.notes.push(format!(
+                "units \"{}\" do not apply to a URDF: its lengths are metres (its meshes' \
+                 `scale` gives their unit)",
+                unit.name()
+            ));
+        }
+        return Ok(loaded);
     }
     parse_mesh(&read_bytes(path)?, path, format, unit)
 }

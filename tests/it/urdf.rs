@@ -288,3 +288,49 @@ fn resume_sees_an_edited_urdf_mesh() {
     let err = resume();
     assert!(err.contains("0 of 1 object already in"), "{err}");
 }
+
+/// A URDF's lengths are metres: a scenario giving it another `units` is an error naming the
+/// key, and `--units` on a bare URDF is a warning that it does not apply.
+#[test]
+fn a_urdf_is_in_metres_whatever_units_say() {
+    let dir = tempfile::tempdir().unwrap();
+    write(
+        dir.path(),
+        "ball.urdf",
+        "<robot name=\"r\"><link name=\"a\"><visual><geometry><sphere radius=\"0.03\"/>\
+         </geometry></visual></link></robot>",
+    );
+    let scenario = |units: &str| {
+        write(
+            dir.path(),
+            "s.toml",
+            format!("[object]\nmesh = \"ball.urdf\"\n{units}"),
+        )
+    };
+    let out = run(&["--no-sim"], &scenario("units = \"cm\"\n"));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("s.toml")
+            && err.contains("object.units")
+            && err.contains("a URDF's lengths are metres"),
+        "{err}"
+    );
+    for units in ["", "units = \"m\"\n"] {
+        let u = json(&run(&["--json", "--no-sim"], &scenario(units)));
+        let h = u["object"]["height_mm"].as_f64().unwrap();
+        assert!((h - 60.0).abs() < 1e-3, "{h}");
+    }
+    let u = json(&run(
+        &["--json", "--no-sim", "--units", "cm"],
+        &dir.path().join("ball.urdf"),
+    ));
+    assert!((u["object"]["height_mm"].as_f64().unwrap() - 60.0).abs() < 1e-3);
+    assert!(
+        u["warnings"]
+            .to_string()
+            .contains("units \\\"cm\\\" do not apply to a URDF"),
+        "{}",
+        u["warnings"]
+    );
+}
