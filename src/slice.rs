@@ -578,6 +578,18 @@ fn map_closed(
 }
 
 impl Slice {
+    /// The slice with open ends within `tol_mm` of each other joined (straight across the gap)
+    /// and the closed contours then united; unchanged when nothing joins. Unlike [`Self::bridged`]
+    /// no gap between closed pieces is filled: the area stays the cut's.
+    pub fn joined(self, tol_mm: f64) -> Slice {
+        let mut contours = self.contours;
+        if join_open(&mut contours, tol_mm) {
+            finish(self.plane, union_closed(contours))
+        } else {
+            Slice { contours, ..self }
+        }
+    }
+
     /// Returns the number of contours that do not close.
     pub fn open_count(&self) -> usize {
         self.contours.iter().filter(|c| !c.is_closed).count()

@@ -32,7 +32,7 @@ pub fn mass_properties(mesh: &Mesh) -> MassProperties {
     // Several shells: the surface integral adds their volumes, counting any overlap twice. Where
     // the union (integrated over slices) is smaller by more than the integration's own error,
     // the shells overlap and the union is the object.
-    let union = sliced_mass_properties(mesh, UNION_SLICES);
+    let union = union_mass_properties(mesh, UNION_SLICES);
     if union.volume_mm3 < exact.volume_mm3 * (1.0 - OVERLAP_TOLERANCE) {
         union
     } else {
@@ -48,10 +48,81 @@ const UNION_SLICES: usize = 400;
 /// Shells whose summed volume exceeds their union by this share overlap.
 const OVERLAP_TOLERANCE: f64 = 1e-3;
 
+/// The union's mass properties sliced across the surface's own long axis (the area-weighted
+/// covariance of its triangles, which moves and turns with the mesh whether or not it is closed),
+/// open ends of a slice within [`super::load::SMALL_HOLE_MM`] joined: what a union of open shells
+/// encloses no longer depends on the frame the file was written in.
+pub fn union_mass_properties(mesh: &Mesh, n: usize) -> MassProperties {
+    let (centre, frame) = surface_frame(mesh);
+    let mut local = mesh.clone();
+    local.map_vertices(|p| Point3::from(frame.transpose() * (p - centre)));
+    let l = sliced_mass_properties_with(&local, n, super::load::SMALL_HOLE_MM);
+    MassProperties {
+        volume_mm3: l.volume_mm3,
+        centroid: centre + frame * l.centroid.coords,
+        inertia: frame * l.inertia * frame.transpose(),
+    }
+}
+
+/// The area-weighted centroid of a surface and the eigenvectors of its area-weighted covariance
+/// (columns, the largest variance last, right-handed, each with its largest component positive).
+fn surface_frame(mesh: &Mesh) -> (Point3<f64>, Matrix3<f64>) {
+    let mut area = 0.0;
+    let mut first = Vector3::zeros();
+    let tris: Vec<(f64, Vector3<f64>)> = (0..mesh.triangles.len())
+        .map(|t| {
+            let [a, b, c] = mesh.corners(t);
+            let w = (b - a).cross(&(c - a)).norm() / 2.0;
+            (w, (a.coords + b.coords + c.coords) / 3.0)
+        })
+        .collect();
+    for &(w, m) in &tris {
+        area += w;
+        first += w * m;
+    }
+    let centre = if area > 0.0 {
+        first / area
+    } else {
+        Vector3::zeros()
+    };
+    let mut cov = Matrix3::zeros();
+    for (t, &(w, _)) in tris.iter().enumerate() {
+        let [a, b, c] = mesh.corners(t);
+        let (a, b, c) = (a.coords - centre, b.coords - centre, c.coords - centre);
+        // The second moment of a triangle of area w about the centre: w/12 (aa + bb + cc + s s)
+        // with s = a + b + c, integrated exactly.
+        let s = a + b + c;
+        cov += w / 12.0
+            * (a * a.transpose() + b * b.transpose() + c * c.transpose() + s * s.transpose());
+    }
+    let eig = nalgebra::SymmetricEigen::new(cov);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&i, &j| eig.eigenvalues[i].total_cmp(&eig.eigenvalues[j]));
+    let mut cols: Vec<Vector3<f64>> = order
+        .iter()
+        .map(|&i| {
+            let v = eig.eigenvectors.column(i).into_owned();
+            let k = v.iamax();
+            if v[k] < 0.0 {
+                -v
+            } else {
+                v
+            }
+        })
+        .collect();
+    cols[1] = cols[2].cross(&cols[0]);
+    (Point3::from(centre), Matrix3::from_columns(&cols))
+}
+
 /// Mass properties (unit density) of the solid a mesh encloses, taken as the union of its
 /// shells: the areas and area moments of `n` horizontal slices (each the union of what the
 /// shells cut, [`crate::slice::slice`]) integrated along Z by the midpoint rule.
 pub fn sliced_mass_properties(mesh: &Mesh, n: usize) -> MassProperties {
+    sliced_mass_properties_with(mesh, n, 0.0)
+}
+
+/// As [`sliced_mass_properties`], open ends within `join_mm` joined in every slice.
+fn sliced_mass_properties_with(mesh: &Mesh, n: usize, join_mm: f64) -> MassProperties {
     let (lo, hi) = mesh.bounds();
     let reference = nalgebra::center(&lo, &hi);
     let dz = (hi.z - lo.z) / n as f64;
@@ -60,7 +131,7 @@ pub fn sliced_mass_properties(mesh: &Mesh, n: usize) -> MassProperties {
     for k in 0..n {
         let z_abs = lo.z + (k as f64 + 0.5) * dz;
         let z = z_abs - reference.z;
-        let s = crate::slice::slice(mesh, &crate::slice::Plane::horizontal(z_abs));
+        let s = crate::slice::slice(mesh, &crate::slice::Plane::horizontal(z_abs)).joined(join_mm);
         let (mut a, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
         for c in s.contours.iter().filter(|c| c.is_closed) {
             let np = c.points.len();
