@@ -18,6 +18,18 @@ fn write(dir: &Path, name: &str, bytes: impl AsRef<[u8]>) -> std::path::PathBuf 
     p
 }
 
+/// A URDF of one link whose `<visual>` holds `visual`.
+fn one_link(visual: &str) -> String {
+    format!("<robot name=\"r\"><link name=\"a\"><visual>{visual}</visual></link></robot>")
+}
+
+/// A URDF of one link with the mesh `file` at scale 0.001 (a mesh in millimetres).
+fn mm_mesh_link(file: &str) -> String {
+    one_link(&format!(
+        "<geometry><mesh filename=\"{file}\" scale=\"0.001 0.001 0.001\"/></geometry>"
+    ))
+}
+
 fn run(args: &[&str], file: &Path) -> Output {
     crate::grasp_sim().args(args).arg(file).output().unwrap()
 }
@@ -146,9 +158,7 @@ fn links_joints_and_shapes_are_placed_and_joined() {
 #[test]
 fn a_broken_urdf_is_one_line_naming_it() {
     let dir = tempfile::tempdir().unwrap();
-    let link = |geometry: &str| {
-        format!("<robot name=\"r\"><link name=\"a\"><visual>{geometry}</visual></link></robot>")
-    };
+    let link = one_link;
     let cases = [
         (
             "unclosed.urdf",
@@ -230,13 +240,7 @@ fn a_folder_of_urdfs_runs_the_urdfs() {
         grasp_sim::objects::cylinder(40.0, 100.0).to_binary_stl(),
     );
     for name in ["a.urdf", "b.urdf"] {
-        write(
-            dir.path(),
-            name,
-            "<robot name=\"r\"><link name=\"a\"><visual><geometry>\
-             <mesh filename=\"d40.stl\" scale=\"0.001 0.001 0.001\"/></geometry></visual>\
-             </link></robot>",
-        );
+        write(dir.path(), name, mm_mesh_link("d40.stl"));
     }
     let out = crate::grasp_sim()
         .args(["batch", "--no-sim"])
@@ -264,12 +268,7 @@ fn resume_sees_an_edited_urdf_mesh() {
     let dir = tempfile::tempdir().unwrap();
     let mesh = |d: f64| grasp_sim::objects::cylinder(d, 100.0).to_binary_stl();
     write(dir.path(), "m.stl", mesh(40.0));
-    let urdf = write(
-        dir.path(),
-        "a.urdf",
-        "<robot name=\"r\"><link name=\"a\"><visual><geometry>\
-         <mesh filename=\"m.stl\" scale=\"0.001 0.001 0.001\"/></geometry></visual></link></robot>",
-    );
+    let urdf = write(dir.path(), "a.urdf", mm_mesh_link("m.stl"));
     let out = dir.path().join("out.jsonl");
     let resume = || {
         let o = crate::grasp_sim()
@@ -297,8 +296,7 @@ fn a_urdf_is_in_metres_whatever_units_say() {
     write(
         dir.path(),
         "ball.urdf",
-        "<robot name=\"r\"><link name=\"a\"><visual><geometry><sphere radius=\"0.03\"/>\
-         </geometry></visual></link></robot>",
+        one_link("<geometry><sphere radius=\"0.03\"/></geometry>"),
     );
     let scenario = |units: &str| {
         write(
@@ -348,12 +346,8 @@ fn open_shells_enclose_the_same_volume_in_a_turned_frame() {
             let urdf = write(
                 dir.path(),
                 &format!("{name}.urdf"),
-                format!(
-                    "<robot name=\"r\"><link name=\"a\"><visual><origin rpy=\"{rpy}\"/>\
-                     <geometry><mesh filename=\"{}\" scale=\"0.001 0.001 0.001\"/></geometry>\
-                     </visual></link></robot>",
-                    mesh.display()
-                ),
+                mm_mesh_link(&mesh.display().to_string())
+                    .replace("<visual>", &format!("<visual><origin rpy=\"{rpy}\"/>")),
             );
             json(&run(&["--json", "--no-sim"], &urdf))["object"]["volume_mm3"]
                 .as_f64()
