@@ -111,6 +111,9 @@ pub struct ObjectShape {
     /// True if and only if the object is inertially a body of revolution about its principal
     /// axis (aligned Z): its two transverse principal moments agree within 0.1 %.
     pub is_revolution: bool,
+    /// For a convex hull thinned where parry would merge curved faces, the full hull's vertex
+    /// count (see `coarsened_hull`).
+    pub coarsened_from: Option<usize>,
 }
 
 /// Convex decompositions made in this process, by the digest of their mesh: the same object
@@ -173,11 +176,16 @@ impl ObjectShape {
         if let Some(hull) = SharedShape::convex_hull(&points) {
             let hull_mm3 = f64::from(hull.mass_properties(1.0).mass()) * 1e9;
             if hull_mm3 <= volume_mm3 * 1.02 {
+                let (shape, coarsened_from) = match coarsened_hull(&points) {
+                    Some((coarse, from)) => (coarse, Some(from)),
+                    None => (hull, None),
+                };
                 return ObjectShape {
-                    shape: hull,
+                    shape,
                     kind: ColliderKind::ConvexHull,
                     parts: 1,
                     is_revolution,
+                    coarsened_from,
                 };
             }
         }
@@ -193,8 +201,206 @@ impl ObjectShape {
             kind: ColliderKind::ConvexDecomposition,
             parts,
             is_revolution,
+            coarsened_from: None,
         }
     }
+}
+
+/// parry builds a hull's faces by merging neighbouring triangles whose unit normals differ by
+/// less than this in `1 − n₁·n₂` (`ConvexPolyhedron::from_convex_mesh`: the square root of
+/// f32's epsilon, about 1.5°).
+const PARRY_FACE_MERGE: f32 = 3.452_669_8e-4;
+
+/// How far a vertex of a merged hull face may lie off that face's plane `[m]`: rapier's allowed
+/// contact error at the check's 1 cm length unit (0.05 mm).
+const MERGED_FACE_TOLERANCE_M: f32 = 5e-5;
+
+/// How far the faces parry makes of the hull `(vertices, triangles)` leave their planes `[m]`.
+/// parry merges neighbouring triangles whose normals are within [`PARRY_FACE_MERGE`] into one
+/// face, with the normal of one of them: right for a plane split into triangles, wrong for a
+/// finely tessellated curved surface (a cylinder of more than about 240 segments, whose faces
+/// meet at under 1.5°), which it chains into one non-planar face. The contacts against that
+/// face let a finger sink in: 8.4 mm into a 512-segment cylinder of 60 mm, against 0.01 mm at
+/// 144 segments.
+fn merged_face_deviation_m(vertices: &[Vector], triangles: &[[u32; 3]]) -> f32 {
+    let normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| vertices[i as usize]);
+        (b - a).cross(c - a).try_normalize()
+    };
+    let normals: Vec<Option<Vector>> = triangles.iter().map(normal).collect();
+    // Union-find over the triangles, joined where parry joins them.
+    let mut parent: Vec<usize> = (0..triangles.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    let mut by_edge: std::collections::HashMap<(u32, u32), usize> = Default::default();
+    for (k, t) in triangles.iter().enumerate() {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            match by_edge.entry((a.min(b), a.max(b))) {
+                std::collections::hash_map::Entry::Occupied(e) => {
+                    let other = *e.get();
+                    if let (Some(n1), Some(n2)) = (normals[k], normals[other]) {
+                        if n1.dot(n2) > 1.0 - PARRY_FACE_MERGE {
+                            let (r1, r2) = (root(&mut parent, k), root(&mut parent, other));
+                            parent[r1.max(r2)] = r1.min(r2);
+                        }
+                    }
+                }
+                std::collections::hash_map::Entry::Vacant(e) => {
+                    e.insert(k);
+                }
+            }
+        }
+    }
+    // Each face's plane: its lowest-numbered triangle's.
+    let mut worst = 0.0f32;
+    for (k, t) in triangles.iter().enumerate() {
+        let r = root(&mut parent, k);
+        if let Some(n) = normals[r] {
+            let p = vertices[triangles[r][0] as usize];
+            for &i in t {
+                worst = worst.max(n.dot(vertices[i as usize] - p).abs());
+            }
+        }
+    }
+    worst
+}
+
+/// Neighbouring faces of the hull from [`coarsened_hull`] are at least this far apart in
+/// normal: 2°, beyond parry's merge of 1.5°.
+const MIN_FACE_ANGLE_RAD: f64 = 2.0 * std::f64::consts::PI / 180.0;
+
+/// A face plane of the hull is a supporting plane if no hull vertex lies further than this
+/// outside it `[m]` (0.1 µm; f32 coordinates of a 0.1 m object are good to about 0.01 µm).
+const SUPPORT_TOLERANCE_M: f64 = 1e-7;
+
+/// The rebuilt hull may stand off the true one by at most this `[m]` (0.05 mm) or it is not used.
+const MAX_OUTER_STANDOFF_M: f64 = 5e-5;
+
+/// The convex hull of `points` (metres), rebuilt where parry would merge curved faces into
+/// non-planar ones ([`merged_face_deviation_m`]): the hull's face planes are taken largest
+/// face first, each kept only if its normal is at least [`MIN_FACE_ANGLE_RAD`] from every plane
+/// kept (a plane split into triangles is one plane, kept once), and the hull is rebuilt as the
+/// intersection of the kept half-spaces (its vertices found through the polar dual: the convex
+/// hull of the planes' poles, each of whose triangles is a vertex where its three planes meet).
+/// Every kept plane is a plane of the true hull, so the rebuilt one contains it, and stands off
+/// it by about r·θ²/8 on a round part of radius r (0.01 mm on a 60 mm cylinder at 2°); any
+/// two of its faces meet at 2° or more, so parry keeps them apart. Returns it with the full
+/// hull's vertex count, or `None` where the full hull needs no rebuilding (every thesis object)
+/// or the rebuilt one would stand off by more than [`MAX_OUTER_STANDOFF_M`].
+fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
+    use rapier3d::parry::transformation::try_convex_hull;
+    let (vertices, triangles) = try_convex_hull(points).ok()?;
+    if merged_face_deviation_m(&vertices, &triangles) <= MERGED_FACE_TOLERANCE_M {
+        return None;
+    }
+    let v64: Vec<Vector3<f64>> = vertices
+        .iter()
+        .map(|v| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z)))
+        .collect();
+    let centre = v64.iter().sum::<Vector3<f64>>() / v64.len() as f64;
+    // Each triangle's plane n·(x − centre) = d, with its area.
+    let mut planes: Vec<(f64, Vector3<f64>, f64)> = triangles
+        .iter()
+        .filter_map(|t| {
+            let [a, b, c] = t.map(|i| v64[i as usize]);
+            let cross = (b - a).cross(&(c - a));
+            let area = cross.norm();
+            (area > 0.0).then(|| {
+                let n = cross / area;
+                (area, n, n.dot(&(a - centre)))
+            })
+        })
+        .filter(|p| p.2 > 0.0)
+        .collect();
+    planes.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.2.total_cmp(&b.2)));
+    let cos_min = MIN_FACE_ANGLE_RAD.cos();
+    let mut kept: Vec<(Vector3<f64>, f64)> = Vec::new();
+    // A sliver triangle of nearly collinear points (a side's rings, one above the other) has a
+    // normal of rounding noise: its plane is kept only if the whole hull is on its inner side.
+    let supporting = |n: &Vector3<f64>, d: f64| {
+        v64.iter()
+            .all(|v| n.dot(&(v - centre)) <= d + SUPPORT_TOLERANCE_M)
+    };
+    for (_, n, d) in planes {
+        if kept.iter().all(|(m, _)| m.dot(&n) < cos_min) && supporting(&n, d) {
+            kept.push((n, d));
+        }
+    }
+    // The poles n / d; each triangle of their hull is a vertex of the intersection.
+    let poles: Vec<Vector> = kept
+        .iter()
+        .map(|(n, d)| {
+            let p = n / *d;
+            Vector::new(p.x as f32, p.y as f32, p.z as f32)
+        })
+        .collect();
+    let (dual_points, dual_triangles) = try_convex_hull(&poles).ok()?;
+    let by_pole: std::collections::HashMap<[u32; 3], usize> = poles
+        .iter()
+        .enumerate()
+        .map(|(k, p)| (p.to_array().map(f32::to_bits), k))
+        .collect();
+    let true_planes: Vec<(Vector3<f64>, Vector3<f64>)> = triangles
+        .iter()
+        .filter_map(|t| {
+            let [a, b, c] = t.map(|i| v64[i as usize]);
+            Some(((b - a).cross(&(c - a)).try_normalize(0.0)?, a))
+        })
+        .collect();
+    // How far a point stands outside the true hull `[m]`.
+    let standoff = |x: &Vector3<f64>| {
+        true_planes
+            .iter()
+            .map(|(n, a)| n.dot(&(x - a)))
+            .fold(0.0f64, f64::max)
+    };
+    let mut corners: Vec<Vector> = Vec::new();
+    for t in &dual_triangles {
+        let planes = t.map(|i| {
+            by_pole
+                .get(&dual_points[i as usize].to_array().map(f32::to_bits))
+                .map(|&k| kept[k])
+        });
+        let [Some(p1), Some(p2), Some(p3)] = planes else {
+            continue;
+        };
+        let m =
+            nalgebra::Matrix3::from_rows(&[p1.0.transpose(), p2.0.transpose(), p3.0.transpose()]);
+        // Three nearly parallel planes (a sliver of the dual hull) meet far off, or nowhere:
+        // their corner is another triangle's.
+        let Some(x) = m.lu().solve(&Vector3::new(p1.1, p2.1, p3.1)) else {
+            continue;
+        };
+        let p = x + centre;
+        if p.iter().all(|c| c.is_finite()) && standoff(&p) <= MAX_OUTER_STANDOFF_M {
+            corners.push(Vector::new(p.x as f32, p.y as f32, p.z as f32));
+        }
+    }
+    let (v, t) = try_convex_hull(&corners).ok()?;
+    if v.len() < 4 || merged_face_deviation_m(&v, &t) > MERGED_FACE_TOLERANCE_M {
+        return None;
+    }
+    // It must hold the whole true hull (no corner lost to the skips above).
+    let inside = t.iter().all(|tri| {
+        let [a, b, c] = tri.map(|i| {
+            let q = v[i as usize];
+            Vector3::new(f64::from(q.x), f64::from(q.y), f64::from(q.z))
+        });
+        let Some(n) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
+            return true;
+        };
+        v64.iter().all(|x| n.dot(&(x - a)) <= SUPPORT_TOLERANCE_M)
+    });
+    if !inside {
+        return None;
+    }
+    SharedShape::convex_hull(&v).map(|s| (s, vertices.len()))
 }
 
 /// Handles of what the protocol measures.
@@ -802,6 +1008,65 @@ mod tests {
         let b = ObjectShape::cached(&prism, v);
         assert_eq!(a.kind, ColliderKind::ConvexHull);
         assert!(!std::sync::Arc::ptr_eq(&a.shape.0, &b.shape.0));
+    }
+
+    /// A cylinder of 60 mm and 120 mm on `segments` facets, with a ring every 10 mm.
+    fn fine_cylinder(segments: usize) -> Mesh {
+        use crate::objects::{radial_solid, uniform_angles, Ring};
+        let rings: Vec<Ring> = (0..=12)
+            .map(|k| Ring {
+                z: 10.0 * k as f64,
+                radii: vec![30.0; segments],
+            })
+            .collect();
+        radial_solid(&uniform_angles(segments), &rings)
+    }
+
+    #[test]
+    fn a_hull_parry_would_merge_into_curved_faces_is_rebuilt_from_its_planes() {
+        let shape = |segments| {
+            let mesh = fine_cylinder(segments);
+            let v = crate::mesh::mass_properties(&mesh).volume_mm3;
+            (ObjectShape::from_mesh(&mesh, v), mesh)
+        };
+        let hull_of = |s: &ObjectShape| {
+            let c = s.shape.as_convex_polyhedron().unwrap();
+            rapier3d::parry::transformation::try_convex_hull(c.points()).unwrap()
+        };
+        // 144 facets meet at 2.5°: parry keeps them apart, and the hull is the plain one, as for
+        // every thesis object.
+        let (plain, _) = shape(144);
+        assert_eq!(plain.coarsened_from, None);
+        assert_eq!(plain.kind, ColliderKind::ConvexHull);
+        // 512 facets meet at 0.7°, within parry's 1.5° merge: the side would become one face
+        // bent round the cylinder, some 30 mm off its own plane.
+        let mesh = fine_cylinder(512);
+        let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
+        let (v, t) = rapier3d::parry::transformation::try_convex_hull(&points).unwrap();
+        let bent = merged_face_deviation_m(&v, &t);
+        assert!(bent > 0.02, "{bent} m");
+        let (rebuilt, mesh) = shape(512);
+        assert_eq!(rebuilt.coarsened_from, Some(1024));
+        let (v, t) = hull_of(&rebuilt);
+        assert!(merged_face_deviation_m(&v, &t) <= MERGED_FACE_TOLERANCE_M);
+        // Fewer facets, no two within 2° of each other: 512 / (2° of 0.703°) rounds to 148 or so.
+        assert!((200..=400).contains(&v.len()), "{} vertices", v.len());
+        // It holds the whole mesh (every vertex inside every face plane, to 0.1 µm) and stands
+        // off it by under 0.05 mm: every corner within 30 mm + 0.05 mm of the axis and within
+        // the caps.
+        for tri in &t {
+            let [a, b, c] = tri.map(|i| v[i as usize]);
+            let n = (b - a).cross(c - a).normalize();
+            for p in &mesh.vertices {
+                let out = n.dot(convert::point_m(p) - a);
+                assert!(out <= 1e-7, "{p:?}: {out} m outside");
+            }
+        }
+        for c in &v {
+            let r = (c.x * c.x + c.y * c.y).sqrt();
+            assert!((0.0299..=0.030_05).contains(&r), "{r} m");
+            assert!(c.z >= -1e-6 && c.z <= 0.120 + 1e-6, "{} m", c.z);
+        }
     }
 
     /// A 40 x 100 x 80 mm box about the z axis, its faces at x = ±20 and y = ±50.
