@@ -66,6 +66,12 @@ pub struct Cli {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100))]
     pub max_checked: Option<u32>,
 
+    /// Gravity directions of the physics check, for every input: `down` (the aligned object's
+    /// −Z) or `six` (±X, ±Y, ±Z in turn, each from the one closing); default: each scenario's
+    /// `[sim] gravity`, `down` for a bare mesh.
+    #[arg(long, value_name = "DIRECTIONS", value_parser = ["down", "six"])]
+    pub gravity: Option<String>,
+
     #[command(subcommand)]
     pub command: Option<Command>,
 }

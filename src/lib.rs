@@ -62,7 +62,7 @@ pub enum Error {
 }
 
 /// How to run a scenario.
-#[derive(Debug, Clone)]
+#[derive(Clone)]
 pub struct RunOptions {
     /// Skip the physics check.
     pub no_sim: bool,
@@ -82,6 +82,9 @@ pub struct RunOptions {
     pub export_urdf: Option<std::path::PathBuf>,
     /// Write figures, 3D scenes and report.html into this folder (a subfolder per scenario).
     pub report: Option<std::path::PathBuf>,
+    /// The name of the subfolder of `report`, `export_mjcf` and `export_urdf` (`None`: the
+    /// scenario's name).
+    pub folder: Option<String>,
 }
 
 /// Candidates the physics check runs on at most before a run settles for the best it saw.
@@ -98,7 +101,33 @@ impl Default for RunOptions {
             export_mjcf: None,
             export_urdf: None,
             report: None,
+            folder: None,
         }
+    }
+}
+
+/// Everything but `folder`, as a derived `Debug` would write it: a batch's input hash is this
+/// text (`batch::input_hash`), and where the outputs go does not change what is computed, so
+/// results files written before `folder` existed still resume.
+impl std::fmt::Debug for RunOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RunOptions")
+            .field("no_sim", &self.no_sim)
+            .field("payload", &self.payload)
+            .field("quality", &self.quality)
+            .field("candidates", &self.candidates)
+            .field("max_checked", &self.max_checked)
+            .field("export_mjcf", &self.export_mjcf)
+            .field("export_urdf", &self.export_urdf)
+            .field("report", &self.report)
+            .finish()
+    }
+}
+
+impl RunOptions {
+    /// The subfolder of the output folders for `scenario`.
+    pub fn folder_for<'a>(&'a self, scenario: &'a Scenario) -> &'a str {
+        self.folder.as_deref().unwrap_or(&scenario.name)
     }
 }
 
@@ -157,7 +186,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
     };
     if let Some(dir) = &options.report {
         visual::write_report(
-            &dir.join(&scenario.name),
+            &dir.join(options.folder_for(scenario)),
             &report,
             &shown.graded,
             chosen.map(|c| &c.grasp),
@@ -380,7 +409,11 @@ fn run_sim(
     Error,
 > {
     if let Some(dir) = &options.export_urdf {
-        export::write_urdf(&dir.join(&scenario.name), &scenario.hand, &scenario.sim)?;
+        export::write_urdf(
+            &dir.join(options.folder_for(scenario)),
+            &scenario.hand,
+            &scenario.sim,
+        )?;
     }
     if options.no_sim && options.export_mjcf.is_none() {
         return Ok((SimReport::not_run("--no-sim"), None, None));
@@ -404,7 +437,7 @@ fn run_sim(
             object: aligned,
             case,
         };
-        export::write_mjcf(&dir.join(&scenario.name), &input)?;
+        export::write_mjcf(&dir.join(options.folder_for(scenario)), &input)?;
     }
     if options.no_sim {
         return Ok((SimReport::not_run("--no-sim"), None, None));
@@ -444,7 +477,15 @@ fn checked_report(
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
         start: Some(sim::scene::start(case)),
-        collider: Some(format!("{} ({} parts)", shape.kind, shape.parts)),
+        collider: Some(match shape.coarsened_from {
+            Some(from) => format!(
+                "{} ({} parts, rebuilt from its face planes, {from} vertices to {}, where parry would merge curved faces)",
+                shape.kind,
+                shape.parts,
+                shape.shape.as_convex_polyhedron().map_or(0, |c| c.points().len())
+            ),
+            None => format!("{} ({} parts)", shape.kind, shape.parts),
+        }),
         mass_kg: Some(case.mass_kg),
         grasp_source: Some(source),
         payload_margin: options
@@ -452,6 +493,11 @@ fn checked_report(
             .then(|| payload.map_or(0.0, |(held, _)| held)),
         payload_fails_at: payload.and_then(|(_, failed)| failed),
         directions: out.directions,
+        limits: Some(report::HoldLimits {
+            translation_mm: case.params.hold_translation_mm,
+            rotation_deg: case.params.hold_rotation_deg,
+            penetration_mm: case.params.max_penetration_mm,
+        }),
     }
 }
 
@@ -493,7 +539,7 @@ fn ungraspable_reason(selection: &select::Selection, hand: &hand::Hand) -> Strin
     match selection.axes.len() {
         1 => first,
         n => format!(
-            "{first} (and no grasp in the {} other axis and rule combinations tried: see plan.axes)",
+            "{first} (and no grasp in the {} other axis and rule combinations tried: `plan.axes` in --json)",
             n - 1
         ),
     }

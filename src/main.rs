@@ -4,7 +4,11 @@ mod cli;
 
 use anyhow::Context;
 use clap::Parser;
-use grasp_sim::{run, scenario::Scenario, RunOptions};
+use grasp_sim::{
+    run,
+    scenario::{GravityMode, Scenario},
+    RunOptions,
+};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -93,6 +97,7 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         export_mjcf: cli.export_mjcf,
         export_urdf: cli.export_urdf,
         report: cli.report,
+        folder: None,
     };
     // Output folders are checked before any work, so an unwritable one costs nothing.
     for (flag, dir) in [
@@ -111,25 +116,56 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
     }
     let mut template = grasp_sim::batch::default_template();
     template.object.units = parse_units(&cli.units);
+    let gravity = cli.gravity.as_deref().map(|g| match g {
+        "six" => GravityMode::Six,
+        _ => GravityMode::Down,
+    });
     // Each input runs on its own: a bad one is reported on stderr and the others still run and
     // print; the exit status is the worst (2 bad input, 1 an expectation not met, 0).
     let mut status = 0u8;
     let mut out = std::io::stdout().lock();
+    let mut names: std::collections::HashMap<String, usize> = Default::default();
+    let writes_folders =
+        options.report.is_some() || options.export_mjcf.is_some() || options.export_urdf.is_some();
     for path in &cli.scenarios {
         let item = if grasp_sim::mesh::MeshFormat::from_path(path).is_some() {
             grasp_sim::batch::Item::Mesh(path.clone())
         } else {
             grasp_sim::batch::Item::Scenario(path.clone())
         };
-        let report = match grasp_sim::batch::scenario_for(&item, &template).and_then(|s| {
+        if cli.units != "mm" && matches!(item, grasp_sim::batch::Item::Scenario(_)) {
+            eprintln!(
+                "grasp-sim: warning: {}: --units {} applies to bare meshes; a scenario gives its unit in `[object] units` (millimetres if it says none)",
+                path.display(),
+                cli.units
+            );
+        }
+        let (report, folder) = match grasp_sim::batch::scenario_for(&item, &template).and_then(|mut s| {
+            if let Some(g) = gravity {
+                s.sim.gravity = g;
+            }
+            // Two inputs of one name (every file of a YCB-style set is `textured.obj`) would
+            // write one output folder: the later ones get `NAME-2`, `NAME-3`, ... and are told.
+            let mut options = options.clone();
+            let count = names.entry(s.name.clone()).or_insert(0);
+            *count += 1;
+            if *count > 1 && writes_folders {
+                let folder = format!("{}-{count}", s.name);
+                eprintln!(
+                    "grasp-sim: warning: {}: an earlier input has the name `{}`; its output folders are `{folder}`",
+                    path.display(),
+                    s.name
+                );
+                options.folder = Some(folder);
+            }
             let spinner = progress_spinner(&s, &options);
-            let r = run(&s, &options);
+            let r = run(&s, &options).map(|r| (r, options.folder));
             if let Some(b) = spinner {
                 b.finish_and_clear();
             }
             r
         }) {
-            Ok(r) => r,
+            Ok((r, folder)) => (r, folder),
             Err(e) => {
                 let msg = format!("{e:#}").replace('\n', " ");
                 // A scenario's mesh or hand file that cannot be read names that file; say which
@@ -139,7 +175,8 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
                 // `.dae`, a `.txt`) was read as a scenario: say what is read.
                 let hint = match item {
                     grasp_sim::batch::Item::Scenario(_)
-                        if !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
+                        if !path.is_dir()
+                            && !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
                     {
                         " (read as a scenario: grasp-sim reads scenarios from .toml files and meshes from .stl, .obj, .ply and .urdf)"
                     }
@@ -158,11 +195,30 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
         for w in &report.warnings {
             eprintln!("grasp-sim: warning: {w}");
         }
+        let folder = folder.as_deref().unwrap_or(&report.scenario);
         if let Some(dir) = &options.report {
             eprintln!(
                 "grasp-sim: report written to {}",
-                dir.join(&report.scenario).join("report.html").display()
+                dir.join(folder).join("report.html").display()
             );
+        }
+        if let Some(dir) = &options.export_mjcf {
+            if dir.join(folder).join("scene.xml").is_file() {
+                eprintln!(
+                    "grasp-sim: MJCF scene written to {}",
+                    dir.join(folder).join("scene.xml").display()
+                );
+            } else {
+                eprintln!(
+                    "grasp-sim: warning: {}: no MJCF scene written: {}",
+                    report.scenario,
+                    report
+                        .plan
+                        .reason
+                        .as_deref()
+                        .unwrap_or("no grasp to export")
+                );
+            }
         }
         if cli.json {
             writeln!(out, "{}", grasp_sim::report::to_rounded_json(&report)?)?;
@@ -205,6 +261,9 @@ fn progress_spinner(s: &Scenario, options: &RunOptions) -> Option<indicatif::Pro
 
 /// Creates `dir` if needed and checks a file can be written in it.
 fn check_writable_dir(dir: &std::path::Path) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!("{}: is a file, not a folder", dir.display());
+    }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("{}: cannot create folder", dir.display()))?;
     let probe = dir.join(".grasp-sim-write-test");
@@ -224,6 +283,13 @@ fn check_writable_file(file: &std::path::Path) -> anyhow::Result<()> {
             "{}: cannot write: no folder {}",
             file.display(),
             dir.display()
+        );
+    }
+    if file.is_dir() {
+        anyhow::bail!(
+            "{}: is a folder; give a file to write the results to (for example {})",
+            file.display(),
+            file.join("results.jsonl").display()
         );
     }
     let probe = dir.join(".grasp-sim-write-test");
@@ -280,6 +346,14 @@ fn tune(
         b.finish_and_clear();
     }
     let result = result?;
+    // Inputs that could not be loaded were left out; each is named, and the run exits 2.
+    for (path, why) in &result.skipped {
+        if why.contains(path.as_str()) {
+            eprintln!("grasp-sim: error: {why}");
+        } else {
+            eprintln!("grasp-sim: error: {path}: {why}");
+        }
+    }
     std::fs::create_dir_all(out)
         .with_context(|| format!("{}: cannot create folder", out.display()))?;
     write_atomically(&out.join("tune.csv"), tune::to_csv(&result).as_bytes())?;
@@ -319,7 +393,7 @@ fn tune(
         best.mean_payload_margin,
         best.mean_translation_mm
             .map_or("-".to_string(), |t| format!("{t:.2}")),
-        batch::plural(items.len(), "object")
+        batch::plural(result.counters.objects_loaded, "object")
     );
     let c = &result.counters;
     eprintln!(
@@ -339,7 +413,7 @@ fn tune(
             .collect::<Vec<_>>()
             .join(", ")
     );
-    Ok(0)
+    Ok(if result.skipped.is_empty() { 0 } else { 2 })
 }
 
 fn parse_units(s: &str) -> grasp_sim::mesh::LengthUnit {

@@ -510,6 +510,22 @@ pub struct SimReport {
     /// Per gravity direction.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub directions: Vec<crate::sim::DirectionOutcome>,
+    /// The limits the verdict was judged by (`[sim] hold_translation_mm`, `hold_rotation_deg`,
+    /// `max_penetration_mm`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub limits: Option<HoldLimits>,
+}
+
+/// The limits of a hold: how far the object may move and turn relative to the palm, and how
+/// deep a finger may end the closing inside it.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct HoldLimits {
+    /// `[mm]`.
+    pub translation_mm: f64,
+    /// `[deg]`.
+    pub rotation_deg: f64,
+    /// `[mm]`.
+    pub penetration_mm: f64,
 }
 
 impl SimReport {
@@ -531,6 +547,7 @@ impl SimReport {
             payload_margin: None,
             payload_fails_at: None,
             directions: Vec::new(),
+            limits: None,
         }
     }
 }
@@ -704,6 +721,15 @@ impl RunReport {
             a[0], a[1], a[2]
         );
         let p = &self.plan;
+        // The height above is along the least axis; a grasp about another one is planned, and
+        // its elevations below measured, along that one.
+        if let Some(g) = p.grasp.as_ref().filter(|g| g.axis_name != "least") {
+            let _ = writeln!(
+                s,
+                "  Grasp axis  the {} principal axis ({:.4}, {:.4}, {:.4}), original frame: the elevations below are along it",
+                g.axis_name, g.axis[0], g.axis[1], g.axis[2]
+            );
+        }
         // Under the extended rules the range is the whole object widened so that an outer
         // finger may overhang its ends: not the thesis's Effective Elevation, so not called so.
         let range_name = match p.grasp.as_ref().map(|g| g.rules) {
@@ -754,9 +780,14 @@ impl RunReport {
                 String::new()
             }
         );
-        let plan_line = match &p.reason {
-            Some(r) => format!("{} ({r})", p.status),
-            None => p.status.to_string(),
+        let plan_line = match (&p.reason, &p.grasp) {
+            (Some(r), _) => format!("{} ({r})", p.status),
+            (None, Some(g)) if g.rules != crate::plan::RuleSet::Thesis => format!(
+                "{} under rules beyond the thesis ({}), as the thesis's own found no grasp, or none that held",
+                p.status,
+                g.one_line_rules()
+            ),
+            (None, _) => p.status.to_string(),
         };
         let checked = if p.candidates_checked > 0 {
             format!(", {} checked", p.candidates_checked)
@@ -820,13 +851,19 @@ impl RunReport {
         let sim_line = match (&self.sim.verdict, self.sim.translation_mm) {
             (SimVerdict::NotRun { reason }, _) => format!("not run ({reason})"),
             (SimVerdict::Ran(verdict), Some(t)) => format!(
-                "{verdict}: moved {:.2} mm and {:.2} deg relative to the palm while held; {} steps, {:.0} ms{}",
+                "{verdict}: moved {:.2} mm and {:.2} deg relative to the palm {}; {} steps, {:.0} ms{}",
                 t,
                 self.sim.rotation_deg.unwrap_or(0.0),
+                if *verdict == Verdict::Drop {
+                    "by the end of the hold"
+                } else {
+                    "while held"
+                },
                 self.sim.steps.unwrap_or(0),
                 self.sim.wall_ms.unwrap_or(0.0),
                 match self.sim.payload_margin {
-                    Some(m) => format!("; payload margin {m:.2}x"),
+                    Some(m) if *verdict == Verdict::Hold => format!("; payload margin {m:.2}x"),
+                    Some(_) => "; payload margin none (it does not hold its own weight)".to_string(),
                     None => String::new(),
                 }
             ),
@@ -883,10 +920,21 @@ impl RunReport {
             SimVerdict::Ran(Verdict::Hold) => {
                 format!("{grasp}: HELD under gravity (moved {moved})")
             }
-            SimVerdict::Ran(Verdict::Slip) => format!(
-                "{grasp}: NOT held: the object slipped {moved}, beyond the hold limits, but stayed \
-                 in the hand"
-            ),
+            SimVerdict::Ran(Verdict::Slip) => match penetrated_slip(sim) {
+                Some((depth, limit)) => format!(
+                    "{grasp}: NOT held: a finger ended the closing {depth:.2} mm inside the \
+                     object, more than max_penetration_mm ({limit} mm), so the grip is not one a \
+                     real hand makes (the object moved {moved})"
+                ),
+                None => format!(
+                    "{grasp}: NOT held: the object slipped {moved}, beyond the hold limits{}, but \
+                     stayed in the hand",
+                    sim.limits.map_or(String::new(), |l| format!(
+                        " ({} mm, {} deg)",
+                        l.translation_mm, l.rotation_deg
+                    ))
+                ),
+            },
             SimVerdict::Ran(Verdict::Drop) => {
                 format!("{grasp}: NOT held: the object fell out of the hand (moved {moved})")
             }
@@ -895,6 +943,23 @@ impl RunReport {
             }
         }
     }
+}
+
+/// For a `slip` that moved within the hold limits in every direction: it is a slip because a
+/// finger ended the closing deeper in the object than the limit. Returns the depth and the
+/// limit `[mm]`.
+fn penetrated_slip(sim: &SimReport) -> Option<(f64, f64)> {
+    let l = sim.limits?;
+    let within = sim.directions.iter().all(|d| {
+        d.verdict != Verdict::Slip
+            || (d.translation_mm <= l.translation_mm && d.rotation_deg <= l.rotation_deg)
+    });
+    let depth = sim
+        .directions
+        .iter()
+        .map(|d| d.closing_penetration_mm)
+        .fold(0.0, f64::max);
+    (within && depth > l.penetration_mm).then_some((depth, l.penetration_mm))
 }
 
 /// The summary's quality line: epsilon and volume, what they were computed from, and why

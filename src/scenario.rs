@@ -249,7 +249,7 @@ impl Scenario {
         if path.is_dir() {
             return Err(ScenarioError::Io {
                 path: path.to_path_buf(),
-                message: "is a directory, not a scenario file".to_string(),
+                message: "is a folder, not a scenario file (`grasp-sim batch FOLDER` runs every scenario, URDF or mesh in a folder)".to_string(),
             });
         }
         let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
@@ -471,6 +471,7 @@ mod tests {
             ("", "[sim]\nduration_s = 0.0", "sim.duration_s"),
             ("", "[sim]\ntimestep_s = 0.1", "sim.timestep_s"),
             ("", "[sim]\nmax_checked = 0", "sim.max_checked"),
+            ("", "[sim]\noverride_index = 5", "sim.override_index"),
             (
                 "",
                 "[sim]\nsolver_iterations = 101",

@@ -295,6 +295,9 @@ pub struct TuneResult {
     pub best: usize,
     /// Work counters.
     pub counters: TuneCounters,
+    /// Inputs that could not be loaded, left out of every setting: the file and the problem.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub skipped: Vec<(String, String)>,
 }
 
 struct Prepared {
@@ -376,10 +379,27 @@ pub fn tune_with_progress(
 ) -> Result<TuneResult, Error> {
     let settings = grid(sweeps);
     let mut prepared = Vec::new();
+    let mut skipped = Vec::new();
+    let mut first_error = None;
+    // A bad input is left out (and reported), as in a batch: the others are still tuned on.
     for item in items {
-        let scenario = scenario_for(item, template)?;
-        let object = PreparedObject::load(&scenario.object, &mut StageTimings::default())?;
-        prepared.push(Prepared { scenario, object });
+        let loaded = scenario_for(item, template).and_then(|scenario| {
+            let object = PreparedObject::load(&scenario.object, &mut StageTimings::default())?;
+            Ok(Prepared { scenario, object })
+        });
+        match loaded {
+            Ok(p) => prepared.push(p),
+            Err(e) => {
+                skipped.push((item.path().display().to_string(), e.to_string()));
+                first_error.get_or_insert(e);
+            }
+        }
+    }
+    // Nothing to tune on: the first input's error, as a run of that input alone would give.
+    if prepared.is_empty() {
+        if let Some(e) = first_error {
+            return Err(e);
+        }
     }
     let work = || -> Vec<PerObject> {
         prepared
@@ -422,6 +442,7 @@ pub fn tune_with_progress(
         settings: results,
         best,
         counters,
+        skipped,
     })
 }
 

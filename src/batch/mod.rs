@@ -96,8 +96,8 @@ impl Item {
 /// else its meshes (`*.stl`, `*.obj`, `*.ply`).
 ///
 /// # Errors
-/// [`ScenarioError::Io`] for an input that does not exist or is neither a folder, a `.toml` nor
-/// a mesh file.
+/// [`ScenarioError::Io`] for an input that does not exist, is neither a folder, a `.toml` nor
+/// a mesh file, or is a folder with none of these in it.
 pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
     let mut items = Vec::new();
     for input in inputs {
@@ -116,6 +116,13 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
                 found.retain(|i| matches!(i, Item::Scenario(_)));
             } else if found.iter().any(|i| is_urdf(i.path())) {
                 found.retain(|i| is_urdf(i.path()));
+            }
+            if found.is_empty() {
+                return Err(ScenarioError::Io {
+                    path: input.clone(),
+                    message: "no scenario (.toml) or mesh (.stl, .obj, .ply, .urdf) in this folder"
+                        .to_string(),
+                });
             }
             found.sort_by(|a, b| a.path().cmp(b.path()));
             items.extend(found);

@@ -745,6 +745,11 @@ fn stl_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
             // stl_io names no line: find the first line that breaks the grammar and name it.
             MeshError::Ascii { path, detail } => MeshError::Ascii {
                 detail: match first_bad_ascii_line(original_text) {
+                    // stl_io's own words add nothing to a non-finite number but its Rust
+                    // names ("expected finite f32, got NaN which is Nan").
+                    Some((n, line, want)) if detail.contains("expected finite f32") => {
+                        format!("line {n} ({line}): {want}, with finite numbers")
+                    }
                     Some((n, line, want)) => format!("line {n} ({line}): {want} ({detail})"),
                     None => detail,
                 },

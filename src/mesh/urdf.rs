@@ -96,7 +96,8 @@ fn resolve(path: &Path, filename: &str) -> Option<PathBuf> {
     let dir = path.parent().unwrap_or(Path::new("."));
     if let Some(rest) = filename.strip_prefix("file://") {
         let p = PathBuf::from(rest);
-        return Some(if p.is_absolute() { p } else { dir.join(p) });
+        let p = if p.is_absolute() { p } else { dir.join(p) };
+        return p.is_file().then_some(p);
     }
     if let Some(rest) = filename.strip_prefix("package://") {
         let without_package = rest.split_once('/').map(|(_, r)| r);
@@ -112,7 +113,8 @@ fn resolve(path: &Path, filename: &str) -> Option<PathBuf> {
         }
         return None;
     }
-    Some(dir.join(filename))
+    let p = dir.join(filename);
+    p.is_file().then_some(p)
 }
 
 /// The geometry of one `<visual>` or `<collision>` element, or why it cannot be read.
@@ -164,17 +166,19 @@ fn geometry(path: &Path, element: roxmltree::Node) -> Result<Result<Placed, Stri
                     format!("line {line}: mesh {name} has a scale of 0"),
                 ));
             }
+            // A format grasp-sim does not read (a `.dae` visual) is a note, found or not: the
+            // link's collision geometry may stand in.
+            if MeshFormat::from_path(Path::new(name)).is_none_or(|f| f == MeshFormat::Urdf) {
+                return Ok(Err(format!(
+                    "mesh {name} is not a format grasp-sim reads (STL, OBJ, PLY)"
+                )));
+            }
             let Some(file) = resolve(path, name) else {
                 return Err(urdf_err(
                     path,
                     format!("line {line}: mesh {name} not found beside the URDF or above it"),
                 ));
             };
-            if MeshFormat::from_path(&file).is_none_or(|f| f == MeshFormat::Urdf) {
-                return Ok(Err(format!(
-                    "mesh {name} is not a format grasp-sim reads (STL, OBJ, PLY)"
-                )));
-            }
             Shape::Mesh(file, scale)
         }
         "box" => {
@@ -414,7 +418,8 @@ pub fn load_urdf(path: &Path) -> Result<LoadedMesh, MeshError> {
     for p in &placed {
         let (triangles, scale) = match &p.shape {
             Shape::Mesh(file, scale) => {
-                let (t, _) = load_raw(file)?;
+                // The mesh's own error names the mesh; say which URDF asked for it too.
+                let (t, _) = load_raw(file).map_err(|e| urdf_err(path, e.to_string()))?;
                 let t: Vec<[[f64; 3]; 3]> = t
                     .into_iter()
                     .map(|tri| tri.map(|v| v.map(f64::from)))

@@ -217,6 +217,13 @@ impl SimParams {
                 ));
             }
         }
+        if s.override_index.is_some() && s.override_angles.is_none() {
+            return Err((
+                "sim.override_index",
+                "applies only with override_angles (the planner places the palm otherwise)"
+                    .to_string(),
+            ));
+        }
         for (key, v) in keyed!("sim", s; squeeze_deg, squeeze2_deg) {
             if !v.is_finite() || v < 0.0 {
                 return Err((key, format!("must be zero or positive, got {v}")));

@@ -644,3 +644,60 @@ fn the_summary_names_the_elevation_range_it_searched() {
     let text = String::from_utf8_lossy(&out.stdout);
     assert!(text.contains("Effective elevation none"), "{text}");
 }
+
+#[test]
+fn gravity_on_the_command_line_overrides_the_scenario() {
+    // `--gravity six` checks a bare mesh in the six directions a scenario's `[sim] gravity`
+    // would; `--gravity down` takes a `six` scenario back to the one direction. The grasp is
+    // the same either way, and the first direction of `six` (+X) differs from `down` (−Z).
+    let dir = tempfile::tempdir().unwrap();
+    let root = crate::root();
+    let mesh = root.join("assets/objects/cylinder_d40.stl");
+    let scenario = dir.path().join("d40_six.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "[object]\nmesh = {:?}\ndensity_kg_m3 = 500.0\nfriction = 0.3\n[sim]\ngravity = \"six\"\n",
+            mesh.to_str().unwrap()
+        ),
+    )
+    .unwrap();
+    let directions = |args: &[&str]| -> (Vec<Vec<f64>>, serde_json::Value) {
+        let out = run_in(dir.path(), args);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let dirs = v["sim"]["directions"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|d| serde_json::from_value(d["gravity"].clone()).unwrap())
+            .collect();
+        // The grasp as planned (its `check` is the physics check's, which gravity changes).
+        let mut grasp = v["plan"]["grasp"].clone();
+        grasp.as_object_mut().unwrap().remove("check");
+        (dirs, grasp)
+    };
+    let m = mesh.to_str().unwrap();
+    let s = scenario.to_str().unwrap();
+    let (bare, grasp) = directions(&["--json", m]);
+    assert_eq!(bare, vec![vec![0.0, 0.0, -1.0]]);
+    let (bare_six, grasp_six) = directions(&["--json", "--gravity", "six", m]);
+    assert_eq!(bare_six.len(), 6, "{bare_six:?}");
+    assert_eq!(bare_six[0], vec![1.0, 0.0, 0.0]);
+    assert!(bare_six.contains(&vec![0.0, 0.0, -1.0]), "{bare_six:?}");
+    assert_eq!(grasp, grasp_six);
+    let (scenario_six, _) = directions(&["--json", s]);
+    assert_eq!(scenario_six, bare_six);
+    let (scenario_down, _) = directions(&["--json", "--gravity", "down", s]);
+    assert_eq!(scenario_down, bare);
+    // Anything else is a usage error, exit 2, that lists the two.
+    let out = run_in(dir.path(), &["--gravity", "sideways", m]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("possible values: down, six"), "{err}");
+}

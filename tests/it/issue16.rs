@@ -243,6 +243,10 @@ fn a_malformed_ascii_stl_names_its_line() {
             "\nsolid t\n  facet normal 0 0 1\n  outer lop\n",
             "line 4 (`outer lop`): expected `outer loop`",
         ),
+        (
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex nan 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n",
+            "line 4 (`vertex nan 0 0`): expected `vertex x y z`, with finite numbers",
+        ),
     ];
     for (k, (text, needle)) in cases.iter().enumerate() {
         let p = dir.path().join(format!("m{k}.stl"));
@@ -459,4 +463,184 @@ fn an_ungraspable_object_shows_the_constraints_that_rejected_it() {
     let why = std::fs::read_to_string(out.join("cup_no_pitch/rejections.svg")).unwrap();
     assert!(why.contains("palm pitch out of range ("), "{why}");
     assert!(why.contains("class=\"rejection\""), "{why}");
+}
+
+/// The newcomer's path of 2026-12-01: one bad input does not sink a `tune`, an output file
+/// that is a folder and a folder with nothing to run are refused before any work, two inputs
+/// of one name write two output folders, and `--units` on a scenario says it does not apply.
+#[test]
+fn tune_batch_and_outputs_keep_the_good_inputs_and_refuse_bad_paths_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let good = crate::root().join("assets/objects/cylinder_d40.stl");
+    let bad = d.join("nan.stl");
+    std::fs::write(&bad, "solid t\nfacet normal 0 0 1\nouter loop\nvertex nan 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n").unwrap();
+    // tune: the bad mesh is named and left out, the good one tuned on, the results written,
+    // exit 2.
+    let out_dir = d.join("tune");
+    let out = grasp_sim()
+        .args(["tune", "--param", "sf_c=0:1:1", "--out"])
+        .arg(&out_dir)
+        .arg(&good)
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("nan.stl: malformed ASCII STL: line 4"),
+        "{err}"
+    );
+    assert!(String::from_utf8_lossy(&out.stdout).contains("over 1 object"));
+    let json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out_dir.join("tune.json")).unwrap()).unwrap();
+    assert_eq!(json["skipped"][0][0], bad.display().to_string());
+    assert_eq!(json["counters"]["objects_loaded"], 1);
+    // tune on the bad mesh alone: its error, nothing written.
+    let alone = d.join("tune_alone");
+    let out = grasp_sim()
+        .args(["tune", "--param", "sf_c=0:1:1", "--out"])
+        .arg(&alone)
+        .arg(&bad)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(!alone.join("tune.json").exists());
+    // A folder with nothing to run, for tune and batch: an error naming it, no work done.
+    let empty = d.join("only_dae");
+    std::fs::create_dir(&empty).unwrap();
+    std::fs::write(empty.join("mug.dae"), "<COLLADA/>").unwrap();
+    for args in [
+        vec!["batch".to_string()],
+        vec![
+            "tune".into(),
+            "--param".into(),
+            "sf_c=0:1:1".into(),
+            "--out".into(),
+            d.join("t2").display().to_string(),
+        ],
+    ] {
+        let out = grasp_sim().args(&args).arg(&empty).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.contains("no scenario (.toml) or mesh (.stl, .obj, .ply, .urdf) in this folder"),
+            "{err}"
+        );
+    }
+    // batch --out naming a folder: refused before the object runs.
+    let out = grasp_sim()
+        .arg("batch")
+        .arg(&good)
+        .arg("--out")
+        .arg(d)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("is a folder; give a file to write the results to"),
+        "{err}"
+    );
+    assert!(!err.contains("[1/1]") && !err.contains("hold"), "{err}");
+    // Two inputs of one name: two report folders, the second told.
+    for sub in ["a", "b"] {
+        std::fs::create_dir(d.join(sub)).unwrap();
+        std::fs::copy(&good, d.join(sub).join("obj.stl")).unwrap();
+    }
+    let reports = d.join("reports");
+    let out = grasp_sim()
+        .args(["--no-sim", "--report"])
+        .arg(&reports)
+        .arg(d.join("a/obj.stl"))
+        .arg(d.join("b/obj.stl"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(reports.join("obj/report.html").is_file());
+    assert!(reports.join("obj-2/report.html").is_file());
+    assert!(
+        err.contains("an earlier input has the name `obj`; its output folders are `obj-2`"),
+        "{err}"
+    );
+    // --units on a scenario: it does not apply, and the run says so.
+    let out = succeed(grasp_sim().args(["--no-sim", "--units", "m", "scenarios/cup.toml"]));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("--units m applies to bare meshes"), "{err}");
+}
+
+#[test]
+fn the_summary_names_the_grasp_axis_and_the_rules_beyond_the_thesis() {
+    // A 50 x 70 x 150 mm box: the thesis's rules find nothing (the palm meets the object in
+    // its plane), the extended rules back the palm off. The Plan line says so.
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("box.stl");
+    std::fs::write(
+        &p,
+        grasp_sim::objects::prism(50.0, 70.0, 150.0).to_binary_stl(),
+    )
+    .unwrap();
+    let out = succeed(grasp_sim().arg("--no-sim").arg(&p));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let plan = text
+        .lines()
+        .find(|l| l.trim_start().starts_with("Plan "))
+        .unwrap();
+    let json = succeed(grasp_sim().args(["--no-sim", "--json"]).arg(&p));
+    let v: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let g = &v["plan"]["grasp"];
+    assert_eq!(g["rules"], "extended", "{g}");
+    assert_eq!(g["relaxations"][0], "palm_backed_off", "{g}");
+    assert!(
+        plan.contains("feasible under rules beyond the thesis (extended: palm_backed_off)"),
+        "{plan}"
+    );
+    // About its least axis, as the Object line: no Grasp axis line.
+    assert_eq!(g["axis_name"], "least");
+    assert!(!text.contains("Grasp axis"), "{text}");
+    // The thesis's cup plans under the thesis's rules: the Plan line says nothing more.
+    let cup = succeed(grasp_sim().args(["--no-sim", "scenarios/cup.toml"]));
+    let cup = String::from_utf8_lossy(&cup.stdout);
+    assert!(cup.contains("  Plan        feasible; "), "{cup}");
+    // An open tube (no caps) is grasped about its own axis, which the mass properties of its
+    // open surface make the largest, not the least (the Object line's height is across it):
+    // the Grasp axis line says which axis the elevations are along.
+    let tube = dir.path().join("tube.stl");
+    std::fs::write(&tube, open_tube(30.0, 120.0, 64)).unwrap();
+    let out = succeed(grasp_sim().args(["--no-sim", "--json"]).arg(&tube));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(
+        v["plan"]["grasp"]["axis_name"], "largest",
+        "{}",
+        v["plan"]["grasp"]
+    );
+    let out = succeed(grasp_sim().arg("--no-sim").arg(&tube));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("  Grasp axis  the largest principal axis (0.0000, 0.0000, 1.0000)"),
+        "{text}"
+    );
+}
+
+/// An open tube of radius `r` and height `h` on `n` facets (no caps), as ASCII STL.
+fn open_tube(r: f64, h: f64, n: usize) -> String {
+    use std::f64::consts::TAU;
+    let p = |k: usize, z: f64| {
+        let a = TAU * k as f64 / n as f64;
+        format!("vertex {} {} {z}\n", r * a.cos(), r * a.sin())
+    };
+    let mut s = String::from("solid tube\n");
+    for k in 0..n {
+        for tri in [
+            [p(k, 0.0), p(k + 1, 0.0), p(k + 1, h)],
+            [p(k, 0.0), p(k + 1, h), p(k, h)],
+        ] {
+            s.push_str("facet normal 0 0 0\nouter loop\n");
+            s.extend(tri);
+            s.push_str("endloop\nendfacet\n");
+        }
+    }
+    s.push_str("endsolid tube\n");
+    s
 }

@@ -635,6 +635,16 @@ fn penetration_after_closing_is_reported_and_bounded() {
         r.sim
     );
     assert_eq!(r.expect.met, Some(false));
+    // The summary says why: the depth, not a motion within the limits.
+    let sentence = r.result_sentence();
+    assert!(
+        sentence.contains(&format!(
+            "a finger ended the closing {:.2} mm inside the object, more than max_penetration_mm (2 mm)",
+            dir.closing_penetration_mm
+        )),
+        "{sentence}"
+    );
+    assert!(!sentence.contains("beyond the hold limits"), "{sentence}");
     // ... unless the bound is raised past the depth.
     let (_d, s) = scenario_with(
         "cylinder_d40.stl",

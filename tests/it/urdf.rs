@@ -176,6 +176,11 @@ fn a_broken_urdf_is_one_line_naming_it() {
             "mesh package://p/gone.stl not found beside the URDF or above it",
         ),
         (
+            "missrel.urdf",
+            link("<geometry><mesh filename=\"meshes/gone.stl\"/></geometry>"),
+            "mesh meshes/gone.stl not found beside the URDF",
+        ),
+        (
             "nan.urdf",
             link("<origin xyz=\"0 nan 0\"/><geometry><sphere radius=\"0.1\"/></geometry>"),
             "line 1: <origin xyz=\"0 nan 0\"> needs 3 finite numbers",
@@ -227,6 +232,7 @@ fn a_broken_urdf_is_one_line_naming_it() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(err.contains("bad.stl: malformed ASCII STL"), "{err}");
+    assert!(err.contains("badmesh.urdf: URDF: "), "{err}");
 }
 
 /// A folder of URDFs and the meshes they name is a folder of URDF objects: the meshes are not
