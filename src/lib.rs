@@ -477,14 +477,14 @@ fn checked_report(
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
         start: Some(sim::scene::start(case)),
-        collider: Some(match shape.coarsened_from {
-            Some(from) => format!(
-                "{} ({} parts, rebuilt from its face planes, {from} vertices to {}, where parry would merge curved faces)",
+        collider: Some(match (shape.kind, shape.coarsened_from) {
+            (sim::ColliderKind::ConvexHull, Some(from)) => format!(
+                "{} ({} parts, rebuilt from its face planes where parry would merge bent faces: {from} vertices to {})",
                 shape.kind,
                 shape.parts,
                 shape.shape.as_convex_polyhedron().map_or(0, |c| c.points().len())
             ),
-            None => format!("{} ({} parts)", shape.kind, shape.parts),
+            _ => format!("{} ({} parts)", shape.kind, shape.parts),
         }),
         mass_kg: Some(case.mass_kg),
         grasp_source: Some(source),

@@ -111,8 +111,8 @@ pub struct ObjectShape {
     /// True if and only if the object is inertially a body of revolution about its principal
     /// axis (aligned Z): its two transverse principal moments agree within 0.1 %.
     pub is_revolution: bool,
-    /// For a convex hull thinned where parry would merge curved faces, the full hull's vertex
-    /// count (see `coarsened_hull`).
+    /// For a convex hull that parry would merge into bent faces, rebuilt from its face planes
+    /// (see `coarsened_hull`): the full hull's vertex count.
     pub coarsened_from: Option<usize>,
 }
 
@@ -145,8 +145,9 @@ fn shape_key(mesh: &Mesh, volume_mm3: f64) -> [u8; 32] {
 }
 
 impl ObjectShape {
-    /// [`ObjectShape::from_mesh`], with convex decompositions (0.1–0.4 s each) kept for the
-    /// rest of the process: the same mesh gives the same shape, bit for bit, either way.
+    /// [`ObjectShape::from_mesh`], with convex decompositions (0.1–0.4 s each) and rebuilt hulls
+    /// (tens of milliseconds) kept for the rest of the process: the same mesh gives the same
+    /// shape, bit for bit, either way.
     pub fn cached(mesh: &Mesh, volume_mm3: f64) -> ObjectShape {
         let key = shape_key(mesh, volume_mm3);
         let lock = || SHAPE_CACHE.lock().unwrap_or_else(|e| e.into_inner());
@@ -154,7 +155,7 @@ impl ObjectShape {
             return s.clone();
         }
         let shape = ObjectShape::from_mesh(mesh, volume_mm3);
-        if shape.kind == ColliderKind::ConvexDecomposition {
+        if shape.kind == ColliderKind::ConvexDecomposition || shape.coarsened_from.is_some() {
             let mut cache = lock();
             if !cache.iter().any(|(k, _)| *k == key) {
                 if cache.len() >= SHAPE_CACHE_LEN {
