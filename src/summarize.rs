@@ -189,7 +189,8 @@ impl Summary {
             "  expectations  {} met, {} not met, {} not judged",
             c.met, c.not_met, c.unjudged
         );
-        let total_s: f64 = self.rows.iter().map(|r| r.wall_ms).sum::<f64>() / 1000.0;
+        // An empty sum of f64 is −0.0; `+ 0.0` makes it print as 0.0.
+        let total_s: f64 = self.rows.iter().map(|r| r.wall_ms).sum::<f64>() / 1000.0 + 0.0;
         let _ = writeln!(
             t,
             "  time          {total_s:.1} s summed over objects ({:.3} s per object)",

@@ -123,3 +123,17 @@ fn summarize_bad_input_is_one_line_naming_the_file() {
     assert_eq!(out.status.code(), Some(2));
     assert!(text(&out.stderr).contains("--csv"), "{}", text(&out.stderr));
 }
+
+#[test]
+fn an_empty_results_file_sums_to_zero_not_minus_zero() {
+    let dir = tempfile::tempdir().unwrap();
+    let empty = dir.path().join("empty.jsonl");
+    std::fs::write(&empty, "").unwrap();
+    let out = crate::succeed(crate::grasp_sim().arg("summarize").arg(&empty));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains(": 0 objects"), "{text}");
+    assert!(
+        text.contains("time          0.0 s summed over objects (0.000 s per object)"),
+        "{text}"
+    );
+}
