@@ -177,7 +177,10 @@ impl ObjectShape {
         if let Some(hull) = SharedShape::convex_hull(&points) {
             let hull_mm3 = f64::from(hull.mass_properties(1.0).mass()) * 1e9;
             if hull_mm3 <= volume_mm3 * 1.02 {
-                let (shape, coarsened_from) = match coarsened_hull(&points) {
+                let rebuilt = (bent_shape_m(&hull) > MERGED_FACE_TOLERANCE_M)
+                    .then(|| coarsened_hull(&points))
+                    .flatten();
+                let (shape, coarsened_from) = match rebuilt {
                     Some((coarse, from)) => (coarse, Some(from)),
                     None => (hull, None),
                 };
@@ -207,69 +210,34 @@ impl ObjectShape {
     }
 }
 
-/// parry builds a hull's faces by merging neighbouring triangles whose unit normals differ by
-/// less than this in `1 − n₁·n₂` (`ConvexPolyhedron::from_convex_mesh`: the square root of
-/// f32's epsilon, about 1.5°).
-const PARRY_FACE_MERGE: f32 = 3.452_669_8e-4;
-
 /// How far a vertex of a merged hull face may lie off that face's plane `[m]`: rapier's allowed
 /// contact error at the check's 1 cm length unit (0.05 mm).
 const MERGED_FACE_TOLERANCE_M: f32 = 5e-5;
 
-/// How far the faces parry makes of the hull `(vertices, triangles)` leave their planes `[m]`.
-/// parry merges neighbouring triangles whose normals are within [`PARRY_FACE_MERGE`] into one
-/// face, with the normal of one of them: right for a plane split into triangles, wrong for a
-/// finely tessellated curved surface (a cylinder of more than about 240 segments, whose faces
-/// meet at under 1.5°), which it chains into one non-planar face. The contacts against that
-/// face let a finger sink in: 8.4 mm into a 512-segment cylinder of 60 mm, against 0.01 mm at
-/// 144 segments.
-fn merged_face_deviation_m(vertices: &[Vector], triangles: &[[u32; 3]]) -> f32 {
-    let normal = |t: &[u32; 3]| {
-        let [a, b, c] = t.map(|i| vertices[i as usize]);
-        (b - a).cross(c - a).try_normalize()
-    };
-    let normals: Vec<Option<Vector>> = triangles.iter().map(normal).collect();
-    // Union-find over the triangles, joined where parry joins them.
-    let mut parent: Vec<usize> = (0..triangles.len()).collect();
-    fn root(parent: &mut [usize], mut i: usize) -> usize {
-        while parent[i] != i {
-            parent[i] = parent[parent[i]];
-            i = parent[i];
-        }
-        i
-    }
-    let mut by_edge: std::collections::HashMap<(u32, u32), usize> = Default::default();
-    for (k, t) in triangles.iter().enumerate() {
-        for i in 0..3 {
-            let (a, b) = (t[i], t[(i + 1) % 3]);
-            match by_edge.entry((a.min(b), a.max(b))) {
-                std::collections::hash_map::Entry::Occupied(e) => {
-                    let other = *e.get();
-                    if let (Some(n1), Some(n2)) = (normals[k], normals[other]) {
-                        if n1.dot(n2) > 1.0 - PARRY_FACE_MERGE {
-                            let (r1, r2) = (root(&mut parent, k), root(&mut parent, other));
-                            parent[r1.max(r2)] = r1.min(r2);
-                        }
-                    }
-                }
-                std::collections::hash_map::Entry::Vacant(e) => {
-                    e.insert(k);
-                }
-            }
-        }
-    }
-    // Each face's plane: its lowest-numbered triangle's.
-    let mut worst = 0.0f32;
-    for (k, t) in triangles.iter().enumerate() {
-        let r = root(&mut parent, k);
-        if let Some(n) = normals[r] {
-            let p = vertices[triangles[r][0] as usize];
-            for &i in t {
-                worst = worst.max(n.dot(vertices[i as usize] - p).abs());
-            }
-        }
-    }
-    worst
+/// How far the faces of `poly` leave their planes `[m]`. parry builds a hull's faces by merging
+/// neighbouring triangles whose unit normals differ by less than √ε of f32 in `1 − n₁·n₂`
+/// (about 1.5°; `ConvexPolyhedron::from_convex_mesh`), with the normal of one of them: right for a plane split into triangles, wrong for a finely tessellated curved
+/// surface (a cylinder of more than about 240 segments, whose faces meet at under 1.5°), which
+/// it chains into one non-planar face. The contacts against that face let a finger sink in:
+/// 8.4 mm into a 512-segment cylinder of 60 mm, against 0.01 mm at 144 segments.
+fn bent_face_m(poly: &rapier3d::parry::shape::ConvexPolyhedron) -> f32 {
+    let (points, ids) = (poly.points(), poly.vertices_adj_to_face());
+    poly.faces()
+        .iter()
+        .map(|f| {
+            let first = f.first_vertex_or_edge as usize;
+            let face = &ids[first..first + f.num_vertices_or_edges as usize];
+            let p = points[face[0] as usize];
+            face.iter()
+                .map(|&i| f.normal.dot(points[i as usize] - p).abs())
+                .fold(0.0f32, f32::max)
+        })
+        .fold(0.0f32, f32::max)
+}
+
+/// [`bent_face_m`] of a shape that is a convex polyhedron (0 for any other).
+fn bent_shape_m(shape: &SharedShape) -> f32 {
+    shape.as_convex_polyhedron().map_or(0.0, bent_face_m)
 }
 
 /// Neighbouring faces of the hull from [`coarsened_hull`] are at least this far apart in
@@ -284,7 +252,7 @@ const SUPPORT_TOLERANCE_M: f64 = 1e-7;
 const MAX_OUTER_STANDOFF_M: f64 = 5e-5;
 
 /// The convex hull of `points` (metres), rebuilt where parry would merge curved faces into
-/// non-planar ones ([`merged_face_deviation_m`]): the hull's face planes are taken largest
+/// non-planar ones ([`bent_face_m`]): the hull's face planes are taken largest
 /// face first, each kept only if its normal is at least [`MIN_FACE_ANGLE_RAD`] from every plane
 /// kept (a plane split into triangles is one plane, kept once), and the hull is rebuilt as the
 /// intersection of the kept half-spaces (its vertices found through the polar dual: the convex
@@ -297,16 +265,13 @@ const MAX_OUTER_STANDOFF_M: f64 = 5e-5;
 fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
     use rapier3d::parry::transformation::try_convex_hull;
     let (vertices, triangles) = try_convex_hull(points).ok()?;
-    if merged_face_deviation_m(&vertices, &triangles) <= MERGED_FACE_TOLERANCE_M {
-        return None;
-    }
     let v64: Vec<Vector3<f64>> = vertices
         .iter()
         .map(|v| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z)))
         .collect();
     let centre = v64.iter().sum::<Vector3<f64>>() / v64.len() as f64;
     // Each triangle's plane n·(x − centre) = d, with its area.
-    let mut planes: Vec<(f64, Vector3<f64>, f64)> = triangles
+    let true_planes: Vec<(f64, Vector3<f64>, f64)> = triangles
         .iter()
         .filter_map(|t| {
             let [a, b, c] = t.map(|i| v64[i as usize]);
@@ -317,8 +282,9 @@ fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
                 (area, n, n.dot(&(a - centre)))
             })
         })
-        .filter(|p| p.2 > 0.0)
         .collect();
+    let mut planes: Vec<(f64, Vector3<f64>, f64)> =
+        true_planes.iter().copied().filter(|p| p.2 > 0.0).collect();
     planes.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.2.total_cmp(&b.2)));
     let cos_min = MIN_FACE_ANGLE_RAD.cos();
     let mut kept: Vec<(Vector3<f64>, f64)> = Vec::new();
@@ -347,18 +313,11 @@ fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
         .enumerate()
         .map(|(k, p)| (p.to_array().map(f32::to_bits), k))
         .collect();
-    let true_planes: Vec<(Vector3<f64>, Vector3<f64>)> = triangles
-        .iter()
-        .filter_map(|t| {
-            let [a, b, c] = t.map(|i| v64[i as usize]);
-            Some(((b - a).cross(&(c - a)).try_normalize(0.0)?, a))
-        })
-        .collect();
-    // How far a point stands outside the true hull `[m]`.
+    // How far a point (relative to the centre) stands outside the true hull `[m]`.
     let standoff = |x: &Vector3<f64>| {
         true_planes
             .iter()
-            .map(|(n, a)| n.dot(&(x - a)))
+            .map(|(_, n, d)| n.dot(x) - d)
             .fold(0.0f64, f64::max)
     };
     let mut corners: Vec<Vector> = Vec::new();
@@ -378,30 +337,30 @@ fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
         let Some(x) = m.lu().solve(&Vector3::new(p1.1, p2.1, p3.1)) else {
             continue;
         };
-        let p = x + centre;
-        if p.iter().all(|c| c.is_finite()) && standoff(&p) <= MAX_OUTER_STANDOFF_M {
+        if x.iter().all(|c| c.is_finite()) && standoff(&x) <= MAX_OUTER_STANDOFF_M {
+            let p = x + centre;
             corners.push(Vector::new(p.x as f32, p.y as f32, p.z as f32));
         }
     }
-    let (v, t) = try_convex_hull(&corners).ok()?;
-    if v.len() < 4 || merged_face_deviation_m(&v, &t) > MERGED_FACE_TOLERANCE_M {
+    let rebuilt = SharedShape::convex_hull(&corners)?;
+    let poly = rebuilt.as_convex_polyhedron()?;
+    if poly.points().len() < 4 || bent_face_m(poly) > MERGED_FACE_TOLERANCE_M {
         return None;
     }
-    // It must hold the whole true hull (no corner lost to the skips above).
-    let inside = t.iter().all(|tri| {
-        let [a, b, c] = tri.map(|i| {
-            let q = v[i as usize];
-            Vector3::new(f64::from(q.x), f64::from(q.y), f64::from(q.z))
-        });
-        let Some(n) = (b - a).cross(&(c - a)).try_normalize(0.0) else {
-            return true;
-        };
+    // It must hold the whole true hull (no corner lost to the skips above): every vertex inside
+    // every face plane parry made.
+    let ids = poly.vertices_adj_to_face();
+    let inside = poly.faces().iter().all(|f| {
+        let a = poly.points()[ids[f.first_vertex_or_edge as usize] as usize];
+        let a = Vector3::new(f64::from(a.x), f64::from(a.y), f64::from(a.z));
+        let n = Vector3::new(
+            f64::from(f.normal.x),
+            f64::from(f.normal.y),
+            f64::from(f.normal.z),
+        );
         v64.iter().all(|x| n.dot(&(x - a)) <= SUPPORT_TOLERANCE_M)
     });
-    if !inside {
-        return None;
-    }
-    SharedShape::convex_hull(&v).map(|s| (s, vertices.len()))
+    inside.then_some((rebuilt, vertices.len()))
 }
 
 /// Handles of what the protocol measures.
@@ -1043,13 +1002,13 @@ mod tests {
         // bent round the cylinder, some 30 mm off its own plane.
         let mesh = fine_cylinder(512);
         let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
-        let (v, t) = rapier3d::parry::transformation::try_convex_hull(&points).unwrap();
-        let bent = merged_face_deviation_m(&v, &t);
+        let bent = bent_shape_m(&SharedShape::convex_hull(&points).unwrap());
         assert!(bent > 0.02, "{bent} m");
+        assert!(bent_shape_m(&plain.shape) <= MERGED_FACE_TOLERANCE_M);
         let (rebuilt, mesh) = shape(512);
         assert_eq!(rebuilt.coarsened_from, Some(1024));
         let (v, t) = hull_of(&rebuilt);
-        assert!(merged_face_deviation_m(&v, &t) <= MERGED_FACE_TOLERANCE_M);
+        assert!(bent_shape_m(&rebuilt.shape) <= MERGED_FACE_TOLERANCE_M);
         // Fewer facets, no two within 2° of each other: 512 / (2° of 0.703°) rounds to 148 or so.
         assert!((200..=400).contains(&v.len()), "{} vertices", v.len());
         // It holds the whole mesh (every vertex inside every face plane, to 0.1 µm) and stands
