@@ -145,13 +145,14 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
     let plan = plan_report(scenario, &selection, &qualities, timings);
     let chosen = selection.chosen();
     let checked_on = chosen.map_or(&object.aligned, |c| &selection.axes[c.axis_plan].aligned);
+    let mut mjcf_scene = None;
     let (sim, sim_poses, ran) = run_sim(
         scenario,
         options,
         &object,
-        checked_on,
-        &selection.axes[0].graded,
+        (checked_on, &selection.axes[0].graded),
         chosen.map(|c| (&c.grasp, c.check.clone())),
+        &mut mjcf_scene,
     )?;
     // A check that ran here (not in the candidate search: `override_angles`) closed its own
     // grip: the quality is that grip's, not the planned contacts'.
@@ -183,6 +184,7 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
         sim,
         expect,
         quality,
+        mjcf_scene,
     };
     if let Some(dir) = &options.report {
         visual::write_report(
@@ -397,9 +399,9 @@ fn run_sim(
     scenario: &Scenario,
     options: &RunOptions,
     object: &PreparedObject,
-    aligned: &mesh::AlignedObject,
-    graded: &plan::GradedDomain,
+    (aligned, graded): (&mesh::AlignedObject, &plan::GradedDomain),
     grasp: Option<(&plan::search::Grasp, Option<sim::SimOutcome>)>,
+    mjcf_scene: &mut Option<std::path::PathBuf>,
 ) -> Result<
     (
         SimReport,
@@ -437,7 +439,9 @@ fn run_sim(
             object: aligned,
             case,
         };
-        export::write_mjcf(&dir.join(options.folder_for(scenario)), &input)?;
+        let folder = dir.join(options.folder_for(scenario));
+        export::write_mjcf(&folder, &input)?;
+        *mjcf_scene = Some(folder.join("scene.xml"));
     }
     if options.no_sim {
         return Ok((SimReport::not_run("--no-sim"), None, None));
@@ -477,14 +481,14 @@ fn checked_report(
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
         start: Some(sim::scene::start(case)),
-        collider: Some(match (shape.kind, shape.coarsened_from) {
-            (sim::ColliderKind::ConvexHull, Some(from)) => format!(
+        collider: Some(match shape.coarsened_from {
+            Some(from) => format!(
                 "{} ({} parts, rebuilt from its face planes where parry would merge bent faces: {from} vertices to {})",
                 shape.kind,
                 shape.parts,
                 shape.shape.as_convex_polyhedron().map_or(0, |c| c.points().len())
             ),
-            _ => format!("{} ({} parts)", shape.kind, shape.parts),
+            None => format!("{} ({} parts)", shape.kind, shape.parts),
         }),
         mass_kg: Some(case.mass_kg),
         grasp_source: Some(source),

@@ -202,12 +202,9 @@ fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
                 dir.join(folder).join("report.html").display()
             );
         }
-        if let Some(dir) = &options.export_mjcf {
-            if dir.join(folder).join("scene.xml").is_file() {
-                eprintln!(
-                    "grasp-sim: MJCF scene written to {}",
-                    dir.join(folder).join("scene.xml").display()
-                );
+        if options.export_mjcf.is_some() {
+            if let Some(scene) = &report.mjcf_scene {
+                eprintln!("grasp-sim: MJCF scene written to {}", scene.display());
             } else {
                 eprintln!(
                     "grasp-sim: warning: {}: no MJCF scene written: {}",

@@ -28,6 +28,9 @@ pub struct RunReport {
     pub quality: Option<crate::quality::Quality>,
     /// One-line warnings about the input (repairs made, an open surface, ...).
     pub warnings: Vec<String>,
+    /// The MJCF scene this run wrote (`--export-mjcf`), if it wrote one: not part of the JSON.
+    #[serde(skip)]
+    pub mjcf_scene: Option<std::path::PathBuf>,
 }
 
 /// The `object` part of the report.
