@@ -19,7 +19,7 @@
 //!   `Q`, and `W` has finitely many; [`EPA_MAX_POINTS`] bounds it all the same.
 //! - **Volume** by rays from the sum's centre, each an exact small linear programme, integrated
 //!   over a fixed set of directions ([`super::rays`]), with its standard error. The whole hull
-//!   ([`minkowski_sum`]: the incremental sum pruned to its hull's vertices by qhull) is exact but
+//!   ([`minkowski_sum`]: the incremental sum pruned to its hull's vertices by [`super::hull`]) is exact but
 //!   feasible only up to 3 contacts at 8 cone edges; it is the reference the rays are tested
 //!   against.
 //!
@@ -334,9 +334,9 @@ impl Polytope {
 }
 
 impl Polytope {
-    /// The hull of `points` by qhull (which must contain the origin strictly inside).
+    /// The hull of `points` ([`super::hull`]; they must contain the origin strictly inside).
     fn hull(points: Vec<Wrench>) -> Option<Polytope> {
-        let facets: Vec<([u32; DIM], Wrench)> = qhull_facets(&points)?
+        let facets: Vec<([u32; DIM], Wrench)> = hull_facets(&points)?
             .into_iter()
             .map(|(v, n, _)| (v, n))
             .collect();
@@ -369,7 +369,7 @@ pub struct Search {
     pub points_added: usize,
     /// Facets made (alive or not): the search's memory.
     pub facets: usize,
-    /// Times qhull hulled the inner polytope again after round-off in an update.
+    /// Times the inner polytope was hulled again after round-off in an update.
     pub rebuilds: usize,
     /// Why epsilon is 0.
     pub note: Option<String>,
@@ -432,13 +432,13 @@ pub fn epsilon(per_contact: &[Vec<Wrench>], max_points: usize) -> Result<Search,
             ));
         }
         if poly.add(s, f, tol_vis).is_none() {
-            // Round-off in the beneath–beyond step (a new facet nearly flat): qhull hulls
+            // Round-off in the beneath–beyond step (a new facet nearly flat): the hull is taken of
             // the points again, the new one with them.
             facets += poly.facets.len();
             let mut points = std::mem::take(&mut poly.points);
             points.push(s);
             poly = Polytope::hull(points).ok_or_else(|| {
-                format!("qhull failed on the inner polytope (epsilon between {lower:.9} and {upper:.9})")
+                format!("the hull failed on the inner polytope (epsilon between {lower:.9} and {upper:.9})")
             })?;
             rebuilds += 1;
         }
@@ -453,7 +453,7 @@ enum Start {
     Outside(String),
 }
 
-/// The initial inner polytope: qhull's hull of support points of `W`, grown (in the
+/// The initial inner polytope: the hull of support points of `W`, grown (in the
 /// directions of the facets the origin is beyond) until the origin is strictly inside; or the
 /// proof that it cannot be (a direction in which `W` does not reach past the origin).
 fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, String> {
@@ -505,7 +505,7 @@ fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, String> {
             }
             continue;
         }
-        let facets = qhull_facets(&points).ok_or("qhull failed on the initial polytope")?;
+        let facets = hull_facets(&points).ok_or("the hull failed on the initial polytope")?;
         // Facets the origin is not strictly inside of: W must reach past the origin there.
         let mut grew = false;
         for (n, offset) in facets.iter().map(|f| (f.1, f.2)) {
@@ -530,54 +530,22 @@ fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, String> {
     Err("no initial polytope around the origin after 200 rounds".to_string())
 }
 
-/// qhull's simplicial facets of `points`: vertex indices, unit normal, offset (`n·x + offset =
-/// 0` on the facet, negative offset when the origin is inside).
+/// The hull's simplicial facets of `points` ([`super::hull`]): vertex indices, unit normal,
+/// offset (`n·x + offset = 0` on the facet, negative offset when the origin is inside).
 #[allow(clippy::type_complexity)]
-pub(crate) fn qhull_facets(points: &[Wrench]) -> Option<Vec<([u32; DIM], Wrench, f64)>> {
-    let coords: Vec<f64> = points.iter().flatten().copied().collect();
-    let n_points = points.len();
-    std::panic::catch_unwind(move || {
-        // Joggled input first (simplicial facets, none degenerate); merged and triangulated
-        // when that fails. The facets' normals are computed again from the exact points.
-        let qh = qhull::Qh::builder()
-            .compute(true)
-            .qhull_args(["QJ"])
-            .map_err(|_| ())
-            .and_then(|b| b.build_managed(DIM, coords.clone()).map_err(|_| ()))
-            .or_else(|_| {
-                qhull::Qh::builder()
-                    .compute(true)
-                    .triangulate(true)
-                    .build_managed(DIM, coords)
-                    .map_err(|_| ())
-            })
-            .ok()?;
-        let mut out = Vec::new();
-        for f in qh.facets() {
-            let n: Wrench = f.normal()?.try_into().ok()?;
-            let mut v = [0u32; DIM];
-            let vs = f.vertices()?;
-            if vs.size(&qh) != DIM {
-                return None;
-            }
-            for (k, x) in vs.iter().enumerate() {
-                let id = usize::try_from(x.point_id(&qh).ok()?).ok()?;
-                if id >= n_points {
-                    return None;
-                }
-                v[k] = id as u32;
-            }
-            out.push((v, n, f.offset()));
-        }
-        Some(out)
-    })
-    .ok()
-    .flatten()
+pub(crate) fn hull_facets(points: &[Wrench]) -> Option<Vec<([u32; DIM], Wrench, f64)>> {
+    let h = super::hull::convex_hull(points)?;
+    Some(
+        h.facets
+            .into_iter()
+            .map(|f| (f.vertices, f.normal, f.offset))
+            .collect(),
+    )
 }
 
 /// The vertices and volume of `W`: the Minkowski sum over contacts, pruned to its hull's
 /// vertices after each contact once it is full-dimensional; `None` when a hull would need more
-/// than `max_points` input points (or qhull fails). The volume is 0 below 6 dimensions.
+/// than `max_points` input points (or the hull fails). The volume is 0 below 6 dimensions.
 pub fn minkowski_sum(per_contact: &[Vec<Wrench>], max_points: usize) -> Option<(Vec<Wrench>, f64)> {
     let mut set: Vec<Wrench> = vec![[0.0; DIM]];
     let mut volume = 0.0;

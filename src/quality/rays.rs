@@ -33,7 +33,7 @@ use nalgebra::{Matrix6, Vector6};
 use rayon::prelude::*;
 
 /// Rays per volume (in antithetic pairs). docs/QUALITY.md: on three-contact grasps, whose
-/// volume qhull gives exactly, the estimate's relative standard error is about 2–4 %, and the
+/// volume the hull gives exactly, the estimate's relative standard error is about 2–4 %, and the
 /// exact volume lies within 3 standard errors.
 pub const VOLUME_RAYS: usize = 1024;
 
