@@ -72,9 +72,36 @@ def replay(scene_dir):
         w = float(np.linalg.norm(d.qvel[od + 3:od + 6]))
         return joint < stall["joint_rad_s"] and v < stall["object_mm_s"] and w < stall["object_rad_s"]
 
+    p0, r0 = relative_pose(m, d, palm, obj)
+    # `approach = "together"` (issue 33): a finger that touches the object stops there until
+    # every finger has touched, or the hand has stopped, then all squeeze (as grasp-sim's).
+    waiting = proto.get("approach", "squeeze") == "together"
+    held = [False] * n
+    finger_bodies = [{m.body(f"{f}_phalanx_{j}").id for j in (1, 2)} for f in proto["fingers"]]
+    joint1_qpos = [m.jnt_qposadr[m.actuator_trnid[2 * k, 0]] for k in range(n)]
+
+    def touching_fingers():
+        out = [False] * n
+        for c in d.contact[: d.ncon]:
+            b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
+            other = b2 if b1 == obj else b1 if b2 == obj else None
+            for k in range(n):
+                if other in finger_bodies[k]:
+                    out[k] = True
+        return out
+
+    def release():
+        for k in range(n):
+            if held[k]:
+                d.ctrl[2 * k] = target[2 * k]
+            held[k] = False
+
     closed = 0
     for phase, max_steps in enumerate([close_steps // 2, close_steps - close_steps // 2]):
         if phase == 1:
+            if waiting:
+                release()
+                waiting = False
             for k in range(n):
                 a = 2 * k
                 joint = m.actuator_trnid[a, 0]
@@ -87,15 +114,39 @@ def replay(scene_dir):
         for _ in range(max_steps):
             mujoco.mj_step(m, d)
             closed += 1
+            if waiting:
+                for k, t in enumerate(touching_fingers()):
+                    if t and not held[k]:
+                        d.ctrl[2 * k] = d.qpos[joint1_qpos[k]]
+                        held[k] = True
+                if all(held):
+                    release()
+                    waiting = False
+                    quiet_steps = 0
             if stall is None:
                 continue
             if quiet():
                 quiet_steps += 1
                 if quiet_steps * dt >= stall["window_s"]:
+                    if waiting:
+                        release()
+                        waiting = False
+                        quiet_steps = 0
+                        continue
                     break
             else:
                 quiet_steps = 0
     pc, rc = relative_pose(m, d, palm, obj)
+    # What the closing did (issue 33): a hold that needed the object pushed farther than
+    # `max_closing_shift_mm` is not a hold of the planned grasp, as in grasp-sim's check.
+    closing_shift = float(np.linalg.norm(pc - p0))
+    q0c = np.zeros(4)
+    qcc = np.zeros(4)
+    mujoco.mju_mat2Quat(q0c, r0.flatten())
+    mujoco.mju_mat2Quat(qcc, rc.flatten())
+    closing_turn = quat_angle_deg(q0c, qcc)
+    max_shift = proto.get("max_closing_shift_mm", math.inf)
+    pushed = closing_shift > max_shift
     m.opt.gravity[:] = gravity
     for _ in range(hold_steps):
         mujoco.mj_step(m, d)
@@ -115,7 +166,8 @@ def replay(scene_dir):
         b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
         if (b1 == obj and b2 in hand_bodies) or (b2 == obj and b1 in hand_bodies):
             in_contact = True
-    if translation <= proto["hold_translation_mm"] and rotation <= proto["hold_rotation_deg"]:
+    if (translation <= proto["hold_translation_mm"] and rotation <= proto["hold_rotation_deg"]
+            and not pushed):
         verdict = "hold"
     elif in_contact:
         verdict = "slip"
@@ -132,6 +184,9 @@ def replay(scene_dir):
         "wall_ms": wall_ms,
         "steps": closed + hold_steps,
         "closed_at_s": closed * dt,
+        "closing_shift_mm": closing_shift,
+        "closing_turn_deg": closing_turn,
+        "closing_pushed": pushed,
     }
 
 

@@ -11,6 +11,6 @@ profile=$(mktemp -d)
 trap 'rm -rf "$profile"' EXIT
 chromium --headless --no-sandbox --disable-gpu --disable-quic --no-first-run \
   --disable-background-networking --disable-component-update --disable-sync \
-  --user-data-dir="$profile" --hide-scrollbars --window-size=1400,2600 \
+  --user-data-dir="$profile" --hide-scrollbars --window-size=${WINDOW:-1400,2600} \
   --screenshot="$png" "file://$html" >/dev/null 2>&1
 echo "$png"

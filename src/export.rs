@@ -296,13 +296,13 @@ fn mjcf_contacts(s: &mut String, hand: &Hand) {
 fn mjcf_actuators(s: &mut String, case: &Case) {
     let sim = case.params;
     let limits = bend_limits(case.hand);
-    let (kp, kv, tau) = (
+    let (kp, kv) = (
         sim.motor_stiffness_nm_per_rad,
         sim.motor_damping_nms_per_rad,
-        sim.torque_limit_nm,
     );
+    let torques = crate::sim::scene::finger_torque_limits(case.hand, sim);
     let _ = writeln!(s, "  <actuator>");
-    for f in &case.hand.finger_list {
+    for (f, tau) in case.hand.finger_list.iter().zip(torques) {
         for (j, (lo, hi)) in [(1, limits[0]), (2, limits[1])] {
             let _ = writeln!(
                 s,
@@ -396,6 +396,8 @@ fn protocol(input: &ExportInput, keys: &Keyframes) -> serde_json::Value {
         "motor_stiffness_nm_per_rad": sim.motor_stiffness_nm_per_rad,
         "hold_translation_mm": sim.hold_translation_mm,
         "hold_rotation_deg": sim.hold_rotation_deg,
+        "max_closing_shift_mm": sim.max_closing_shift_mm,
+        "approach": sim.approach,
         "gravity": match sim.gravity { GravityMode::Down => "down", GravityMode::Six => "six" },
         "is_revolution": case.object.is_revolution,
         "mass_kg": case.mass_kg,

@@ -194,7 +194,9 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
             chosen.map(|c| &c.grasp),
             &shown.aligned.mesh,
             &scenario.hand,
-            sim_poses.as_deref(),
+            sim_poses
+                .as_ref()
+                .map(|(end, closed)| visual::SimulatedPoses { end, closed }),
         )?;
     }
     Ok(report)
@@ -405,7 +407,7 @@ fn run_sim(
 ) -> Result<
     (
         SimReport,
-        Option<Vec<sim::BodyPose>>,
+        Option<(Vec<sim::BodyPose>, Vec<sim::BodyPose>)>,
         Option<sim::SimOutcome>,
     ),
     Error,
@@ -458,7 +460,7 @@ fn run_sim(
             (out, payload, true)
         }
     };
-    let poses = out.final_poses.clone();
+    let poses = (out.final_poses.clone(), out.closed_poses.clone());
     let ran = ran.then(|| out.clone());
     let report = checked_report(out, payload, &case, &shape, source, options);
     Ok((report, Some(poses), ran))
@@ -496,11 +498,13 @@ fn checked_report(
             .payload
             .then(|| payload.map_or(0.0, |(held, _)| held)),
         payload_fails_at: payload.and_then(|(_, failed)| failed),
+        closing: Some(out.closing),
         directions: out.directions,
         limits: Some(report::HoldLimits {
             translation_mm: case.params.hold_translation_mm,
             rotation_deg: case.params.hold_rotation_deg,
             penetration_mm: case.params.max_penetration_mm,
+            closing_shift_mm: case.params.max_closing_shift_mm,
         }),
     }
 }

@@ -510,6 +510,10 @@ pub struct SimReport {
     /// once around that boundary: near it the outcome depends on the details of the contacts.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub payload_fails_at: Option<f64>,
+    /// What the closing did (issue 33): the object's shift and turn, each finger's planned and
+    /// final joint angles, and the first touch.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub closing: Option<crate::sim::ClosingOutcome>,
     /// Per gravity direction.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub directions: Vec<crate::sim::DirectionOutcome>,
@@ -529,6 +533,8 @@ pub struct HoldLimits {
     pub rotation_deg: f64,
     /// `[mm]`.
     pub penetration_mm: f64,
+    /// How far the closing may push the object (`[sim] max_closing_shift_mm`) `[mm]`.
+    pub closing_shift_mm: f64,
 }
 
 impl SimReport {
@@ -549,6 +555,7 @@ impl SimReport {
             grasp_source: None,
             payload_margin: None,
             payload_fails_at: None,
+            closing: None,
             directions: Vec::new(),
             limits: None,
         }
@@ -873,6 +880,26 @@ impl RunReport {
             (SimVerdict::Ran(verdict), None) => verdict.to_string(),
         };
         let _ = writeln!(s, "  Sim         {sim_line}");
+        if let Some(c) = &self.sim.closing {
+            let _ = writeln!(s, "  Closing     {}", closing_line(c));
+            let set = |f: &crate::sim::FingerClosing,
+                       which: fn(&crate::sim::FingerClosing) -> [f64; 2]| {
+                let [a, b] = which(f);
+                format!("{a:.1}/{b:.1}")
+            };
+            let planned: Vec<String> = c
+                .fingers
+                .iter()
+                .map(|f| format!("{} {}", f.name, set(f, |f| f.planned_deg)))
+                .collect();
+            let closed: Vec<String> = c
+                .fingers
+                .iter()
+                .map(|f| format!("{} {}", f.name, set(f, |f| f.final_deg)))
+                .collect();
+            let _ = writeln!(s, "    theta1/theta2 planned {} deg", planned.join(", "));
+            let _ = writeln!(s, "    theta1/theta2 closed  {} deg", closed.join(", "));
+        }
         if let Some(q) = &self.quality {
             let _ = writeln!(s, "  Quality     {}", quality_line(q));
         }
@@ -923,13 +950,19 @@ impl RunReport {
             SimVerdict::Ran(Verdict::Hold) => {
                 format!("{grasp}: HELD under gravity (moved {moved})")
             }
-            SimVerdict::Ran(Verdict::Slip) => match penetrated_slip(sim) {
-                Some((depth, limit)) => format!(
+            SimVerdict::Ran(Verdict::Slip) => match (penetrated_slip(sim), pushed_slip(sim)) {
+                (None, Some(c)) => format!(
+                    "{grasp}: NOT held as planned: the closing pushed the object {:.1} mm, more \
+                     than max_closing_shift_mm ({} mm), before the fingers caught it, so the \
+                     grasp that held is not the one planned (the object then moved {moved})",
+                    c.shift_mm, c.max_shift_mm
+                ),
+                (Some((depth, limit)), _) => format!(
                     "{grasp}: NOT held: a finger ended the closing {depth:.2} mm inside the \
                      object, more than max_penetration_mm ({limit} mm), so the grip is not one a \
                      real hand makes (the object moved {moved})"
                 ),
-                None => format!(
+                (None, None) => format!(
                     "{grasp}: NOT held: the object slipped {moved}, beyond the hold limits{}, but \
                      stayed in the hand",
                     sim.limits.map_or(String::new(), |l| format!(
@@ -963,6 +996,61 @@ fn penetrated_slip(sim: &SimReport) -> Option<(f64, f64)> {
         .map(|d| d.closing_penetration_mm)
         .fold(0.0, f64::max);
     (within && depth > l.penetration_mm).then_some((depth, l.penetration_mm))
+}
+
+/// For a `slip` that moved within the hold limits in every direction and left no finger too
+/// deep: it is a slip because the closing pushed the object farther than its bound.
+fn pushed_slip(sim: &SimReport) -> Option<&crate::sim::ClosingOutcome> {
+    let l = sim.limits?;
+    let c = sim.closing.as_ref().filter(|c| c.pushed)?;
+    let within = sim.directions.iter().all(|d| {
+        d.verdict != Verdict::Slip
+            || (d.translation_mm <= l.translation_mm && d.rotation_deg <= l.rotation_deg)
+    });
+    within.then_some(c)
+}
+
+/// The summary's closing line (issue 33): how far the closing pushed and turned the object,
+/// which body touched first, and the joint furthest from its plan, e.g. "the closing pushed
+/// the object 23.0 mm; finger_2 stopped 27.0 deg short of its plan".
+pub fn closing_line(c: &crate::sim::ClosingOutcome) -> String {
+    let mut s = format!(
+        "the closing pushed the object {:.1} mm and turned it {:.1} deg{}",
+        c.shift_mm,
+        c.turn_deg,
+        if c.pushed {
+            format!(
+                " (more than max_closing_shift_mm, {} mm: not a hold of the planned grasp)",
+                c.max_shift_mm
+            )
+        } else {
+            String::new()
+        }
+    );
+    if let Some((name, joint, e)) = c.worst_joint() {
+        let how = if e < 0.0 { "short of" } else { "past" };
+        s += &format!(
+            "; {name} joint {joint} stopped {:.1} deg {how} its plan",
+            e.abs()
+        );
+    }
+    let phalanges = 2 * c.fingers.len();
+    s += &format!(
+        "; {} of {phalanges} phalanges end on the object within {} deg of their plan",
+        c.phalanges_on_plan,
+        crate::sim::protocol::WITHIN_PLAN_DEG
+    );
+    match &c.first_touch {
+        Some(t) if t.phalanx == 0 => s += &format!("; the palm touched first, at {:.3} s", t.at_s),
+        Some(t) => {
+            s += &format!(
+                "; {} phalanx {} touched first, at {:.3} s",
+                t.body, t.phalanx, t.at_s
+            )
+        }
+        None => s += "; nothing touched the object",
+    }
+    s
 }
 
 /// The summary's quality line: epsilon and volume, what they were computed from, and why

@@ -11,7 +11,7 @@
 use crate::hand::{Hand, HandError};
 use crate::mesh::LengthUnit;
 pub use crate::plan::PlannerParams;
-pub use crate::sim::params::{GravityMode, Protocol, SimParams};
+pub use crate::sim::params::{Approach, GravityMode, Protocol, SimParams};
 use crate::sim::Verdict;
 use serde::Deserialize;
 use std::collections::BTreeMap;

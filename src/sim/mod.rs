@@ -35,7 +35,8 @@ pub mod scene;
 
 pub use protocol::{
     check, check_closed, check_with_payload, payload_bracket, payload_margin, Closed,
-    DirectionOutcome, EarlyDecision, SimOutcome, Stall, Verdict, STALL,
+    ClosingOutcome, DirectionOutcome, EarlyDecision, FingerClosing, FirstTouch, SimOutcome, Stall,
+    Verdict, STALL,
 };
 pub use scene::{collider_inertia, Case, ColliderKind, ObjectShape, OverrideError, SimHand};
 

@@ -27,6 +27,9 @@ pub enum Protocol {
     Full,
 }
 
+/// The default of `[sim] max_closing_shift_mm` `[mm]` (docs/SIM.md, "What the closing does").
+pub const DEFAULT_MAX_CLOSING_SHIFT_MM: f64 = 5.0;
+
 /// Physics check parameters (DESIGN.md section 5); used by the physics check.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -98,6 +101,32 @@ pub struct SimParams {
     /// the object is not a hold (issue 14). Beyond it the verdict is `slip` (the object stays
     /// in the hand, but not by a grasp a real hand could make).
     pub max_penetration_mm: f64,
+    /// Farthest the closing may push the object relative to the palm for the grasp to count
+    /// as a hold of the planned grasp `[mm]` (issue 33): beyond it the object was pushed across
+    /// until the other fingers caught it, a different grasp from the one planned, and the
+    /// verdict is `slip` (`closing_pushed`), so the candidate search moves on as for a slip.
+    pub max_closing_shift_mm: f64,
+    /// Each finger's motors are capped at `torque_limit_nm` times the number of fingers on the
+    /// palm's less crowded side over the number on its own side, so that the two sides squeeze
+    /// the object equally (issue 33: with equal torques the thesis hand's two fingers push the
+    /// object across towards its one thumb until the contacts' angles balance them);
+    /// `false`: every finger at `torque_limit_nm`.
+    pub balanced_squeeze: bool,
+    /// How joint 1 closes: `squeeze` (each finger straight to its target, the check before
+    /// issue 33) or `together` (a finger that touches the object stops there until every
+    /// finger has touched, or the others have stopped, then all squeeze at once).
+    pub approach: Approach,
+}
+
+/// How the fingers' joint 1 close (`[sim] approach`, docs/SIM.md "What the closing does").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Approach {
+    /// Every finger closes straight to its squeeze target.
+    Squeeze,
+    /// A finger stops where it touches until every finger has touched (or the hand has
+    /// stopped), then all squeeze together.
+    Together,
 }
 
 impl Default for SimParams {
@@ -130,6 +159,9 @@ impl Default for SimParams {
             override_index: None,
             max_checked: crate::DEFAULT_MAX_CHECKED,
             max_penetration_mm: 2.0,
+            max_closing_shift_mm: DEFAULT_MAX_CLOSING_SHIFT_MM,
+            balanced_squeeze: true,
+            approach: Approach::Squeeze,
         }
     }
 }
@@ -158,6 +190,7 @@ impl SimParams {
             rest_safety,
             rest_margin,
             max_penetration_mm,
+            max_closing_shift_mm,
         ) {
             if !(v.is_finite() && v > 0.0) {
                 return Err((key, format!("must be positive, got {v}")));

@@ -19,11 +19,13 @@ use std::time::Instant;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Verdict {
-    /// The object stayed within the thresholds, and no hand collider ended the closing
-    /// deeper inside it than `max_penetration_mm`.
+    /// The object stayed within the thresholds, no hand collider ended the closing deeper
+    /// inside it than `max_penetration_mm`, and the closing pushed it no farther than
+    /// `max_closing_shift_mm`.
     Hold,
     /// It moved beyond them but still touches the hand, or it stayed but a finger ended the
-    /// closing deeper inside it than `max_penetration_mm` (not a grasp a real hand makes).
+    /// closing deeper inside it than `max_penetration_mm` (not a grasp a real hand makes), or
+    /// the closing pushed it farther than `max_closing_shift_mm` (not the grasp planned).
     Slip,
     /// It left the hand.
     Drop,
@@ -64,6 +66,12 @@ pub struct DirectionOutcome {
     pub tilt_deg: f64,
     /// Object translation relative to the palm while the fingers closed `[mm]`.
     pub closing_translation_mm: f64,
+    /// Object rotation relative to the palm while the fingers closed `[deg]` (the full
+    /// rotation).
+    pub closing_rotation_deg: f64,
+    /// True if and only if the closing pushed the object farther than `max_closing_shift_mm`:
+    /// then the verdict is not `hold` (issue 33), whatever the hold did.
+    pub closing_pushed: bool,
     /// Deepest penetration of a finger or the palm into the object at the end of closing `[mm]`
     /// (rapier's contact depth): a grasp that holds only because a finger passed into the object
     /// shows here (issue 14).
@@ -115,6 +123,91 @@ pub struct SimOutcome {
     /// The contacts that carried the grip at the end of closing (gravity still off; the first
     /// direction's closing under the `full` protocol): [`super::contacts::grip_contacts`].
     pub grip_contacts: Vec<super::contacts::GripContact>,
+    /// What the closing did (the first direction's closing under the `full` protocol).
+    pub closing: ClosingOutcome,
+    /// Where the closing left the bodies, gravity still off (aligned frame, metres): the
+    /// palm, phalanx 1 and 2 of each finger, then the object.
+    pub closed_poses: Vec<super::BodyPose>,
+}
+
+/// What the closing did to the planned grasp (issue 33, docs/SIM.md "What the closing does"):
+/// how far it pushed the object, where each joint stopped against its plan, and which phalanx
+/// touched the object first. Reported as `sim.closing`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ClosingOutcome {
+    /// Object translation relative to the palm from the start of the closing to its end `[mm]`.
+    pub shift_mm: f64,
+    /// Object rotation relative to the palm over the closing `[deg]` (the full rotation).
+    pub turn_deg: f64,
+    /// How long the closing took `[s]`.
+    pub duration_s: f64,
+    /// The bound on `shift_mm` (`[sim] max_closing_shift_mm`) `[mm]`.
+    pub max_shift_mm: f64,
+    /// True if and only if `shift_mm` exceeds `max_shift_mm`: the grasp that held (if it did)
+    /// is not the one planned, and the verdict is not `hold`.
+    pub pushed: bool,
+    /// The first hand body to touch the object, and when; `None` if nothing touched it.
+    pub first_touch: Option<FirstTouch>,
+    /// True if and only if the palm touches the object at the end of the closing.
+    pub palm_touching: bool,
+    /// Per finger, in the hand's order.
+    pub fingers: Vec<FingerClosing>,
+    /// Phalanges that end the closing touching the object within [`WITHIN_PLAN_DEG`] of their
+    /// planned bend.
+    pub phalanges_on_plan: usize,
+}
+
+/// A phalanx ends the closing "on its plan" when it touches the object and its joint is within
+/// this of the planned bend `[deg]` (the thesis's Joint Angular Deviation, 5°).
+pub const WITHIN_PLAN_DEG: f64 = 5.0;
+
+/// The first touch of the closing.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FirstTouch {
+    /// `palm`, or the finger's name.
+    pub body: String,
+    /// 1 or 2 for a finger's phalanx, 0 for the palm.
+    pub phalanx: usize,
+    /// Time into the closing `[s]`.
+    pub at_s: f64,
+}
+
+/// One finger's closing: planned and final joint angles, in the thesis's interior angles.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FingerClosing {
+    /// The finger's name.
+    pub name: String,
+    /// Planned `[θ1, θ2]` `[deg]` (the Grasp Parameter Set).
+    pub planned_deg: [f64; 2],
+    /// `[θ1, θ2]` where the closing left the joints `[deg]`: the set a hand would be commanded
+    /// to reach this grasp.
+    pub final_deg: [f64; 2],
+    /// Bend after closing minus the planned bend `[deg]` (negative: stopped short of the plan,
+    /// more open than planned; `final_deg = planned_deg − error_deg`).
+    pub error_deg: [f64; 2],
+    /// True if and only if phalanx 1, phalanx 2 touches the object at the end of the closing
+    /// (a contact rapier's solver holds: within its prediction distance, 0.2 mm).
+    pub touching: [bool; 2],
+    /// The gap between phalanx 1, phalanx 2 and the object's collider at the end of the closing
+    /// `[mm]` (0 when touching or inside).
+    pub gap_mm: [f64; 2],
+    /// When phalanx 1, phalanx 2 first touched the object `[s]` (`None`: never).
+    pub first_contact_s: [Option<f64>; 2],
+}
+
+impl ClosingOutcome {
+    /// The finger joint furthest from its plan: (finger name, joint 1 or 2, error `[deg]`).
+    pub fn worst_joint(&self) -> Option<(&str, usize, f64)> {
+        let mut worst: Option<(&str, usize, f64)> = None;
+        for f in &self.fingers {
+            for (j, e) in f.error_deg.iter().enumerate() {
+                if worst.is_none_or(|w| e.abs() > w.2.abs()) {
+                    worst = Some((&f.name, j + 1, *e));
+                }
+            }
+        }
+        worst
+    }
 }
 
 /// Standard gravity `[m/s²]`.
@@ -363,6 +456,12 @@ fn directions(mode: GravityMode) -> Vec<Vector3<f64>> {
 struct Closing {
     /// Object translation relative to the palm at the start `[mm]`.
     p0: Vector3<f64>,
+    /// Object rotation relative to the palm at the start.
+    q0: UnitQuaternion<f64>,
+    /// What the closing did, as reported.
+    outcome: ClosingOutcome,
+    /// Where it left the bodies.
+    poses: Vec<super::BodyPose>,
     /// ... and after closing `[mm]`.
     pc: Vector3<f64>,
     /// Object rotation relative to the palm after closing.
@@ -388,7 +487,7 @@ impl Closed {
     /// Builds the scene of `case` and closes the hand.
     pub fn new(case: &Case) -> Closed {
         let mut scene = build(case);
-        let closing = close(&mut scene, case.params);
+        let closing = close(&mut scene, case);
         Closed { scene, closing }
     }
 
@@ -442,11 +541,11 @@ fn check_full(case: &Case) -> SimOutcome {
     let mut outcomes = Vec::new();
     let mut steps = 0;
     let mut final_poses = Vec::new();
-    let mut grip_contacts = None;
+    let mut first_closing: Option<Closing> = None;
     for g in directions(params.gravity) {
         let mut scene = build(case);
-        let closing = close(&mut scene, params);
-        grip_contacts.get_or_insert_with(|| closing.contacts.clone());
+        let closing = close(&mut scene, case);
+        first_closing.get_or_insert_with(|| closing.clone());
         let (o, n) = hold(
             &mut scene,
             g,
@@ -461,8 +560,11 @@ fn check_full(case: &Case) -> SimOutcome {
         outcomes.push(o);
         steps += closing.steps + n;
     }
+    let closing = first_closing.expect("at least one direction");
     SimOutcome {
-        grip_contacts: grip_contacts.unwrap_or_default(),
+        grip_contacts: closing.contacts,
+        closing: closing.outcome,
+        closed_poses: closing.poses,
         ..summarise(outcomes, steps, params, t0, final_poses)
     }
 }
@@ -494,6 +596,8 @@ pub fn check_closed(closed: &Closed, case: &Case, k: f64, t0: Instant) -> SimOut
     let final_poses = runs[0].2.clone();
     SimOutcome {
         grip_contacts: closed.closing.contacts.clone(),
+        closing: closed.closing.outcome.clone(),
+        closed_poses: closed.closing.poses.clone(),
         ..summarise(
             runs.into_iter().map(|r| r.0).collect(),
             steps,
@@ -530,6 +634,18 @@ fn summarise(
         wall_ms: t0.elapsed().as_secs_f64() * 1000.0,
         final_poses,
         grip_contacts: Vec::new(),
+        closing: ClosingOutcome {
+            shift_mm: 0.0,
+            turn_deg: 0.0,
+            duration_s: 0.0,
+            max_shift_mm: params.max_closing_shift_mm,
+            pushed: false,
+            first_touch: None,
+            palm_touching: false,
+            fingers: Vec::new(),
+            phalanges_on_plan: 0,
+        },
+        closed_poses: Vec::new(),
     }
 }
 
@@ -566,26 +682,57 @@ fn relative(scene: &Scene) -> (Vector3<f64>, UnitQuaternion<f64>) {
 
 /// Closes the hand, gravity off: joint 1 first, then joint 2, each for half `close_duration_s`
 /// or, with `close_until_stalled`, until the hand and the object have stopped ([`STALL`]).
-fn close(scene: &mut Scene, params: &SimParams) -> Closing {
+fn close(scene: &mut Scene, case: &Case) -> Closing {
+    let params = case.params;
     let stall = params.close_until_stalled.then_some(&STALL);
     let dt = params.timestep_s;
     let close_steps = (params.close_duration_s / dt).round() as usize;
-    let (p0, _) = relative(scene);
+    let (p0, q0) = relative(scene);
+    let mut first_contact = FirstContacts::new(scene.fingers.len());
     // Joint 1 closes for at most half the closing time, joint 2 for the rest.
     let phases = [close_steps / 2, close_steps - close_steps / 2];
     let mut steps = 0;
+    // `together`: fingers held where they touched, until all have or the hand has stopped.
+    let mut waiting = params.approach == crate::scenario::Approach::Together;
+    let mut held = vec![false; scene.fingers.len()];
     for (phase, max_steps) in phases.into_iter().enumerate() {
         if phase == 1 {
+            if waiting {
+                release_held(scene, &mut held);
+                waiting = false;
+            }
             scene.release_joint2();
         }
         let mut quiet_steps = 0;
         for _ in 0..max_steps {
             scene.world.step();
             steps += 1;
+            let now = touching(scene);
+            first_contact.update(&now, steps as f64 * dt);
+            if waiting {
+                for (k, t) in now.fingers.iter().enumerate() {
+                    if (t[0] || t[1]) && !held[k] {
+                        scene.hold_joint1(k, true);
+                        held[k] = true;
+                    }
+                }
+                if held.iter().all(|h| *h) {
+                    release_held(scene, &mut held);
+                    waiting = false;
+                    quiet_steps = 0;
+                }
+            }
             let Some(rule) = stall else { continue };
             if rule.quiet(motion(scene)) {
                 quiet_steps += 1;
                 if quiet_steps as f64 * dt >= rule.window_s {
+                    if waiting {
+                        // A finger that stopped without touching: the others squeeze now.
+                        release_held(scene, &mut held);
+                        waiting = false;
+                        quiet_steps = 0;
+                        continue;
+                    }
                     break;
                 }
             } else {
@@ -594,14 +741,214 @@ fn close(scene: &mut Scene, params: &SimParams) -> Closing {
         }
     }
     let (pc, qc) = relative(scene);
+    let joint_errors_deg = joint_errors(scene);
+    let outcome = closing_outcome(
+        case,
+        &first_contact,
+        &touching(scene),
+        &gaps_mm(scene),
+        &joint_errors_deg,
+        ((pc - p0).norm(), q0.angle_to(&qc).to_degrees()),
+        steps as f64 * dt,
+    );
     Closing {
         p0,
+        q0,
         pc,
         qc,
         penetration_mm: penetration_mm(scene),
-        joint_errors_deg: joint_errors(scene),
+        joint_errors_deg,
         steps,
         contacts: super::contacts::grip_contacts(scene),
+        outcome,
+        poses: poses(scene),
+    }
+}
+
+/// Per finger, the gap between phalanx 1, phalanx 2 (its nearest collider) and the object's
+/// collider now `[mm]`, 0 when they touch or overlap.
+fn gaps_mm(scene: &Scene) -> Vec<[f64; 2]> {
+    let w = &scene.world;
+    let object = &w.colliders[scene.object_collider];
+    let gap = |body: RigidBodyHandle| -> f64 {
+        w.bodies[body]
+            .colliders()
+            .iter()
+            .filter_map(|&h| {
+                let c = &w.colliders[h];
+                rapier3d::parry::query::distance(
+                    c.position(),
+                    c.shape(),
+                    object.position(),
+                    object.shape(),
+                )
+                .ok()
+            })
+            .map(|d| f64::from(d.distance) * 1000.0)
+            .fold(f64::INFINITY, f64::min)
+            .max(0.0)
+    };
+    scene
+        .fingers
+        .iter()
+        .map(|f| [gap(f.phalanx1), gap(f.phalanx2)])
+        .collect()
+}
+
+/// Sends every held finger's joint 1 on to its squeeze target.
+fn release_held(scene: &mut Scene, held: &mut [bool]) {
+    for (k, h) in held.iter_mut().enumerate() {
+        if *h {
+            scene.hold_joint1(k, false);
+        }
+        *h = false;
+    }
+}
+
+/// Which hand bodies touch the object now: the palm, and phalanx 1 and 2 of each finger.
+struct Touching {
+    palm: bool,
+    fingers: Vec<[bool; 2]>,
+}
+
+/// When each hand body first touched the object during the closing `[s]`.
+struct FirstContacts {
+    palm: Option<f64>,
+    fingers: Vec<[Option<f64>; 2]>,
+}
+
+impl FirstContacts {
+    fn new(fingers: usize) -> FirstContacts {
+        FirstContacts {
+            palm: None,
+            fingers: vec![[None; 2]; fingers],
+        }
+    }
+
+    /// Records the bodies of `now` that touch for the first time at `t`.
+    fn update(&mut self, now: &Touching, t: f64) {
+        if now.palm && self.palm.is_none() {
+            self.palm = Some(t);
+        }
+        for (first, touch) in self.fingers.iter_mut().zip(&now.fingers) {
+            for j in 0..2 {
+                if touch[j] && first[j].is_none() {
+                    first[j] = Some(t);
+                }
+            }
+        }
+    }
+
+    /// The earliest first touch: (`palm` or the finger's name, phalanx, time); the palm, then
+    /// the fingers in order, on a tie.
+    fn first(&self, names: &[String]) -> Option<FirstTouch> {
+        let mut best: Option<FirstTouch> = self.palm.map(|t| FirstTouch {
+            body: "palm".to_string(),
+            phalanx: 0,
+            at_s: t,
+        });
+        for (name, first) in names.iter().zip(&self.fingers) {
+            for (j, t) in first.iter().enumerate() {
+                if let Some(t) = *t {
+                    if best.as_ref().is_none_or(|b| t < b.at_s) {
+                        best = Some(FirstTouch {
+                            body: name.clone(),
+                            phalanx: j + 1,
+                            at_s: t,
+                        });
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The hand bodies in contact with the object now (a solver contact: within rapier's
+/// prediction distance, 0.2 mm at the scene's length unit).
+fn touching(scene: &Scene) -> Touching {
+    let w = &scene.world;
+    let mut now = Touching {
+        palm: false,
+        fingers: vec![[false; 2]; scene.fingers.len()],
+    };
+    for pair in w.narrow_phase.contact_pairs_with(scene.object_collider) {
+        if !pair.has_any_active_contact() {
+            continue;
+        }
+        let other = if pair.collider1 == scene.object_collider {
+            pair.collider2
+        } else {
+            pair.collider1
+        };
+        let Some(body) = w.colliders.get(other).and_then(|c| c.parent()) else {
+            continue;
+        };
+        if body == scene.palm {
+            now.palm = true;
+        }
+        for (k, f) in scene.fingers.iter().enumerate() {
+            if body == f.phalanx1 {
+                now.fingers[k][0] = true;
+            }
+            if body == f.phalanx2 {
+                now.fingers[k][1] = true;
+            }
+        }
+    }
+    now
+}
+
+/// The report of a closing: `shift` is the object's (translation `[mm]`, rotation `[deg]`)
+/// relative to the palm over the closing, `duration_s` its length.
+fn closing_outcome(
+    case: &Case,
+    first: &FirstContacts,
+    end: &Touching,
+    gaps: &[[f64; 2]],
+    errors: &[[f64; 2]],
+    (shift_mm, turn_deg): (f64, f64),
+    duration_s: f64,
+) -> ClosingOutcome {
+    let names: Vec<String> = case
+        .hand
+        .finger_list
+        .iter()
+        .map(|f| f.name.clone())
+        .collect();
+    let fingers: Vec<FingerClosing> = names
+        .iter()
+        .zip(&case.pose.theta_deg)
+        .zip(errors)
+        .zip(end.fingers.iter().zip(&first.fingers).zip(gaps))
+        .map(
+            |(((name, planned), error), ((touching, first), gap))| FingerClosing {
+                name: name.clone(),
+                planned_deg: *planned,
+                final_deg: [planned[0] - error[0], planned[1] - error[1]],
+                error_deg: *error,
+                touching: *touching,
+                gap_mm: *gap,
+                first_contact_s: *first,
+            },
+        )
+        .collect();
+    let phalanges_on_plan = fingers
+        .iter()
+        .flat_map(|f| (0..2).map(move |j| f.touching[j] && f.error_deg[j].abs() <= WITHIN_PLAN_DEG))
+        .filter(|on| *on)
+        .count();
+    let max_shift_mm = case.params.max_closing_shift_mm;
+    ClosingOutcome {
+        shift_mm,
+        turn_deg,
+        duration_s,
+        max_shift_mm,
+        pushed: shift_mm > max_shift_mm,
+        first_touch: first.first(&names),
+        palm_touching: end.palm,
+        fingers,
+        phalanges_on_plan,
     }
 }
 
@@ -733,8 +1080,16 @@ fn hold(
         }
         hand_was_still = hand_still;
         let remaining_s = (hold_steps - steps) as f64 * dt;
+        // A grasp the closing left too deep in the object, or pushed too far, is `slip`
+        // whatever it does while on the hand.
         let penetrated = closing.penetration_mm > params.max_penetration_mm;
-        match rule.decide(&samples, &frame, remaining_s, params, penetrated) {
+        match rule.decide(
+            &samples,
+            &frame,
+            remaining_s,
+            params,
+            penetrated || closing.outcome.pushed,
+        ) {
             Some(Verdict::Hold) => {}
             Some(_) if touches_hand(scene) => {}
             _ => continue,
@@ -771,6 +1126,7 @@ fn hold(
     } else if translation_mm <= params.hold_translation_mm
         && judged_rotation <= params.hold_rotation_deg
         && closing.penetration_mm <= params.max_penetration_mm
+        && !closing.outcome.pushed
     {
         Verdict::Hold
     } else if in_contact {
@@ -786,6 +1142,8 @@ fn hold(
         full_rotation_deg: rotation_deg,
         tilt_deg,
         closing_translation_mm: (pc - p0).norm(),
+        closing_rotation_deg: closing.q0.angle_to(&qc).to_degrees(),
+        closing_pushed: closing.outcome.pushed,
         closing_penetration_mm: closing.penetration_mm,
         closed_at_s: closing.steps as f64 * dt,
         joint_error_deg,

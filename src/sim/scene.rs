@@ -403,6 +403,8 @@ pub struct SimFinger {
     pub joint2: MultibodyJointHandle,
     /// Joint 2's motor target once released `[rad]`.
     pub joint2_target: f32,
+    /// Joint 1's motor target while it closes `[rad]`.
+    pub joint1_target: f32,
 }
 
 /// A copy of `w` that continues bit for bit as `w` would: every part of rapier's state, with
@@ -442,6 +444,25 @@ impl Scene {
     pub fn set_object_mass(&mut self, mass_kg: f64) {
         if let Some(c) = self.world.colliders.get_mut(self.object_collider) {
             c.set_mass(mass_kg as f32);
+        }
+    }
+
+    /// Holds finger `k`'s joint 1 where it is now (`hold`) or sends it on to its closing target
+    /// (the approach that waits for every finger to touch, `[sim] approach = "together"`).
+    pub fn hold_joint1(&mut self, k: usize, hold: bool) {
+        let (stiffness, d) = self.motor_gains;
+        let Some(f) = self.fingers.get(k) else { return };
+        if let Some((mb, id)) = self.world.multibody_joints.get_mut(f.joint1) {
+            if let Some(link) = mb.link_mut(id) {
+                let target = if hold {
+                    link.joint.coords()[3]
+                } else {
+                    f.joint1_target
+                };
+                link.joint
+                    .data
+                    .set_motor_position(JointAxis::AngX, target, stiffness, d);
+            }
         }
     }
 
@@ -503,6 +524,30 @@ impl Case<'_> {
             ..*self
         }
     }
+}
+
+/// Each finger's joint torque limit `[N·m]`, in the hand's order: `torque_limit_nm`, or with
+/// `balanced_squeeze` scaled by the number of fingers on the palm's less crowded side over the
+/// number on the finger's own side (the thesis hand: 0.5 for finger_1 and finger_3, 1 for the
+/// thumb), so that both sides squeeze equally.
+pub fn finger_torque_limits(hand: &Hand, params: &SimParams) -> Vec<f64> {
+    let count = |side| hand.finger_list.iter().filter(|f| f.side == side).count();
+    let (left, right) = (
+        count(crate::hand::Side::Left),
+        count(crate::hand::Side::Right),
+    );
+    let fewest = left.min(right);
+    hand.finger_list
+        .iter()
+        .map(|f| {
+            let own = count(f.side);
+            if params.balanced_squeeze && fewest > 0 && own > 0 {
+                params.torque_limit_nm * fewest as f64 / own as f64
+            } else {
+                params.torque_limit_nm
+            }
+        })
+        .collect()
 }
 
 /// The collision shape of a hand box `[m]`.
@@ -683,12 +728,14 @@ pub fn build(case: &Case) -> Scene {
         .iter()
         .zip(&pose.theta_deg)
         .zip(&start.open_bend_rad)
-        .map(|((f, theta), open)| {
+        .zip(finger_torque_limits(hand, params))
+        .map(|(((f, theta), open), torque_nm)| {
             let at = FingerAt {
                 finger: f,
                 theta_deg: *theta,
                 open_bend_rad: *open,
                 palm_pose: (start.origin_mm, r_palm),
+                torque_nm,
             };
             insert_finger(&mut world, &mut hand_colliders, case, palm, &at)
         })
@@ -775,6 +822,8 @@ struct FingerAt<'a> {
     theta_deg: [f64; 2],
     open_bend_rad: [f64; 2],
     palm_pose: BodyPose,
+    /// Its joints' torque limit `[N·m]` ([`finger_torque_limits`]).
+    torque_nm: f64,
 }
 
 /// Inserts one finger's phalanx bodies, their colliders (pushed onto `hand_colliders`) and its
@@ -812,7 +861,7 @@ fn insert_finger(
                 params.motor_stiffness_nm_per_rad as f32,
                 params.motor_damping_nms_per_rad as f32,
             )
-            .motor_max_force(params.torque_limit_nm as f32)
+            .motor_max_force(at.torque_nm as f32)
             .contacts_enabled(false)
     };
     let (p1, p2) = hand.phalanx_boxes(f.side);
@@ -858,6 +907,7 @@ fn insert_finger(
         joint1,
         joint2,
         joint2_target: motor(bend(t2) + squeeze2, limits2),
+        joint1_target: motor(bend(t1) + squeeze, limits1),
     }
 }
 

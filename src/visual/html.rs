@@ -15,7 +15,12 @@ fn verdict_sentence(report: &RunReport) -> String {
         SimVerdict::NotRun { .. } => "not run",
         SimVerdict::Ran(v) => v.as_str(),
     };
-    match (sim.translation_mm, sim.rotation_deg) {
+    let closing = sim
+        .closing
+        .as_ref()
+        .map(|c| format!(". Closing: {}", crate::report::closing_line(c)))
+        .unwrap_or_default();
+    let sentence = match (sim.translation_mm, sim.rotation_deg) {
         (Some(t), Some(r)) => format!(
             "Physics check: {word} (moved {t:.2} mm and {r:.2} deg relative to the palm under gravity{})",
             sim.payload_margin
@@ -26,7 +31,8 @@ fn verdict_sentence(report: &RunReport) -> String {
             Some(why) => format!("Physics check: {word} ({why})"),
             None => format!("Physics check: {word}"),
         },
-    }
+    };
+    sentence + &closing
 }
 
 /// The Grasp Parameter Set as a table (thesis 3.7), or the reason there is none.
@@ -41,20 +47,35 @@ fn parameter_set(report: &RunReport) -> String {
                 .unwrap_or("the planner found no feasible grasp"))
         );
     };
-    let mut s = String::from(
-        "<table class=\"gps\"><tr><th>Grasp condition</th><td colspan=\"3\">Passed</td></tr>",
+    // The closed set beside the planned one (issue 33): the angles the closing reached.
+    let closing = report.sim.closing.as_ref();
+    let cols = if closing.is_some() { 5 } else { 3 };
+    let mut s = format!(
+        "<table class=\"gps\"><tr><th>Grasp condition</th><td colspan=\"{cols}\">Passed</td></tr>"
     );
-    s.push_str(
-        "<tr><th>Finger</th><th>theta1 [deg]</th><th>theta2 [deg]</th><th>contact</th></tr>",
-    );
-    for f in &g.fingers {
+    s.push_str("<tr><th>Finger</th><th>theta1 [deg]</th><th>theta2 [deg]</th><th>contact</th>");
+    if closing.is_some() {
+        s.push_str("<th>closed theta1 [deg]</th><th>closed theta2 [deg]</th>");
+    }
+    s.push_str("</tr>");
+    for (k, f) in g.fingers.iter().enumerate() {
         s.push_str(&format!(
-            "<tr><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{}</td></tr>",
+            "<tr><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{}</td>",
             esc(&f.name),
             f.theta1_deg,
             f.theta2_deg,
             if f.tip_contact { "tip" } else { "phalanx" }
         ));
+        if let Some(c) = closing {
+            match c.fingers.get(k) {
+                Some(fc) => s.push_str(&format!(
+                    "<td>{:.1}</td><td>{:.1}</td>",
+                    fc.final_deg[0], fc.final_deg[1]
+                )),
+                None => s.push_str("<td></td><td></td>"),
+            }
+        }
+        s.push_str("</tr>");
     }
     let pp = &g.palm_pose;
     let rows = [
@@ -91,7 +112,7 @@ fn parameter_set(report: &RunReport) -> String {
     ];
     for (k, v) in rows {
         s.push_str(&format!(
-            "<tr><th>{}</th><td colspan=\"3\">{}</td></tr>",
+            "<tr><th>{}</th><td colspan=\"{cols}\">{}</td></tr>",
             esc(k),
             esc(&v)
         ));
@@ -102,7 +123,15 @@ fn parameter_set(report: &RunReport) -> String {
 
 /// The page for one scenario's run: the verdict in words, the Grasp Parameter Set as a table,
 /// links to the 3D scenes written (`scenes`), the full summary, and every figure, inline.
-pub fn page(report: &RunReport, figures: &[(String, String)], scenes: &[&str]) -> String {
+///
+/// `views` are the three rendered views of the grasp (`view_*.svg`) and their one-line legend,
+/// shown first, after the verdict.
+pub fn page(
+    report: &RunReport,
+    figures: &[(String, String)],
+    scenes: &[&str],
+    views: (&[(String, String)], &str),
+) -> String {
     let mut s = String::new();
     s.push_str("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">");
     s.push_str(&format!(
@@ -140,6 +169,16 @@ pub fn page(report: &RunReport, figures: &[(String, String)], scenes: &[&str]) -
             "no expectation given: nothing judged".to_string()
         }
     ));
+    let (view_figs, legend) = views;
+    if !view_figs.is_empty() {
+        s.push_str("<h2>The grasp in three views</h2><div class=\"figs\">");
+        for (name, svg) in view_figs {
+            s.push_str(&format!("<div class=\"fig\" id=\"{}\">", esc(name)));
+            s.push_str(svg);
+            s.push_str("</div>");
+        }
+        s.push_str(&format!("</div><p class=\"legend\">{}</p>", esc(legend)));
+    }
     s.push_str("<h2>Grasp Parameter Set</h2>");
     s.push_str(&parameter_set(report));
     if scenes.is_empty() {

@@ -5,6 +5,7 @@ pub mod figures;
 pub mod glb;
 pub mod html;
 pub mod svg;
+pub mod views;
 
 use crate::hand::Hand;
 use crate::mesh::Mesh;
@@ -12,6 +13,16 @@ use crate::plan::search::Grasp;
 use crate::plan::GradedDomain;
 use crate::report::RunReport;
 use std::path::Path;
+
+/// Where the physics check left the bodies (aligned frame, metres; the palm, phalanx 1 and 2 of
+/// each finger, then the object).
+#[derive(Clone, Copy)]
+pub struct SimulatedPoses<'a> {
+    /// At the end of the first gravity direction's hold.
+    pub end: &'a [crate::sim::BodyPose],
+    /// At the end of the closing, gravity still off.
+    pub closed: &'a [crate::sim::BodyPose],
+}
 
 /// Writes every figure (`*.svg`) and `report.html` into `dir`; returns the figure names.
 ///
@@ -24,8 +35,10 @@ pub fn write_report(
     grasp: Option<&Grasp>,
     mesh: &Mesh,
     hand: &Hand,
-    simulated: Option<&[crate::sim::BodyPose]>,
+    simulated: Option<SimulatedPoses>,
 ) -> Result<Vec<String>, crate::export::ExportError> {
+    let closed = simulated.map(|s| s.closed);
+    let simulated = simulated.map(|s| s.end);
     let err = |path: &Path, e: std::io::Error| crate::export::ExportError {
         path: path.to_path_buf(),
         message: e.to_string(),
@@ -67,6 +80,34 @@ pub fn write_report(
         let path = dir.join(format!("{name}.svg"));
         std::fs::write(&path, svg).map_err(|e| err(&path, e))?;
     }
+    // The three views of the grasp (issue 33): planned and closed hand over the object.
+    let mut view_figs: Vec<(String, String)> = Vec::new();
+    let mut view_legend = String::new();
+    if let Some(g) = grasp {
+        let theta: Vec<[f64; 2]> = g
+            .fingers
+            .iter()
+            .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
+            .collect();
+        let planned = glb::planned_poses(hand, &g.palm.origin, &g.palm.axes, &theta);
+        let scene = views::Scene {
+            mesh,
+            hand,
+            planned: &planned,
+            closed: closed.filter(|c| c.len() == planned.len() + 1),
+            shift: report
+                .sim
+                .closing
+                .as_ref()
+                .map(|c| (c.shift_mm, c.turn_deg)),
+        };
+        view_legend = views::page_legend(&scene);
+        view_figs = views::render(&scene);
+    }
+    for (name, svg) in &view_figs {
+        let path = dir.join(format!("{name}.svg"));
+        std::fs::write(&path, svg).map_err(|e| err(&path, e))?;
+    }
     let mut scenes: Vec<&str> = Vec::new();
     if let Some(g) = grasp {
         let theta: Vec<[f64; 2]> = g
@@ -94,7 +135,11 @@ pub fn write_report(
         }
     }
     // A re-run into an old folder must not leave a scene (or a figure) this run did not make.
-    let written: Vec<String> = figs.iter().map(|(n, _)| format!("{n}.svg")).collect();
+    let written: Vec<String> = figs
+        .iter()
+        .chain(&view_figs)
+        .map(|(n, _)| format!("{n}.svg"))
+        .collect();
     for stale in [
         "grasp_planned.glb",
         "grasp_simulated.glb",
@@ -104,6 +149,9 @@ pub fn write_report(
         "finger_2.svg",
         "finger_3.svg",
         "rejections.svg",
+        "view_top.svg",
+        "view_side.svg",
+        "view_oblique.svg",
     ] {
         let path = dir.join(stale);
         let made = written.iter().any(|w| w == stale) || scenes.contains(&stale);
@@ -112,6 +160,7 @@ pub fn write_report(
         }
     }
     let path = dir.join("report.html");
-    std::fs::write(&path, html::page(report, &figs, &scenes)).map_err(|e| err(&path, e))?;
-    Ok(figs.into_iter().map(|(n, _)| n).collect())
+    let page = html::page(report, &figs, &scenes, (&view_figs, &view_legend));
+    std::fs::write(&path, page).map_err(|e| err(&path, e))?;
+    Ok(figs.into_iter().chain(view_figs).map(|(n, _)| n).collect())
 }

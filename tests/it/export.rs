@@ -65,9 +65,18 @@ fn mjcf_has_the_hand_the_object_and_the_actuators() {
         .collect();
     assert_eq!(actuators.len(), 6);
     for a in &actuators {
+        // The balanced squeeze: the thumb (finger_2) alone on its side at the torque limit,
+        // finger_1 and finger_3 sharing the other side at half of it each.
+        let thumb = a
+            .attribute("name")
+            .is_some_and(|n| n.starts_with("finger_2"));
         assert_eq!(
             a.attribute("forcerange"),
-            Some("-1.000000 1.000000"),
+            Some(if thumb {
+                "-1.000000 1.000000"
+            } else {
+                "-0.500000 0.500000"
+            }),
             "the torque limit"
         );
         assert_eq!(a.attribute("kp"), Some("20"));

@@ -2,6 +2,7 @@
 
 mod batch;
 mod cli;
+mod closing;
 mod engines;
 mod export;
 mod formats;

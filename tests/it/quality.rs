@@ -53,7 +53,9 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
     );
     let q = r.quality.unwrap();
     assert_eq!(q.source, "sim");
-    assert!(q.contacts.len() >= 9, "{} contacts", q.contacts.len());
+    // Six or more: the grasp chosen since issue 33 (the first candidate's closing pushed the
+    // object 6 mm) holds by both phalanges of every finger.
+    assert!(q.contacts.len() >= 6, "{} contacts", q.contacts.len());
     for f in ["finger_1", "finger_2", "finger_3"] {
         assert!(
             q.contacts.iter().any(|c| c.finger == f),
@@ -72,11 +74,13 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
     let points: Vec<[f64; 3]> = q.contacts.iter().map(|c| c.point_mm).collect();
     let far = farthest_from_surface(&aligned.mesh, &points);
     assert!(far < 6.0, "a contact {far:.2} mm from the surface");
-    // The grip is force closure: measured 0.111 (L1, 8 cone edges; the cup's is 0.132).
+    // The grip is force closure: measured 0.054 (L1, 8 cone edges) on the grasp chosen since
+    // issue 33 (0.111 on the first candidate, whose closing pushed the object 6 mm; the cup's
+    // is 0.125).
     assert!(q.force_closure, "{:?}", q.note);
     assert!(
-        (0.08..0.14).contains(&q.epsilon),
-        "epsilon {} outside 0.08..0.14",
+        (0.03..0.14).contains(&q.epsilon),
+        "epsilon {} outside 0.03..0.14",
         q.epsilon
     );
     assert!(q.volume > 1e-3, "volume {}", q.volume);
@@ -92,9 +96,9 @@ fn the_summary_gives_epsilon_and_the_json_has_it_per_candidate() {
         .find(|l| l.starts_with("  Quality     "))
         .unwrap_or_else(|| panic!("no quality line in\n{text}"));
     assert!(
-        line.contains("epsilon 0.122 (force closure)")
+        line.contains("epsilon 0.125 (force closure)")
             && line.contains("8 cone edges, mu 0.3")
-            && line.contains("8 contacts at the end of closing"),
+            && line.contains("9 contacts at the end of closing"),
         "{line}"
     );
     // Without it: from the planned contacts (palm and the phalanges of every ALS), for every

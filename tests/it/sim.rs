@@ -618,15 +618,16 @@ fn penetration_after_closing_is_reported_and_bounded() {
         r.sim
     );
     assert!(depth < 0.5, "{depth} mm");
-    // Soft contacts (300 Hz) let the motors drive the fingers about 6 mm into it. The object
+    // Soft contacts (150 Hz) let the motors drive the fingers about 4 mm into it (6 mm at
+    // 300 Hz before the balanced squeeze halved finger_1's and finger_3's torque). The object
     // does not move, but a grasp made by fingers inside the object is not a hold ...
     let (_d, s) = scenario_with(
         "cylinder_d40.stl",
-        "max_checked = 1\ncontact_stiffness_hz = 300.0",
+        "max_checked = 1\ncontact_stiffness_hz = 150.0",
     );
     let r = run(&s, &with_sim()).unwrap();
     let dir = &r.sim.directions[0];
-    assert!(dir.closing_penetration_mm > 4.0, "{dir:?}");
+    assert!(dir.closing_penetration_mm > 3.0, "{dir:?}");
     assert!(dir.translation_mm < 1.0, "{dir:?}");
     assert_eq!(
         r.sim.verdict,
@@ -648,7 +649,7 @@ fn penetration_after_closing_is_reported_and_bounded() {
     // ... unless the bound is raised past the depth.
     let (_d, s) = scenario_with(
         "cylinder_d40.stl",
-        "max_checked = 1\ncontact_stiffness_hz = 300.0\nmax_penetration_mm = 10.0",
+        "max_checked = 1\ncontact_stiffness_hz = 150.0\nmax_penetration_mm = 10.0",
     );
     let r = run(&s, &with_sim()).unwrap();
     assert_eq!(

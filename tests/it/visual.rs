@@ -99,10 +99,10 @@ fn the_report_has_figures_scenes_and_a_page() {
     let html = std::fs::read_to_string(d.join("report.html")).unwrap();
     assert!(html.contains("Physics check: hold"));
     assert!(html.contains("Grasp Parameter Set") && html.contains("Palm_Pitch_Angle"));
-    assert_eq!(html.matches("<svg").count(), 10);
+    assert_eq!(html.matches("<svg").count(), 13);
     for remote in ["http://", "https://", "<script", "src=\""] {
         let hits = html.matches(remote).count();
-        let allowed = if remote == "http://" { 10 } else { 0 }; // the SVG namespace only
+        let allowed = if remote == "http://" { 13 } else { 0 }; // the SVG namespace only
         assert_eq!(hits, allowed, "{remote} appears {hits} times");
     }
 }
@@ -117,4 +117,52 @@ fn an_ungraspable_object_still_gets_its_stage_figures() {
     assert!(!d.join("grasp_planned.glb").exists());
     let html = std::fs::read_to_string(d.join("report.html")).unwrap();
     assert!(html.contains("ungraspable"));
+}
+
+#[test]
+fn the_report_shows_the_grasp_in_three_views() {
+    // Issue 33: the planned hand (dashed) and the hand where the closing left it (filled) over
+    // the object, from above, the side and obliquely, with the closing's shift in the legend.
+    let dir = report("cylinder_d40");
+    let d = dir.path().join("cylinder_d40");
+    let html = std::fs::read_to_string(d.join("report.html")).unwrap();
+    let json = crate::succeed(crate::grasp_sim().args(["--json", "scenarios/cylinder_d40.toml"]));
+    let r: serde_json::Value = serde_json::from_slice(&json.stdout).unwrap();
+    let shift = r["sim"]["closing"]["shift_mm"].as_f64().unwrap();
+    let legend = format!("closing shift {shift:.1} mm");
+    for view in ["view_top", "view_side", "view_oblique"] {
+        let text = std::fs::read_to_string(d.join(format!("{view}.svg"))).unwrap();
+        let doc = roxmltree::Document::parse(&text).unwrap_or_else(|e| panic!("{view}: {e}"));
+        assert_eq!(doc.root_element().tag_name().name(), "svg");
+        // The object's triangles and the closed hand's faces, filled ...
+        let polygons = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("polygon"))
+            .count();
+        assert!(polygons > 100, "{view}: {polygons} polygons");
+        // ... and the planned hand: 12 dashed edges per box, 7 bodies (phalanx 2 with no tip).
+        let dashed = doc
+            .descendants()
+            .filter(|n| n.has_tag_name("line") && n.attribute("stroke") == Some("#1f4fbf"))
+            .count();
+        assert_eq!(dashed, 12 * 7, "{view}");
+        assert!(text.contains(&legend), "{view}: no `{legend}`");
+        // Inline in the page, as written.
+        assert!(html.contains(&text), "{view} not inline in report.html");
+    }
+    assert!(html.contains("The grasp in three views"));
+    assert!(html.contains("closed theta1 [deg]"));
+    // The same run writes the same views, byte for byte.
+    let again = report("cylinder_d40");
+    for view in ["view_top", "view_side", "view_oblique"] {
+        let a = std::fs::read(d.join(format!("{view}.svg"))).unwrap();
+        let b = std::fs::read(
+            again
+                .path()
+                .join("cylinder_d40")
+                .join(format!("{view}.svg")),
+        )
+        .unwrap();
+        assert_eq!(a, b, "{view}");
+    }
 }
