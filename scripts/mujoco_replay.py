@@ -72,6 +72,8 @@ def replay(scene_dir):
         w = float(np.linalg.norm(d.qvel[od + 3:od + 6]))
         return joint < stall["joint_rad_s"] and v < stall["object_mm_s"] and w < stall["object_rad_s"]
 
+    # Body poses of the keyframe (mj_resetDataKeyframe sets qpos only): positions, nothing else.
+    mujoco.mj_kinematics(m, d)
     p0, r0 = relative_pose(m, d, palm, obj)
     # `approach = "together"` (issue 33): a finger that touches the object stops there until
     # every finger has touched, or the hand has stopped, then all squeeze (as grasp-sim's).
