@@ -83,9 +83,59 @@ def summary_of(r):
             (d.get("closing_penetration_mm", 0.0) for d in sim.get("directions", [])), default=None
         ),
     }
+    out.update(closing_of(sim, g))
     if g:
         out.update(axis=g["axis_name"], rules=g["rules"], relaxations=g["relaxations"])
     return out
+
+
+def closing_of(sim, grasp):
+    """What the closing did (issue 33): the object's shift and turn, each finger's final bend
+    against its plan, and how many phalanges ended touching the object within 5 degrees of it.
+    From `sim.closing` where the binary writes it; from `sim.directions[0]` (shift and joint
+    errors only, touching unknown) for a binary from before issue 33."""
+    dirs = sim.get("directions") or []
+    if not dirs:
+        return {}
+    c = sim.get("closing")
+    names = [f["name"] for f in (grasp or {}).get("fingers", [])]
+    if c:
+        errors = [f["error_deg"] for f in c["fingers"]]
+        names = [f["name"] for f in c["fingers"]]
+        touching = [f["touching"] for f in c["fingers"]]
+        gaps = [f.get("gap_mm", [None, None]) for f in c["fingers"]]
+        shift, turn = c["shift_mm"], c["turn_deg"]
+    else:
+        errors = dirs[0].get("joint_errors_deg") or []
+        touching = None
+        gaps = None
+        shift, turn = dirs[0].get("closing_translation_mm"), None
+    if len(names) != len(errors):
+        names = [f"finger_{k + 1}" for k in range(len(errors))]
+    worst = None
+    for name, e in zip(names, errors):
+        for j, v in enumerate(e):
+            if worst is None or abs(v) > abs(worst[2]):
+                worst = (name, j + 1, v)
+    phalanges = [
+        abs(v) <= 5.0 and (touching is None or touching[k][j])
+        for k, e in enumerate(errors)
+        for j, v in enumerate(e)
+    ]
+    near = None if gaps is None or any(g is None for gg in gaps for g in gg) else sum(
+        abs(v) <= 5.0 and gaps[k][j] <= 0.5 for k, e in enumerate(errors) for j, v in enumerate(e))
+    return {
+        "phalanges_within_5deg_and_0_5mm": near,
+        "closing_shift_mm": shift,
+        "closing_turn_deg": turn,
+        "joint_errors_deg": errors,
+        "touching_known": touching is not None,
+        "phalanges": len(phalanges),
+        "phalanges_within_5deg": sum(phalanges),
+        "worst_finger": None if worst is None else
+        {"name": worst[0], "joint": worst[1], "error_deg": worst[2]},
+        "pushed": any(d.get("closing_pushed", False) for d in dirs),
+    }
 
 
 def main():
@@ -97,6 +147,12 @@ def main():
     ap.add_argument("--write-doc", action="store_true")
     ap.add_argument("--sim", action="append", default=[], metavar="KEY=VALUE",
                     help="add KEY = VALUE to every scenario's [sim] table (e.g. squeeze_deg=5)")
+    ap.add_argument("--before", metavar="RESULTS_JSON",
+                    help="an earlier run's results.json: the table shows its closing shift and "
+                         "worst finger beside this run's (issue 33)")
+    ap.add_argument("--mujoco-only", action="store_true",
+                    help="replay OUT/mjcf in MuJoCo again for OUT/results.json, without running "
+                         "grasp-sim (after a change to scripts/mujoco_replay.py)")
     ap.add_argument("names", nargs="*", help="only these objects")
     a = ap.parse_args()
 
@@ -113,13 +169,15 @@ def main():
     mjcf = out / "mjcf"
     mjcf.mkdir(parents=True, exist_ok=True)
     results = {}
+    if a.mujoco_only:
+        results = json.loads((out / "results.json").read_text())
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(a.jobs) as pool:
         jobs = {
             (s.stem, g): pool.submit(run_one, a.binary, s, g, tmp, mjcf if g == "down" else None, a.sim)
             for s in scenarios
             for g in ("down", "six")
-        }
-        for s in scenarios:
+        } if not a.mujoco_only else {}
+        for s in (scenarios if not a.mujoco_only else []):
             down = jobs[(s.stem, "down")].result()
             six = jobs[(s.stem, "six")].result()
             results[s.stem] = {
@@ -138,11 +196,13 @@ def main():
             if r["down"].get("verdict") in ("hold", "slip", "drop") and (scene / "scene.xml").is_file():
                 try:
                     m = mujoco_replay.replay(scene)
-                    r["mujoco"] = {k: m[k] for k in ("verdict", "translation_mm", "rotation_deg")}
+                    r["mujoco"] = {k: m.get(k) for k in ("verdict", "translation_mm", "rotation_deg",
+                                                         "closing_shift_mm", "closing_pushed")}
                 except Exception as e:  # noqa: BLE001 - a scene MuJoCo refuses is a finding
                     r["mujoco"] = {"verdict": f"error: {str(e).splitlines()[0][:80]}"}
     (out / "results.json").write_text(json.dumps(results, indent=1, sort_keys=True))
-    doc = table(results, a.no_mujoco)
+    before = json.loads(pathlib.Path(a.before).read_text()) if a.before else None
+    doc = table(results, a.no_mujoco, before)
     print(doc)
     if a.write_doc:
         path = ROOT / "docs" / "REAL_OBJECTS.md"
@@ -155,11 +215,59 @@ def fmt(x, d=1):
     return "" if x is None else f"{x:.{d}f}"
 
 
-def table(results, no_mujoco):
+def worst(d):
+    w = d.get("worst_finger")
+    return "" if not w else f"{w['name']} j{w['joint']} {w['error_deg']:+.0f}°"
+
+
+def closing_stats(results, key="down"):
+    """Over every planned-and-held grasp (`down` and `six` runs, every label): the closing
+    shifts' median and 90th percentile [mm], and the phalanges that end on the object within
+    5 degrees of their plan (a share, or None when the binary does not say which touch)."""
+    shifts, on, total, known = [], 0, 0, True
+    for r in results.values():
+        for run in ("down", "six"):
+            d = r.get(run, {})
+            if d.get("verdict") != "hold" or d.get("closing_shift_mm") is None:
+                continue
+            shifts.append(d["closing_shift_mm"])
+            on += d.get("phalanges_within_5deg", 0)
+            total += d.get("phalanges", 0)
+            known = known and d.get("touching_known", False)
+    shifts.sort()
+
+    def q(p):
+        if not shifts:
+            return None
+        k = p * (len(shifts) - 1)
+        i = int(k)
+        j = min(i + 1, len(shifts) - 1)
+        return shifts[i] + (shifts[j] - shifts[i]) * (k - i)
+
+    return {"n": len(shifts), "median": q(0.5), "p90": q(0.9), "max": shifts[-1] if shifts else None,
+            "on_plan": on, "phalanges": total, "touching_known": known}
+
+
+def stats_line(name, st):
+    if not st["n"]:
+        return f"{name}: no held grasp."
+    share = 100.0 * st["on_plan"] / st["phalanges"] if st["phalanges"] else 0.0
+    within = (f"{st['on_plan']} of {st['phalanges']} phalanges ({share:.0f} %) end touching the "
+              "object within 5° of their plan" if st["touching_known"] else
+              f"{st['on_plan']} of {st['phalanges']} joints ({share:.0f} %) end within 5° of their "
+              "plan (whether they touch is not reported by that binary)")
+    return (f"{name}: {st['n']} planned-and-held grasps (`down` and `six`); closing shift median "
+            f"{st['median']:.1f} mm, 90th percentile {st['p90']:.1f} mm, at most {st['max']:.1f} mm; "
+            f"{within}.")
+
+
+def table(results, no_mujoco, before=None):
+    cols = "| closing shift [mm] | worst joint |" if before is None else \
+        "| closing shift [mm], before → after | worst joint, before → after |"
     rows = [
         "| object | label | triangles | axis | rules (relaxations) | plan | down: verdict, mm, deg "
-        "| six: verdict, mm, deg | MuJoCo (down) | checked | penetration [mm] | time [s] |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| six: verdict, mm, deg | MuJoCo (down) | checked | penetration [mm] " + cols + " time [s] |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     n = {"graspable": 0, "planned": 0, "down": 0, "six": 0, "mj": 0, "agree": 0}
     for name, r in sorted(results.items()):
@@ -175,7 +283,11 @@ def table(results, no_mujoco):
             f"| {s.get('verdict')}, {fmt(s.get('translation_mm'))}, {fmt(s.get('rotation_deg'))} "
             f"| {'' if mj is None else mj['verdict'] + ('' if agree else ' (differs)')} "
             f"| {d.get('candidates_checked', '')} | {fmt(d.get('penetration_mm'), 2)} "
-            f"| {fmt(d.get('wall_s'))} |"
+            + (f"| {fmt(d.get('closing_shift_mm'))} | {worst(d)} " if before is None else
+               f"| {fmt(before.get(name, {}).get('down', {}).get('closing_shift_mm'))} → "
+               f"{fmt(d.get('closing_shift_mm'))} "
+               f"| {worst(before.get(name, {}).get('down', {}))} → {worst(d)} ")
+            + f"| {fmt(d.get('wall_s'))} |"
         )
         if r["label"] == "graspable":
             n["graspable"] += 1
@@ -196,6 +308,20 @@ def table(results, no_mujoco):
     if not no_mujoco:
         line += (f" MuJoCo replays {n['mj']} checked grasps and agrees on {n['agree']} "
                  f"({pct(n['agree'], n['mj'])}).")
+    line += "\n\n" + stats_line("**Closing** (this run)", closing_stats(results))
+    mj = sorted(r["mujoco"]["closing_shift_mm"] for r in results.values()
+                if r.get("mujoco", {}).get("closing_shift_mm") is not None
+                and r["down"].get("verdict") == "hold")
+    if mj:
+        rp = sorted(r["down"]["closing_shift_mm"] for r in results.values()
+                    if r.get("mujoco", {}).get("closing_shift_mm") is not None
+                    and r["down"].get("verdict") == "hold")
+        med = lambda v: v[len(v) // 2] if len(v) % 2 else (v[len(v) // 2 - 1] + v[len(v) // 2]) / 2  # noqa: E731
+        line += (f" MuJoCo's own closing of the same {len(mj)} held `down` grasps: shift median "
+                 f"{med(mj):.1f} mm (rapier {med(rp):.1f}), at most {mj[-1]:.1f} mm (rapier "
+                 f"{rp[-1]:.1f}).")
+    if before is not None:
+        line += "\n\n" + stats_line("**Closing before**", closing_stats(before))
     return line + "\n\n" + "\n".join(rows) + "\n"
 
 
