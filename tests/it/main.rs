@@ -5,6 +5,7 @@ mod cli;
 mod engines;
 mod export;
 mod formats;
+mod frames;
 mod geometry;
 mod isolation;
 mod issue16;
