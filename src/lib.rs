@@ -227,6 +227,7 @@ fn select_grasps(
             max_checked: checks_candidates.then_some(max_checked.max(1)),
             check: &check,
             domains: None,
+            frame: scenario.object.frame,
         },
         timings,
     )

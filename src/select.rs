@@ -15,7 +15,7 @@
 //! slipped, else the first checked), and every candidate checked is reported with its verdict.
 
 use crate::hand::Hand;
-use crate::mesh::{align_with, AlignedObject, GraspAxis, MassProperties, Mesh};
+use crate::mesh::{align_with_rule, AlignedObject, FrameRule, GraspAxis, MassProperties, Mesh};
 use crate::plan::search::{candidate_count, search_with, Grasp, Rejection};
 use crate::plan::{self, GradedDomain, RuleSet};
 use crate::report::StageTimings;
@@ -132,6 +132,8 @@ pub struct SelectParams<'a> {
     /// Stage-1 domains kept across calls (a parameter sweep): they depend only on the axis, the
     /// rule set, the AngularStep and the HeightStep. `None`: built afresh.
     pub domains: Option<&'a DomainCache>,
+    /// How the object's own frame is chosen (`[object] frame`).
+    pub frame: FrameRule,
 }
 
 /// Stage-1 domains by (axis, rule set, AngularStep bits, HeightStep bits).
@@ -165,7 +167,7 @@ pub fn select(
                 break;
             }
             let aligned = aligned_cache[k]
-                .get_or_insert_with(|| align_with(mesh, props, *axis))
+                .get_or_insert_with(|| align_with_rule(mesh, props, *axis, p.frame))
                 .clone();
             let mut t = StageTimings::default();
             // The pinch pass searches the extended rules' graded domain again (it changes only
