@@ -167,3 +167,55 @@ fn every_real_object_plans_alike_in_five_random_frames() {
     );
     assert!(failures.is_empty(), "{} differences", failures.len());
 }
+
+/// Plans `mesh` (in mm, no physics) written in `frame`, with the default (geometric) frame rule.
+fn plan_mesh_in(
+    mesh: &grasp_sim::mesh::Mesh,
+    frame: &Isometry3<f64>,
+    dir: &std::path::Path,
+) -> RunReport {
+    let mut m = mesh.clone();
+    m.map_vertices(|p| frame * p);
+    let path = dir.join("m.stl");
+    std::fs::write(&path, m.to_binary_stl()).unwrap();
+    let s = Scenario::parse("[object]\nmesh = \"m.stl\"\n", &dir.join("s.toml")).unwrap();
+    run(
+        &s,
+        &RunOptions {
+            no_sim: true,
+            ..RunOptions::default()
+        },
+    )
+    .unwrap()
+}
+
+#[test]
+fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frames() {
+    // The shapes the frame rule is for: square sections (equal moments: the in-plane axes from
+    // the farthest vertex), a body of revolution wider at one end (the sense from the third
+    // moment), and the thesis's chapter 4 object with its vertical ridge (no symmetry at all).
+    // Each is planned as written and in five random rigid frames.
+    use grasp_sim::objects::{self, hard};
+    let dir = tempfile::tempdir().unwrap();
+    let shapes = [
+        ("square_bar_20", hard::square_bar(20.0, 150.0, 1)),
+        ("square_bar_35", hard::square_bar(35.0, 150.0, 3)),
+        ("frustum_56_80", objects::frustum(56.0, 80.0, 110.0)),
+        (
+            "chapter4",
+            objects::chapter4(&objects::Chapter4Dims::default()),
+        ),
+    ];
+    let mut failures = Vec::new();
+    for (name, mesh) in &shapes {
+        let reference = plan_mesh_in(mesh, &Isometry3::identity(), dir.path());
+        assert_eq!(reference.plan.status, PlanStatus::Feasible, "{name}");
+        for (k, f) in frames().iter().enumerate() {
+            let d = differences(&reference, &plan_mesh_in(mesh, f, dir.path()));
+            if !d.is_empty() {
+                failures.push(format!("{name} frame {k}: {}", d.join("; ")));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
