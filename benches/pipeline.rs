@@ -100,6 +100,7 @@ fn bench_plan(c: &mut Criterion) {
                         max_checked: None,
                         check: &never,
                         domains: None,
+                        frame: grasp_sim::mesh::FrameRule::File,
                     },
                     &mut t,
                 )

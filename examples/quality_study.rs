@@ -98,6 +98,7 @@ fn plan_one(path: &Path, collect: usize) -> Result<Planned, String> {
             max_checked: None,
             check: &no_check,
             domains: None,
+            frame: sc.object.frame,
         },
         &mut grasp_sim::report::StageTimings::default(),
     );

@@ -162,6 +162,11 @@ pub enum Command {
         /// Output folder.
         #[arg(long, default_value = "assets/objects")]
         out: PathBuf,
+        /// Write the hard meshes instead (issue 30: a helical gear, a cage, a studded brick,
+        /// square bars, scan-sized meshes, rings too big for the hand; 20k–250k triangles,
+        /// 40 MB in all), into `--out` (give one: they are not committed).
+        #[arg(long)]
+        hard: bool,
     },
 }
 

@@ -130,6 +130,12 @@ pub struct FingerGeometry {
     pub offset_mm: f64,
     /// Thickness of the thinned fingertip of phalanx 2 `[mm]` (thesis Fig. 3.8).
     pub tip_thickness_mm: f64,
+    /// Relief a finger does not feel `[mm]` (beyond the thesis, issue 30): the search places
+    /// fingers and the palm on slice contours simplified within this distance (teeth, knurls,
+    /// a scanner's noise shallower than it are not there for the finger). Optional: without
+    /// it, an eighth of the fingertip's thickness ([`Hand::relief_mm`]).
+    #[serde(default)]
+    pub relief_mm: Option<f64>,
 }
 
 /// One phalanx.
@@ -171,6 +177,15 @@ impl Hand {
     /// 3.3.2), so no gap narrower than this lets a finger in.
     pub fn finger_width_mm(&self) -> f64 {
         2.0 * self.fingers.offset_mm
+    }
+
+    /// The relief this hand's fingers do not feel `[mm]`: `fingers.relief_mm`, or an eighth of
+    /// the fingertip's thickness (0.5 mm for the thesis hand's 4 mm tip). Slice contours are
+    /// simplified within it before a finger or the palm is placed on them.
+    pub fn relief_mm(&self) -> f64 {
+        self.fingers
+            .relief_mm
+            .unwrap_or(self.fingers.tip_thickness_mm / 8.0)
     }
 
     /// Reads and validates a hand file, applying `overrides` (dotted key → number) first.
@@ -274,6 +289,14 @@ impl Hand {
                 self.phalanx_2.unusable_distal_mm,
             ),
         ];
+        if let Some(v) = self.fingers.relief_mm {
+            if !(v.is_finite() && (0.0..self.fingers.offset_mm).contains(&v)) {
+                return bad(
+                    "fingers.relief_mm",
+                    format!("must be zero or positive and below fingers.offset_mm, got {v}"),
+                );
+            }
+        }
         for (key, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(key, format!("must be zero or positive, got {v}"));

@@ -229,6 +229,7 @@ fn select_grasps(
             max_checked: checks_candidates.then_some(max_checked.max(1)),
             check: &check,
             domains: None,
+            frame: scenario.object.frame,
         },
         timings,
     )
@@ -363,6 +364,12 @@ fn plan_report(
             palm: g.palm.clone(),
         },
         candidates_tried: selection.axes.iter().map(|a| a.candidates_tried).sum(),
+        search_stopped: selection.budget_stops().map(|s| {
+            format!(
+                "candidate budget of {} per rule set reached on {s}",
+                scenario.planner.candidate_budget
+            )
+        }),
         rejections: rejections(selection, &scenario.hand),
         grasp: chosen_report,
         grasps: if all_grasps.len() > 1 {
@@ -544,12 +551,23 @@ fn ungraspable_reason(selection: &select::Selection, hand: &hand::Hand) -> Strin
         )
     };
     let first = describe(&selection.axes[0]);
-    match selection.axes.len() {
+    let reason = match selection.axes.len() {
         1 => first,
         n => format!(
             "{first} (and no grasp in the {} other axis and rule combinations tried: `plan.axes` in --json)",
             n - 1
         ),
+    };
+    match selection.budget_stops() {
+        None => reason,
+        Some(_) => {
+            let tried: usize = selection.axes.iter().map(|a| a.candidates_tried).sum();
+            let stopped = selection.axes.iter().filter(|a| a.budget_stopped).count();
+            format!(
+                "{reason}; the search stopped at its candidate budget on {stopped} of them \
+                 ({tried} candidates tried in all: `plan.search_stopped`)"
+            )
+        }
     }
 }
 
@@ -563,6 +581,8 @@ fn axis_report(a: &select::AxisPlan) -> report::AxisReport {
         indexed_elevations: a.graded.domain.elevations.len(),
         sorted_indices: a.graded.sorted_indices.len(),
         candidates_tried: a.candidates_tried,
+        candidates_available: a.candidates_available,
+        budget_stopped: a.budget_stopped,
         grasps_found: a.grasps_found,
         reason: (a.grasps_found == 0).then(|| {
             a.graded

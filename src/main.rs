@@ -42,7 +42,10 @@ fn main() -> ExitCode {
 
 fn real_main(cli: cli::Cli) -> anyhow::Result<u8> {
     match cli.command {
-        Some(cli::Command::GenAssets { out }) => return gen_assets(&out).map(|()| 0),
+        Some(cli::Command::GenAssets { out, hard: true }) => {
+            return gen_hard_assets(&out).map(|()| 0)
+        }
+        Some(cli::Command::GenAssets { out, hard: false }) => return gen_assets(&out).map(|()| 0),
         Some(cli::Command::Batch(args)) => return batch(&args),
         Some(cli::Command::BatchWorker {
             path,
@@ -774,6 +777,17 @@ fn summarize(
 /// file.
 fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> anyhow::Result<()> {
     Ok(grasp_sim::batch::journal::write_atomically(path, bytes)?)
+}
+
+fn gen_hard_assets(out: &std::path::Path) -> anyhow::Result<()> {
+    std::fs::create_dir_all(out)
+        .with_context(|| format!("{}: cannot create folder", out.display()))?;
+    for (name, mesh) in grasp_sim::objects::hard::hard_objects() {
+        let path = out.join(format!("{name}.stl"));
+        write_atomically(&path, &mesh.to_binary_stl())?;
+        println!("{}: {} triangles", path.display(), mesh.triangles.len());
+    }
+    Ok(())
 }
 
 fn gen_assets(out: &std::path::Path) -> anyhow::Result<()> {

@@ -8,6 +8,8 @@
 //!
 //! Output is a [`Mesh`] in millimetres, aligned already (principal axis +Z, bottom at Z = 0).
 
+pub mod hard;
+
 use crate::mesh::Mesh;
 use nalgebra::Point3;
 use std::f64::consts::{PI, TAU};

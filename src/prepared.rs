@@ -39,7 +39,7 @@ impl PreparedObject {
         timings.load = ms(t0);
         let t1 = Instant::now();
         let props = mesh::mass_properties(&loaded.mesh);
-        let aligned = mesh::align_with(&loaded.mesh, &props, GraspAxis::THESIS);
+        let aligned = mesh::align_with_rule(&loaded.mesh, &props, GraspAxis::THESIS, object.frame);
         timings.align = ms(t1);
         let mass_kg = object.mass.mass_kg(props.volume_mm3, loaded.mass_kg);
         Ok(PreparedObject {

@@ -1042,6 +1042,7 @@ mod tests {
                     max_checked: None,
                     check: &no_check,
                     domains: None,
+                    frame: sc.object.frame,
                 },
                 &mut crate::report::StageTimings::default(),
             );

@@ -97,6 +97,11 @@ pub struct PlanReport {
     pub grades: GradesReport,
     /// Candidates (elevation × approach angle) tried by the search.
     pub candidates_tried: usize,
+    /// Where the search stopped at its candidate budget (`planner.candidate_budget`, per rule
+    /// set) with candidates left: each axis and rule set, with the candidates it tried of those
+    /// it had. Absent when the budget stopped nothing.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub search_stopped: Option<String>,
     /// How often each constraint rejected a candidate.
     pub rejections: std::collections::BTreeMap<String, usize>,
     /// The first feasible grasp (the thesis's Grasp Parameter Set).
@@ -346,6 +351,12 @@ pub struct AxisReport {
     pub sorted_indices: usize,
     /// Candidates (elevation × approach angle) tried.
     pub candidates_tried: usize,
+    /// Candidates the sorted domain held (elevations × approach angles).
+    pub candidates_available: usize,
+    /// True when the candidate budget stopped this search with candidates left; absent
+    /// otherwise.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub budget_stopped: bool,
     /// Feasible grasps found.
     pub grasps_found: usize,
     /// Why there was none, when there was none.

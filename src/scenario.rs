@@ -83,6 +83,8 @@ pub struct ObjectSpec {
     pub mass: MassSpec,
     /// Coulomb friction coefficient between hand and object (thesis: 0.3).
     pub friction: f64,
+    /// How the object's own frame is chosen ([`FrameRule`]; `[object] frame`).
+    pub frame: crate::mesh::FrameRule,
 }
 
 impl ObjectSpec {
@@ -94,6 +96,7 @@ impl ObjectSpec {
             units: LengthUnit::default(),
             mass: MassSpec::Default,
             friction: DEFAULT_FRICTION,
+            frame: crate::mesh::FrameRule::default(),
         }
     }
 }
@@ -219,6 +222,8 @@ struct RawObject {
     mass_kg: Option<f64>,
     #[serde(default = "default_friction")]
     friction: f64,
+    #[serde(default)]
+    frame: crate::mesh::FrameRule,
 }
 
 fn default_friction() -> f64 {
@@ -395,6 +400,7 @@ impl Scenario {
                 units: o.units.unwrap_or_default(),
                 mass,
                 friction: o.friction,
+                frame: o.frame,
             },
             hand,
             hand_file,

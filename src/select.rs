@@ -15,8 +15,8 @@
 //! slipped, else the first checked), and every candidate checked is reported with its verdict.
 
 use crate::hand::Hand;
-use crate::mesh::{align_with, AlignedObject, GraspAxis, MassProperties, Mesh};
-use crate::plan::search::{search_with, Grasp, Rejection};
+use crate::mesh::{align_with_rule, AlignedObject, FrameRule, GraspAxis, MassProperties, Mesh};
+use crate::plan::search::{candidate_count, search_with, Grasp, Rejection};
 use crate::plan::{self, GradedDomain, RuleSet};
 use crate::report::StageTimings;
 use crate::scenario::PlannerParams;
@@ -40,6 +40,11 @@ pub struct AxisPlan {
     pub grasps_found: usize,
     /// True if and only if the search walked the whole sorted domain.
     pub exhausted: bool,
+    /// The candidates the sorted domain holds (elevations × approach angles).
+    pub candidates_available: usize,
+    /// True if and only if the search stopped at its share of the candidate budget
+    /// ([`PlannerParams::candidate_budget`]) with candidates left untried.
+    pub budget_stopped: bool,
 }
 
 /// A feasible grasp and, when the physics check ran on it, its outcome.
@@ -83,6 +88,30 @@ impl Selection {
     pub fn checked(&self) -> usize {
         self.candidates.iter().filter(|c| c.check.is_some()).count()
     }
+
+    /// Where the candidate budget stopped the search, in words (`None` when it stopped
+    /// nowhere): each axis and rule set stopped, with the candidates it tried of those it had.
+    pub fn budget_stops(&self) -> Option<String> {
+        let stops: Vec<String> = self
+            .axes
+            .iter()
+            .filter(|a| a.budget_stopped)
+            .map(|a| {
+                let rules = match a.rules {
+                    RuleSet::Thesis => "thesis",
+                    RuleSet::Extended => "extended",
+                    RuleSet::Pinch => "pinch",
+                };
+                format!(
+                    "{} {rules} ({} of {})",
+                    a.aligned.axis.name(),
+                    a.candidates_tried,
+                    a.candidates_available
+                )
+            })
+            .collect();
+        (!stops.is_empty()).then(|| stops.join(", "))
+    }
 }
 
 /// What the selection needs besides the object.
@@ -103,6 +132,8 @@ pub struct SelectParams<'a> {
     /// Stage-1 domains kept across calls (a parameter sweep): they depend only on the axis, the
     /// rule set, the AngularStep and the HeightStep. `None`: built afresh.
     pub domains: Option<&'a DomainCache>,
+    /// How the object's own frame is chosen (`[object] frame`).
+    pub frame: FrameRule,
 }
 
 /// Stage-1 domains by (axis, rule set, AngularStep bits, HeightStep bits).
@@ -129,12 +160,14 @@ pub fn select(
         if rules.is_extended() && (!p.planner.extended_rules || !wants_extended(&sel, p)) {
             break;
         }
+        // The candidates this rule set has tried over its axes (the budget is per rule set).
+        let mut spent = 0usize;
         for (k, axis) in GraspAxis::SEARCH_ORDER.iter().enumerate() {
             if is_done(&sel, p, collect) {
                 break;
             }
             let aligned = aligned_cache[k]
-                .get_or_insert_with(|| align_with(mesh, props, *axis))
+                .get_or_insert_with(|| align_with_rule(mesh, props, *axis, p.frame))
                 .clone();
             let mut t = StageTimings::default();
             // The pinch pass searches the extended rules' graded domain again (it changes only
@@ -181,8 +214,23 @@ pub fn select(
             let t0 = std::time::Instant::now();
             let mut found = 0;
             let mut stopped = false;
-            let (tried, rejections) =
-                search_with(&aligned.mesh, p.hand, &graded, p.planner, rules, |g| {
+            // An equal share of what is left of the rule set's budget (rounded up, so an axis
+            // with few candidates leaves more to those after it).
+            let budget = match p.planner.candidate_budget {
+                0 => usize::MAX,
+                b => b
+                    .saturating_sub(spent)
+                    .div_ceil(GraspAxis::SEARCH_ORDER.len() - k),
+            };
+            let available = candidate_count(&graded, p.planner);
+            let (tried, rejections) = search_with(
+                &aligned.mesh,
+                p.hand,
+                &graded,
+                p.planner,
+                rules,
+                budget,
+                |g| {
                     found += 1;
                     let check = match p.max_checked {
                         Some(max) if sel.checked() < max && !has_hold(&sel) => {
@@ -197,9 +245,11 @@ pub fn select(
                     });
                     stopped = is_done(&sel, p, collect);
                     !stopped
-                });
+                },
+            );
             t.search += ms(t0);
             timings.add(&t);
+            spent += tried;
             sel.axes.push(AxisPlan {
                 aligned,
                 rules,
@@ -207,7 +257,9 @@ pub fn select(
                 candidates_tried: tried,
                 rejections,
                 grasps_found: found,
-                exhausted: !stopped,
+                exhausted: !stopped && tried == available,
+                candidates_available: available,
+                budget_stopped: !stopped && tried < available,
             });
         }
     }

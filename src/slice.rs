@@ -198,12 +198,224 @@ const TINY_SEGMENT_MM: f64 = 1e-9;
 
 /// Cuts `mesh` with `plane`.
 pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
-    let n = plane.normal();
     let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
-    let above = |i: u32| dist[i as usize] >= 0.0;
+    cut(mesh, plane, 0..mesh.triangles.len(), |i| dist[i as usize])
+}
+
+/// [`slice`] with the triangles the plane may cut found through `index` (built once for the
+/// mesh): the same slice, bit for bit, at a cost that grows with the triangles cut rather than
+/// with the mesh (a search slices thousands of finger planes of one mesh).
+///
+/// `index` must have been built from `mesh` ([`SliceIndex::new`]).
+pub fn slice_indexed(mesh: &Mesh, index: &SliceIndex, plane: &Plane) -> Slice {
+    slice_indexed_within(mesh, index, plane, 0.0)
+}
+
+/// [`slice_indexed`], with the raw cut simplified within `tol_mm` ([`Contour::simplified`])
+/// before its open ends are joined and its overlapping pieces united, where it has any: the
+/// union and the joining cost grow with the points, and a slice of a many-shell or open mesh
+/// has many. A slice in closed pieces that do not overlap is the exact cut.
+pub fn slice_indexed_within(mesh: &Mesh, index: &SliceIndex, plane: &Plane, tol_mm: f64) -> Slice {
+    let tris = index.candidates(plane);
+    // A distance is a few flops, the same bits each time it is taken: cheaper than a table.
+    cut_within(
+        mesh,
+        plane,
+        tris.into_iter(),
+        |i| plane.distance(&mesh.vertices[i as usize]),
+        tol_mm,
+    )
+}
+
+/// A multiplicative hash for the slicer's edge tables (FxHash's mixing): SipHash's protection
+/// against chosen keys is not needed for mesh edges, and it was a fifth of the search's time.
+/// Only lookups use these tables, never their iteration order, so results do not depend on it.
+#[derive(Default, Clone, Copy)]
+struct EdgeHasher(u64);
+
+impl std::hash::Hasher for EdgeHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(i as u64);
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+}
+
+type EdgeBuild = std::hash::BuildHasherDefault<EdgeHasher>;
+
+/// A bounding-volume hierarchy over a mesh's triangles: which triangles a plane may cut.
+///
+/// Built once per mesh (O(n log n)); a query visits the boxes the plane crosses, about the
+/// square root of the triangle count for a plane through a closed surface. Deterministic: the
+/// split is a median by centroid with ties broken by triangle index.
+#[derive(Debug, Clone)]
+pub struct SliceIndex {
+    nodes: Vec<BvhNode>,
+    order: Vec<u32>,
+    triangles: usize,
+}
+
+#[derive(Debug, Clone)]
+struct BvhNode {
+    min: Vector3<f64>,
+    max: Vector3<f64>,
+    /// Leaf: `order[start..start + count]`; inner: children at `start` and `start + 1`.
+    start: u32,
+    count: u32,
+}
+
+/// Triangles per leaf of a [`SliceIndex`].
+const BVH_LEAF: usize = 8;
+
+impl SliceIndex {
+    /// Builds the index of `mesh`'s triangles.
+    pub fn new(mesh: &Mesh) -> SliceIndex {
+        let boxes: Vec<(Vector3<f64>, Vector3<f64>)> = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.vertices[i as usize].coords);
+                (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
+        let mut nodes = vec![BvhNode {
+            min: Vector3::zeros(),
+            max: Vector3::zeros(),
+            start: 0,
+            count: 0,
+        }];
+        // Iterative build: (node, range of `order`).
+        let mut stack = vec![(0usize, 0usize, order.len())];
+        while let Some((node, lo, hi)) = stack.pop() {
+            let (mut bmin, mut bmax) = (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            );
+            let (mut cmin, mut cmax) = (bmin, bmax);
+            for &t in &order[lo..hi] {
+                let (a, b) = &boxes[t as usize];
+                bmin = bmin.inf(a);
+                bmax = bmax.sup(b);
+                let c = (a + b) * 0.5;
+                cmin = cmin.inf(&c);
+                cmax = cmax.sup(&c);
+            }
+            nodes[node].min = bmin;
+            nodes[node].max = bmax;
+            if hi - lo <= BVH_LEAF {
+                nodes[node].start = lo as u32;
+                nodes[node].count = (hi - lo) as u32;
+                continue;
+            }
+            let ext = cmax - cmin;
+            let axis = if ext.x >= ext.y && ext.x >= ext.z {
+                0
+            } else if ext.y >= ext.z {
+                1
+            } else {
+                2
+            };
+            let key = |t: &u32| {
+                let (a, b) = &boxes[*t as usize];
+                a[axis] + b[axis]
+            };
+            let mid = lo + (hi - lo) / 2;
+            order[lo..hi]
+                .select_nth_unstable_by(mid - lo, |x, y| key(x).total_cmp(&key(y)).then(x.cmp(y)));
+            let first = nodes.len();
+            for _ in 0..2 {
+                nodes.push(BvhNode {
+                    min: Vector3::zeros(),
+                    max: Vector3::zeros(),
+                    start: 0,
+                    count: 0,
+                });
+            }
+            nodes[node].start = first as u32;
+            nodes[node].count = 0;
+            stack.push((first, lo, mid));
+            stack.push((first + 1, mid, hi));
+        }
+        SliceIndex {
+            nodes,
+            order,
+            triangles: mesh.triangles.len(),
+        }
+    }
+
+    /// The triangles whose bounding box `plane` crosses (a superset of those it cuts), in
+    /// increasing index order.
+    fn candidates(&self, plane: &Plane) -> Vec<usize> {
+        let n = plane.normal();
+        let na = n.abs();
+        let o = plane.origin.coords;
+        let mut out = Vec::new();
+        if self.triangles == 0 {
+            return out;
+        }
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i];
+            let c = (node.min + node.max) * 0.5;
+            let e = (node.max - node.min) * 0.5;
+            let d = n.dot(&(c - o));
+            let r = na.dot(&e);
+            // Generous slack: the exact side test is made per vertex afterwards.
+            let slack = 1e-6 * (1.0 + r + d.abs());
+            if d - r > slack || d + r < -slack {
+                continue;
+            }
+            if node.count > 0 {
+                let (s, k) = (node.start as usize, node.count as usize);
+                out.extend(self.order[s..s + k].iter().map(|&t| t as usize));
+            } else {
+                stack.push(node.start as usize);
+                stack.push(node.start as usize + 1);
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+}
+
+/// The cut of `mesh` by `plane` through the triangles `tris` (in increasing index order), with
+/// `dist` the signed distance of a vertex from the plane.
+fn cut(
+    mesh: &Mesh,
+    plane: &Plane,
+    tris: impl Iterator<Item = usize>,
+    dist: impl Fn(u32) -> f64,
+) -> Slice {
+    cut_within(mesh, plane, tris, dist, 0.0)
+}
+
+/// [`cut`], simplifying the contours within `tol_mm` first when they need joining or uniting.
+fn cut_within(
+    mesh: &Mesh,
+    plane: &Plane,
+    tris: impl Iterator<Item = usize>,
+    dist: impl Fn(u32) -> f64,
+    tol_mm: f64,
+) -> Slice {
+    let n = plane.normal();
+    let above = |i: u32| dist(i) >= 0.0;
 
     let mut segments: Vec<Segment> = Vec::new();
-    for (t, tri) in mesh.triangles.iter().enumerate() {
+    for t in tris {
+        let tri = &mesh.triangles[t];
         let s = [above(tri[0]), above(tri[1]), above(tri[2])];
         if s[0] == s[1] && s[1] == s[2] {
             continue;
@@ -235,7 +447,7 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
 
     let point = |e: Edge| -> Point3<f64> {
         let (i, j) = e;
-        let (di, dj) = (dist[i as usize], dist[j as usize]);
+        let (di, dj) = (dist(i), dist(j));
         let (pi, pj) = (mesh.vertices[i as usize], mesh.vertices[j as usize]);
         if di == 0.0 {
             pi
@@ -247,8 +459,10 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
         }
     };
 
-    let mut by_from: HashMap<Edge, usize> = HashMap::with_capacity(segments.len());
-    let mut ends: HashSet<Edge> = HashSet::with_capacity(segments.len());
+    let mut by_from: HashMap<Edge, usize, EdgeBuild> =
+        HashMap::with_capacity_and_hasher(segments.len(), EdgeBuild::default());
+    let mut ends: HashSet<Edge, EdgeBuild> =
+        HashSet::with_capacity_and_hasher(segments.len(), EdgeBuild::default());
     for (i, s) in segments.iter().enumerate() {
         by_from.entry(s.from).or_insert(i);
         ends.insert(s.to);
@@ -285,6 +499,10 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
         ));
     }
     contours.retain(|c| c.points.len() >= 2 && !c.normals.is_empty());
+    if tol_mm > 0.0 && (contours.iter().any(|c| !c.is_closed) || has_overlapping_outers(&contours))
+    {
+        contours = contours.iter().map(|c| c.simplified(tol_mm)).collect();
+    }
     // A closed single-shell mesh never takes this path, so its slices are exactly the cut.
     let mut repaired = false;
     if contours.iter().any(|c| !c.is_closed) {
@@ -602,6 +820,36 @@ impl Slice {
     /// finger cannot enter a perforation or a slot narrower than itself, so for the planner it
     /// is solid. A slice in one closed piece is returned unchanged.
     pub fn bridged(self, gap_mm: f64) -> Slice {
+        self.bridged_within(gap_mm, 0.0)
+    }
+
+    /// [`Slice::bridged`], then [`Slice::simplified`] within `tol_mm`; a slice that needs its
+    /// pieces bridged or its ends joined is simplified before as well (the morphological closing
+    /// costs by the point, and closes nothing a finger could feel). A slice in one closed piece
+    /// is only simplified.
+    pub fn bridged_within(self, gap_mm: f64, tol_mm: f64) -> Slice {
+        self.bridged_prepared(gap_mm, tol_mm).simplified(tol_mm)
+    }
+
+    /// [`Slice::bridged`], the slice simplified within `tol_mm` first if (and only if) it needs
+    /// its pieces bridged or its ends joined: a slice in one closed piece is the exact cut.
+    pub fn bridged_prepared(self, gap_mm: f64, tol_mm: f64) -> Slice {
+        let needs_overlay = self.contours.iter().any(|c| !c.is_closed)
+            || self
+                .contours
+                .iter()
+                .filter(|c| c.is_closed && c.signed_area() > 0.0)
+                .count()
+                >= 2;
+        let s = if needs_overlay && tol_mm > 0.0 {
+            self.simplified(tol_mm)
+        } else {
+            self
+        };
+        s.bridged_exact(gap_mm)
+    }
+
+    fn bridged_exact(self, gap_mm: f64) -> Slice {
         let plane = self.plane;
         let outermost = self.outermost;
         let mut contours = self.contours;
@@ -623,6 +871,108 @@ impl Slice {
         }
         finish(plane, close_gaps(contours, 0.5 * gap_mm))
     }
+}
+
+impl Slice {
+    /// The slice with every contour simplified within `tol_mm` ([`Contour::simplified`]): what a
+    /// finger that does not feel relief shallower than `tol_mm` meets (issue 30), and far fewer
+    /// segments for the search to test on a finely meshed or scanned object. `tol_mm <= 0`
+    /// returns the slice unchanged.
+    pub fn simplified(self, tol_mm: f64) -> Slice {
+        if tol_mm.is_nan() || tol_mm <= 0.0 || self.contours.iter().all(|c| c.points.len() <= 3) {
+            return self;
+        }
+        let contours = self.contours.iter().map(|c| c.simplified(tol_mm)).collect();
+        finish(self.plane, contours)
+    }
+}
+
+impl Contour {
+    /// The contour with the dents a finger does not feel filled: Douglas–Peucker, one-sided.
+    /// A point is dropped where it lies on the material's side of the simplified polyline by
+    /// at most `tol_mm` (a tooth gap, a groove, a scanner's pit shallower than that), or off it
+    /// by at most [`COLLINEAR_MM`] (the vertices of a finely divided flat face); a point that
+    /// stands out beyond the polyline is never dropped, so the contour never moves into the
+    /// object (a convex arc keeps every vertex, and the finger meets what is there). Points
+    /// kept are original points. A closed contour is split at its first point and the point
+    /// farthest from it, and keeps at least three points; an open one keeps its ends. Normals
+    /// are taken from the geometry ([`Contour::from_polyline`]: material on the left of the
+    /// direction of travel, the slicer's orientation). A contour with nothing to drop is
+    /// returned as it is.
+    pub fn simplified(&self, tol_mm: f64) -> Contour {
+        let n = self.points.len();
+        if n <= 3 || tol_mm.is_nan() || tol_mm <= 0.0 {
+            return self.clone();
+        }
+        let p = &self.points;
+        let mut keep = vec![false; n];
+        // Spans (i, j) of indices to simplify, j > i, indices taken modulo n.
+        let mut spans = Vec::new();
+        if self.is_closed {
+            let far = (1..n)
+                .max_by(|&a, &b| {
+                    (p[a] - p[0])
+                        .norm_squared()
+                        .total_cmp(&(p[b] - p[0]).norm_squared())
+                        .then(b.cmp(&a))
+                })
+                .unwrap_or(1);
+            keep[0] = true;
+            keep[far] = true;
+            spans.push((0, far));
+            spans.push((far, n));
+        } else {
+            keep[0] = true;
+            keep[n - 1] = true;
+            spans.push((0, n - 1));
+        }
+        while let Some((i, j)) = spans.pop() {
+            if j <= i + 1 {
+                continue;
+            }
+            let (a, b) = (p[i % n], p[j % n]);
+            let (mut worst, mut at) = (0.0, i);
+            for k in i + 1..j {
+                // Positive outward (right of the travel a → b), negative into the material.
+                let s = outward_offset(p[k % n], a, b);
+                let excess = (s - COLLINEAR_MM).max(-s - tol_mm);
+                if excess > worst {
+                    worst = excess;
+                    at = k;
+                }
+            }
+            if worst > 0.0 {
+                keep[at % n] = true;
+                spans.push((i, at));
+                spans.push((at, j));
+            }
+        }
+        let kept = keep.iter().filter(|&&k| k).count();
+        if kept == n {
+            return self.clone();
+        }
+        if self.is_closed && kept < 3 {
+            return self.clone();
+        }
+        let points: Vec<Point2<f64>> = (0..n).filter(|&k| keep[k]).map(|k| p[k]).collect();
+        Contour::from_polyline(points, self.is_closed)
+    }
+}
+
+/// How far off a straight line a point may be dropped on the outer side of a contour `[mm]`:
+/// the vertices of a finely divided flat face, written in any frame, are this close to it.
+pub const COLLINEAR_MM: f64 = 1e-6;
+
+/// The signed distance of `q` from the line through `a` and `b`, positive on the right of the
+/// direction `a → b` (outside the material) `[mm]`; the distance to `a` when `a = b`.
+fn outward_offset(q: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> f64 {
+    let d = b - a;
+    let len = d.norm();
+    if len == 0.0 {
+        return (q - a).norm();
+    }
+    let w = q - a;
+    -(d.x * w.y - d.y * w.x) / len
 }
 
 /// Morphological closing of the closed contours by a polygon of inradius `r` (i_overlay's outline
@@ -689,6 +1039,39 @@ mod tests {
                 "{plane:?}: length {l}, expected {length}"
             );
             assert!(s.contours.iter().all(|c| !c.is_hole()));
+        }
+    }
+
+    #[test]
+    fn an_indexed_slice_is_the_plain_slice_bit_for_bit() {
+        // Planes at every tilt and height through a cup (many triangles, open top) and the
+        // chapter 4 object, including planes through vertices (Z = 0, the top) and planes that
+        // miss: the index must hand over exactly the triangles the plain cut uses.
+        for mesh in [
+            crate::objects::frustum(56.0, 80.0, 110.0),
+            crate::objects::chapter4(&crate::objects::Chapter4Dims::default()),
+            crate::objects::uv_sphere(30.0, 24),
+        ] {
+            let index = SliceIndex::new(&mesh);
+            let (lo, hi) = mesh.bounds();
+            let mut planes = 0;
+            for k in 0..=24 {
+                let z = lo.z - 1.0 + (hi.z - lo.z + 2.0) * k as f64 / 24.0;
+                for pitch_deg in [-12.0f64, 0.0, 7.0, 30.0, 90.0] {
+                    let plane = Plane::finger(Point3::new(3.0, -2.0, z), pitch_deg.to_radians());
+                    assert_eq!(
+                        slice_indexed(&mesh, &index, &plane),
+                        slice(&mesh, &plane),
+                        "z {z}, pitch {pitch_deg}"
+                    );
+                    planes += 1;
+                }
+            }
+            for z in [lo.z, hi.z] {
+                let plane = Plane::horizontal(z);
+                assert_eq!(slice_indexed(&mesh, &index, &plane), slice(&mesh, &plane));
+            }
+            assert_eq!(planes, 125);
         }
     }
 

@@ -625,6 +625,7 @@ fn run_planned(
             max_checked: Some(p.scenario.sim.max_checked.max(1)),
             check: &check,
             domains: Some(&shared.select_domains),
+            frame: p.scenario.object.frame,
         },
         &mut t,
     );

@@ -196,6 +196,170 @@ pub fn align_with(mesh: &Mesh, props: &MassProperties, which: GraspAxis) -> Alig
     }
 }
 
+/// How an object's own frame (the aligned frame's axes and senses) is chosen.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Deserialize, serde::Serialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum FrameRule {
+    /// From the geometry alone (issue 30), so that the grasp in the object's frame and the
+    /// check's verdict do not depend on the frame the file was written in: see
+    /// [`canonical_rotation`] and docs/FRAMES.md.
+    #[default]
+    Geometry,
+    /// The file's frame decides the senses and, where moments are equal, the in-plane axes
+    /// (the rule at the top of this module): for an object its user has aligned, as the thesis
+    /// asks (its 6.2), so that the thesis's cup and inverted cup are two objects.
+    File,
+}
+
+/// [`align_with`] under a [`FrameRule`]: with [`FrameRule::Geometry`] the mesh is first turned
+/// into its [`canonical_rotation`], aligned there by the file rule, and the transform composed,
+/// so `to_aligned` still maps the file's frame to the aligned one.
+pub fn align_with_rule(
+    mesh: &Mesh,
+    props: &MassProperties,
+    which: GraspAxis,
+    rule: FrameRule,
+) -> AlignedObject {
+    match rule {
+        FrameRule::File => align_with(mesh, props, which),
+        FrameRule::Geometry => {
+            let c = canonical_rotation(mesh, props);
+            let mut turned_mesh = mesh.clone();
+            turned_mesh.map_vertices(|p| c * p);
+            // The inertia in the canonical frame, made exactly diagonal, and moments the rule
+            // calls equal made exactly equal: the file rule then takes the canonical axes as
+            // they are (ties by axis index), never the eigen-solver's choice within a plane of
+            // equal moments, which round-off would turn with the file's frame.
+            let m = c.matrix();
+            let turned = m * props.inertia * m.transpose();
+            let mut d = [turned[(0, 0)], turned[(1, 1)], turned[(2, 2)]];
+            for (i, j) in [(0, 1), (1, 2), (0, 2)] {
+                let scale = d[i].abs().max(d[j].abs()).max(f64::MIN_POSITIVE);
+                if (d[i] - d[j]).abs() / scale <= DEGENERATE_MOMENTS {
+                    let mean = 0.5 * (d[i] + d[j]);
+                    d[i] = mean;
+                    d[j] = mean;
+                }
+            }
+            let turned_props = MassProperties {
+                centroid: c * props.centroid,
+                inertia: Matrix3::from_diagonal(&Vector3::new(d[0], d[1], d[2])),
+                ..*props
+            };
+            let mut a = align_with(&turned_mesh, &turned_props, which);
+            a.to_aligned *= Isometry3::from_parts(
+                Translation3::identity(),
+                UnitQuaternion::from_rotation_matrix(&c),
+            );
+            a.original = *props;
+            a
+        }
+    }
+}
+
+/// A rotation into the object's canonical frame, from its geometry alone: its rows are the
+/// canonical X (the middle principal axis), Y and Z (the least) in the file's frame.
+///
+/// The rule (docs/FRAMES.md):
+/// 1. Z is the principal axis of least moment, X that of the middle, Y = Z × X.
+/// 2. Where two moments are equal (relative difference at most 1e-6: a square bar, a body of
+///    revolution), the axis within their plane is the direction, projected into the plane, of
+///    the vertex farthest from the centroid (a square bar's corner, one of a faceted
+///    cylinder's rim vertices: which one is a symmetry of the shape); all three equal, Z is
+///    that direction itself.
+/// 3. Each axis points the way its area-weighted third moment of the surface is positive
+///    (the end with the longer tail of surface, a bottle's neck), else (a shape symmetric
+///    across the plane normal to it) towards the farther extreme point, else (symmetric in
+///    that too) as the eigen-solver gave it: then either sense gives the same shape.
+pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64> {
+    let eig = SymmetricEigen::new(props.inertia);
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| {
+        eig.eigenvalues[a]
+            .total_cmp(&eig.eigenvalues[b])
+            .then(a.cmp(&b))
+    });
+    let m: Vec<f64> = order.iter().map(|&i| eig.eigenvalues[i]).collect();
+    let e: Vec<Vector3<f64>> = order
+        .iter()
+        .map(|&i| eig.eigenvectors.column(i).into_owned())
+        .collect();
+    let c = props.centroid;
+    let equal = |a: f64, b: f64| {
+        let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
+        (b - a).abs() / scale <= DEGENERATE_MOMENTS
+    };
+    // The vertex farthest from the centroid in the plane normal to `n` (all of space if `n` is
+    // zero), as a unit direction in that plane.
+    let farthest = |n: Vector3<f64>| -> Option<Vector3<f64>> {
+        let mut best: Option<(f64, Vector3<f64>)> = None;
+        for p in &mesh.vertices {
+            let d = p - c;
+            let d = d - n * n.dot(&d);
+            let r = d.norm_squared();
+            if best.is_none_or(|(b, _)| r > b) {
+                best = Some((r, d));
+            }
+        }
+        best.and_then(|(_, d)| d.try_normalize(1e-12))
+    };
+    let (z, x) = match (equal(m[0], m[1]), equal(m[1], m[2])) {
+        (false, false) => (e[0], e[1]),
+        // Least and middle equal: Z within their plane, X the middle of what is left.
+        (true, false) => {
+            let n = e[2];
+            let z = farthest(n).unwrap_or(e[0]);
+            (z, n.cross(&z))
+        }
+        // Middle and largest equal: X within their plane.
+        (false, true) => {
+            let z = e[0];
+            (z, farthest(z).unwrap_or(e[1]))
+        }
+        (true, true) => {
+            let z = farthest(Vector3::zeros()).unwrap_or(e[0]);
+            (z, farthest(z).unwrap_or_else(|| z.cross(&Vector3::x())))
+        }
+    };
+    let x = (x - z * z.dot(&x)).normalize();
+    let z = geometric_sense(mesh, c, z);
+    let x = geometric_sense(mesh, c, x);
+    let y = z.cross(&x);
+    // Rows: the canonical frame's X (the middle axis), Y and Z (the least) in the file's frame.
+    Rotation3::from_matrix_unchecked(Matrix3::from_rows(&[
+        x.transpose(),
+        y.transpose(),
+        z.transpose(),
+    ]))
+}
+
+/// `v` or `-v`, whichever the surface's third moment along it makes positive (rule 3 of
+/// [`canonical_rotation`]).
+fn geometric_sense(mesh: &Mesh, c: Point3<f64>, v: Vector3<f64>) -> Vector3<f64> {
+    let (mut m3, mut abs3) = (0.0, 0.0);
+    for t in 0..mesh.triangles.len() {
+        let [a, b, d] = mesh.corners(t);
+        let area = 0.5 * (b - a).cross(&(d - a)).norm();
+        let s = ((a.coords + b.coords + d.coords) / 3.0 - c.coords).dot(&v);
+        m3 += area * s * s * s;
+        abs3 += area * (s * s * s).abs();
+    }
+    if m3.abs() > 1e-6 * abs3 {
+        return if m3 > 0.0 { v } else { -v };
+    }
+    let (lo, hi) = mesh.vertices.iter().fold((0.0f64, 0.0f64), |(lo, hi), p| {
+        let s = (p - c).dot(&v);
+        (lo.min(s), hi.max(s))
+    });
+    let scale = hi.max(-lo).max(f64::MIN_POSITIVE);
+    if (hi + lo).abs() > 1e-9 * scale {
+        return if hi + lo > 0.0 { v } else { -v };
+    }
+    v
+}
+
 /// Flips `v` so that its first non-negligible dot product with `hints` is positive.
 fn sign_towards(v: Vector3<f64>, hints: &[Vector3<f64>]) -> Vector3<f64> {
     for h in hints {

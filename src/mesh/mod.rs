@@ -17,7 +17,10 @@ mod load;
 mod mass;
 pub mod urdf;
 
-pub use align::{align, align_about, align_with, AlignedObject, GraspAxis};
+pub use align::{
+    align, align_about, align_with, align_with_rule, canonical_rotation, AlignedObject, FrameRule,
+    GraspAxis,
+};
 pub use load::{load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh, MeshFormat};
 pub use mass::{mass_properties, sliced_mass_properties, surface_mass_properties, MassProperties};
 

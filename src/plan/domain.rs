@@ -69,7 +69,10 @@ impl Domain {
         let angles_deg: Vec<f64> = (0..count).map(|k| k as f64 * step).collect();
         let slices: Vec<Slice> = angles_deg
             .iter()
-            .map(|a| slice(mesh, &Plane::vertical(a.to_radians())).bridged(hand.finger_width_mm()))
+            .map(|a| {
+                slice(mesh, &Plane::vertical(a.to_radians()))
+                    .bridged_prepared(hand.finger_width_mm(), hand.relief_mm())
+            })
             .collect();
         let slice_z_range_mm: Vec<[f64; 2]> = slices.iter().map(|s| z_range(&s.contours)).collect();
         let mut lo = f64::NEG_INFINITY;

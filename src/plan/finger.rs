@@ -24,7 +24,7 @@ use super::palm::{PalmPlacement, PENETRATION_TOL_MM};
 use super::{Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice, Slice};
+use crate::slice::{slice_indexed_within, Slice, SliceIndex};
 use nalgebra::{Point2, Rotation2, Vector2};
 use std::f64::consts::PI;
 
@@ -95,6 +95,7 @@ pub enum FingerRejection {
 /// is reported with the finger's angles. Every other rejection (range, penetration) stands.
 pub fn place_finger(
     mesh: &Mesh,
+    index: &SliceIndex,
     hand: &Hand,
     palm: &PalmPlacement,
     k: usize,
@@ -105,7 +106,9 @@ pub fn place_finger(
     let o = hand.fingers.offset_mm;
     let mirror = f.side.sign();
     let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
-        let s = slice(mesh, &palm.finger_plane(f.height_mm + dz)).bridged(2.0 * o);
+        let tol = hand.relief_mm();
+        let s = slice_indexed_within(mesh, index, &palm.finger_plane(f.height_mm + dz), tol)
+            .bridged_within(2.0 * o, tol);
         match place_als(&s, hand, mirror) {
             Err(e) if rules == RuleSet::Pinch && e != FingerRejection::PalmPenetration => {
                 place_als_distal(&s, hand, mirror).map_err(|_| e)
@@ -262,9 +265,22 @@ impl FingerPlane {
 
     /// True if the object takes in part of `poly`.
     fn hits(&self, poly: &ConvexPolygon) -> bool {
-        self.segments
-            .iter()
-            .any(|(a, b)| poly.is_penetrated_by(*a, *b, PENETRATION_TOL_MM))
+        // A segment that misses the outline's bounding box cannot reach inside it: the same
+        // answer as testing every segment, at a compare or two for most of them.
+        let (lo, hi) = poly.corners.iter().fold(
+            (
+                Point2::new(f64::INFINITY, f64::INFINITY),
+                Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        self.segments.iter().any(|(a, b)| {
+            a.x.max(b.x) >= lo.x
+                && a.x.min(b.x) <= hi.x
+                && a.y.max(b.y) >= lo.y
+                && a.y.min(b.y) <= hi.y
+                && poly.is_penetrated_by(*a, *b, PENETRATION_TOL_MM)
+        })
     }
 
     /// A contact on a contact line in the palm's frame, mirrored back to the plane's.
@@ -489,7 +505,16 @@ mod tests {
         let mesh = crate::objects::cylinder(40.0, 124.0);
         let palm = place_palm(&mesh, &hand, 80.0, 0.0, 0.2).unwrap();
         for k in 0..hand.finger_list.len() {
-            let f = place_finger(&mesh, &hand, &palm, k, [5.0, 5.0], RuleSet::Thesis).unwrap();
+            let f = place_finger(
+                &mesh,
+                &SliceIndex::new(&mesh),
+                &hand,
+                &palm,
+                k,
+                [5.0, 5.0],
+                RuleSet::Thesis,
+            )
+            .unwrap();
             assert_eq!(f.name, hand.finger_list[k].name);
             assert!(f.relaxations.is_empty());
             for als in [f.top, f.centre, f.bottom] {
@@ -520,7 +545,7 @@ mod tests {
         // bent 67.6° from phalanx 1 (θ2 = 112.4°).
         let hand = thesis_hand();
         let prism = crate::objects::prism(100.0, 30.0, 124.0);
-        let s = slice(
+        let s = crate::slice::slice(
             &prism,
             &crate::slice::Plane {
                 origin: nalgebra::Point3::new(50.0, 0.0, 62.0),
@@ -554,7 +579,15 @@ mod tests {
         let hand = thesis_hand();
         let rod = crate::objects::cylinder(10.0, 124.0);
         let palm = place_palm(&rod, &hand, 80.0, 0.0, 0.2).unwrap();
-        let r = place_finger(&rod, &hand, &palm, 0, [5.0, 5.0], RuleSet::Thesis);
+        let r = place_finger(
+            &rod,
+            &SliceIndex::new(&rod),
+            &hand,
+            &palm,
+            0,
+            [5.0, 5.0],
+            RuleSet::Thesis,
+        );
         assert_eq!(r, Err(FingerRejection::Theta1OutOfRange));
     }
 }

@@ -80,7 +80,8 @@ pub fn place_palm(
 /// finger width: it depends on the angle only, so a search cuts it once per angle and hands it
 /// to [`place_palm_on`] for every elevation.
 pub fn vertical_slice(mesh: &Mesh, hand: &Hand, approach_rad: f64) -> Slice {
-    slice(mesh, &Plane::vertical(approach_rad)).bridged(hand.finger_width_mm())
+    slice(mesh, &Plane::vertical(approach_rad))
+        .bridged_within(hand.finger_width_mm(), hand.relief_mm())
 }
 
 /// [`place_palm`] in `vslice`, the [`vertical_slice`] at `approach_rad`; with `back_off`, a

@@ -176,7 +176,9 @@ pub fn rank_with(
     let mut sorted: Vec<(i64, usize)> = palm
         .iter()
         .enumerate()
-        .filter_map(|(i, g)| g.map(|g| ((g * 1e9).round() as i64, i + 1)))
+        // Grades are compared at 1e-6: two elevations a symmetry makes equal differ by
+        // round-off (1e-13), which must not decide their order in one frame and not another.
+        .filter_map(|(i, g)| g.map(|g| ((g * 1e6).round() as i64, i + 1)))
         .collect();
     sorted.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.cmp(&a.1)));
     let sorted_indices: Vec<usize> = sorted.into_iter().map(|(_, i)| i).collect();

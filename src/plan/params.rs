@@ -31,7 +31,16 @@ pub struct PlannerParams {
     /// nothing (or, with the physics check, nothing that holds); `false`: the thesis's rules
     /// only, as the thesis plans.
     pub extended_rules: bool,
+    /// The search's budget (beyond the thesis, issue 30): each rule set (the thesis's, the
+    /// extended rules, the fingertip pinch) tries at most this many candidates over all its
+    /// axes, each axis at most an equal share of what is left of it, so a run's cost is bounded
+    /// whatever the object; a search stopped by it says so (`plan.search_stopped`). Counted in
+    /// candidates, not seconds, so the answer does not depend on the machine. 0: no limit.
+    pub candidate_budget: usize,
 }
+
+/// The default [`PlannerParams::candidate_budget`]: a rule set's candidates over all axes.
+pub const DEFAULT_CANDIDATE_BUDGET: usize = 1500;
 
 impl Default for PlannerParams {
     fn default() -> Self {
@@ -46,6 +55,7 @@ impl Default for PlannerParams {
             joint_deviation_theta2_deg: 5.0,
             pitch_range_deg: 20.0,
             extended_rules: true,
+            candidate_budget: DEFAULT_CANDIDATE_BUDGET,
         }
     }
 }

@@ -12,7 +12,7 @@ use super::PlannerParams;
 use super::{GradedDomain, Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::Slice;
+use crate::slice::{slice_indexed_within, Slice, SliceIndex};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
@@ -101,11 +101,18 @@ pub fn search(
     max_grasps: usize,
 ) -> SearchResult {
     let mut grasps = Vec::new();
-    let (candidates_tried, rejections) =
-        search_with(mesh, hand, graded, params, RuleSet::Thesis, |g| {
+    let (candidates_tried, rejections) = search_with(
+        mesh,
+        hand,
+        graded,
+        params,
+        RuleSet::Thesis,
+        usize::MAX,
+        |g| {
             grasps.push(g);
             grasps.len() < max_grasps
-        });
+        },
+    );
     SearchResult {
         grasps,
         candidates_tried,
@@ -136,21 +143,31 @@ pub fn approach_angles_deg(graded: &GradedDomain, params: &PlannerParams) -> Vec
 }
 
 /// Walks the sorted domain, handing each feasible grasp to `on_grasp` in search order until it
-/// returns false or the domain is exhausted. Returns the candidates tried and the rejections.
+/// returns false, the domain is exhausted or `budget` candidates have been tried. Returns the
+/// candidates tried and the rejections.
 pub fn search_with(
     mesh: &Mesh,
     hand: &Hand,
     graded: &GradedDomain,
     params: &PlannerParams,
     rules: RuleSet,
+    budget: usize,
     on_grasp: impl FnMut(Grasp) -> bool,
 ) -> (usize, BTreeMap<Rejection, usize>) {
     let schedule = (SEARCH_SEQUENTIAL, SEARCH_BLOCK);
-    search_scheduled(mesh, hand, graded, params, rules, schedule, on_grasp)
+    search_scheduled(
+        mesh, hand, graded, params, rules, schedule, budget, on_grasp,
+    )
+}
+
+/// The number of candidates (elevation × approach angle) the search would try on `graded`.
+pub fn candidate_count(graded: &GradedDomain, params: &PlannerParams) -> usize {
+    graded.sorted_indices.len() * approach_angles_deg(graded, params).len()
 }
 
 /// [`search_with`], trying the first `sequential` candidates one at a time and then blocks
 /// doubling from 2 up to `max_block` (the tests compare schedules).
+#[allow(clippy::too_many_arguments)]
 fn search_scheduled(
     mesh: &Mesh,
     hand: &Hand,
@@ -158,6 +175,7 @@ fn search_scheduled(
     params: &PlannerParams,
     rules: RuleSet,
     (sequential, max_block): (usize, usize),
+    budget: usize,
     mut on_grasp: impl FnMut(Grasp) -> bool,
 ) -> (usize, BTreeMap<Rejection, usize>) {
     let mut tried = 0;
@@ -174,17 +192,20 @@ fn search_scheduled(
         .sorted_indices
         .iter()
         .flat_map(|&index| (0..angles.len()).map(move |a| (index, a)))
+        .take(budget)
         .collect();
-    let evaluate = |&(index, a): &(usize, usize)| {
+    // Every finger plane of every candidate is cut through one index of the mesh's triangles.
+    let index = SliceIndex::new(mesh);
+    let evaluate = |&(index_z, a): &(usize, usize)| {
         let approach_deg = angles[a];
         let vslice =
             vslices[a].get_or_init(|| vertical_slice(mesh, hand, approach_deg.to_radians()));
         let candidate = Candidate {
-            z1: graded.domain.elevations[index - 1],
+            z1: graded.domain.elevations[index_z - 1],
             approach_deg,
             vslice,
         };
-        try_candidate(mesh, hand, &candidate, params, deviation, rules)
+        try_candidate(mesh, &index, hand, &candidate, params, deviation, rules)
     };
     // Candidates are tried in blocks on rayon's threads, each block's results then taken in
     // search order: the grasps, the count tried and the rejections are the sequential search's
@@ -256,6 +277,7 @@ struct Candidate<'a> {
 
 fn try_candidate(
     mesh: &Mesh,
+    index: &SliceIndex,
     hand: &Hand,
     candidate: &Candidate,
     params: &PlannerParams,
@@ -275,7 +297,7 @@ fn try_candidate(
     if extended {
         // The palm stops at its first contact in any finger plane, not only in the vertical
         // plane it was placed in.
-        let depth = palm_backoff_in_finger_planes(mesh, hand, &palm);
+        let depth = palm_backoff_in_finger_planes(mesh, index, hand, &palm);
         if depth > PENETRATION_TOL_MM {
             palm.origin += palm.axes[0] * depth;
             palm.backed_off_mm += depth;
@@ -283,7 +305,7 @@ fn try_candidate(
     }
     let fingers = (0..hand.finger_list.len())
         .map(|k| {
-            place_finger(mesh, hand, &palm, k, deviation, rules)
+            place_finger(mesh, index, hand, &palm, k, deviation, rules)
                 .map_err(|r| Rejection::Finger(k, r))
         })
         .collect::<Result<Vec<_>, _>>()?;
@@ -317,14 +339,20 @@ fn finger_indices(graded: &GradedDomain, index: usize) -> impl Iterator<Item = u
 
 /// How far the palm must move back along its normal so that its outline touches but does not
 /// take in the object in any finger slice plane (the three ALS planes of every finger) `[mm]`.
-fn palm_backoff_in_finger_planes(mesh: &Mesh, hand: &Hand, palm: &PalmPlacement) -> f64 {
+fn palm_backoff_in_finger_planes(
+    mesh: &Mesh,
+    index: &SliceIndex,
+    hand: &Hand,
+    palm: &PalmPlacement,
+) -> f64 {
     let o = hand.fingers.offset_mm;
     let hw = hand.palm.half_width_mm;
     let mut depth = f64::NEG_INFINITY;
     for f in &hand.finger_list {
         for dz in [-o, 0.0, o] {
-            let s = crate::slice::slice(mesh, &palm.finger_plane(f.height_mm + dz))
-                .bridged(hand.finger_width_mm());
+            let tol = hand.relief_mm();
+            let s = slice_indexed_within(mesh, index, &palm.finger_plane(f.height_mm + dz), tol)
+                .bridged_within(hand.finger_width_mm(), tol);
             // Finger-plane coordinates: x away from the object (contact surface at 0), y sideways.
             depth = depth.max(penetration_depth(
                 &s,
@@ -374,6 +402,7 @@ mod tests {
                 &params,
                 rules,
                 schedule,
+                usize::MAX,
                 |g| {
                     grasps.push(g);
                     grasps.len() < stop_after

@@ -6,6 +6,7 @@ mod closing;
 mod engines;
 mod export;
 mod formats;
+mod frames;
 mod geometry;
 mod isolation;
 mod issue16;

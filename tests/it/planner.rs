@@ -231,3 +231,56 @@ fn the_bh8_hand_grasps_and_holds_the_cup() {
     let [lo, hi] = [0, 1].map(|i| v["plan"]["graspable_diameter_mm"][i].as_f64().unwrap());
     assert!(lo > 20.0 && hi > 150.0, "{lo}..{hi}");
 }
+
+#[test]
+fn the_candidate_budget_bounds_the_search_and_says_where_it_stopped() {
+    // A flat box held only by the fingertip pinch (README, real objects): the thesis's rules
+    // and the extended wraps try hundreds of candidates first. With a budget of 40 per rule
+    // set, each rule set tries at most 40 (an equal share of what is left per axis), the run
+    // says where the budget stopped it, and finds nothing; without a budget it finds the pinch.
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = grasp_sim::objects::prism(100.0, 30.0, 150.0);
+    std::fs::write(dir.path().join("box.stl"), mesh.to_binary_stl()).unwrap();
+    let plan_with = |budget: usize| {
+        let s = Scenario::parse(
+            &format!("[object]\nmesh = \"box.stl\"\n[planner]\ncandidate_budget = {budget}\n"),
+            &dir.path().join("s.toml"),
+        )
+        .unwrap();
+        run(
+            &s,
+            &RunOptions {
+                no_sim: true,
+                ..RunOptions::default()
+            },
+        )
+        .unwrap()
+    };
+    let free = plan_with(0);
+    assert_eq!(free.plan.status, grasp_sim::report::PlanStatus::Feasible);
+    assert!(free.plan.search_stopped.is_none());
+    let tried_free = free.plan.candidates_tried;
+    assert!(tried_free > 120, "{tried_free} candidates without a budget");
+    let bounded = plan_with(40);
+    assert!(
+        bounded.plan.candidates_tried <= 3 * 40,
+        "{} candidates tried with a budget of 40 per rule set",
+        bounded.plan.candidates_tried
+    );
+    let stopped = bounded.plan.search_stopped.as_deref().unwrap_or_default();
+    assert!(stopped.contains("candidate budget of 40"), "{stopped}");
+    for rules in ["thesis", "extended"] {
+        let per_rules: usize = bounded
+            .plan
+            .axes
+            .iter()
+            .filter(|a| format!("{:?}", a.rules).to_lowercase() == rules && !a.pinch)
+            .map(|a| a.candidates_tried)
+            .sum();
+        assert!(per_rules <= 40, "{rules}: {per_rules}");
+    }
+    if bounded.plan.status == grasp_sim::report::PlanStatus::Ungraspable {
+        let reason = bounded.plan.reason.unwrap_or_default();
+        assert!(reason.contains("candidate budget"), "{reason}");
+    }
+}

@@ -206,12 +206,19 @@ fn the_palm_pose_is_given_in_the_original_frame() {
     let d40 = grasp("cylinder_d40");
     assert!((g.fingers[0].theta1_deg - d40.fingers[0].theta1_deg).abs() < 0.05);
     // The palm centre in the original frame lies on the palm's side of the moved cylinder:
-    // 20 mm from its axis (on its surface), at Finger_1's height minus 25 mm along it.
+    // 20 mm from its axis (on its surface), at Finger_1's height minus 25 mm along it. The
+    // cylinder is symmetric end for end, so which way its own frame's axis points is a
+    // symmetry (docs/FRAMES.md): the height is taken along the axis the grasp reports.
     let p = nalgebra::Point3::from(g.palm_pose.position_mm);
-    let axis = rot * Vector3::z();
-    let rel = p - nalgebra::Point3::from(shift);
-    let along = rel.dot(&axis);
-    let radial = (rel - axis * along).norm();
+    let axis = Vector3::from(g.axis);
+    assert!(
+        axis.dot(&(rot * Vector3::z())).abs() > 0.9999,
+        "axis {axis:?}"
+    );
+    let centre = nalgebra::Point3::from(shift + rot * Vector3::new(0.0, 0.0, 62.0));
+    let rel = p - centre;
+    let radial = (rel - axis * rel.dot(&axis)).norm();
+    let along = rel.dot(&axis) + 62.0;
     assert!(
         (radial - 20.0).abs() < 0.05,
         "palm centre {radial} mm from the axis"

@@ -48,6 +48,9 @@ fn settings_that_must_rank_differently_do_and_geometry_is_built_once() {
     for s in &r.settings {
         assert_eq!(s.hold_rate, 1.0, "{:?}", s.values);
         let cup = s.objects[0].payload_margin.unwrap();
+        // The pinch's margin moves with rounding-level changes of its placement: 22.6 before
+        // issue 30, 9.5 once the palm's vertical slice lost its collinear vertices (the same
+        // grasp, index 23 at 30° on the middle axis). Either way below the wrap's.
         let (lo, hi) = if s.values[0] == 0.0 {
             (5.0, 30.0)
         } else {
