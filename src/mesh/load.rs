@@ -226,7 +226,25 @@ pub(super) fn load_raw(path: &Path) -> Result<Raw, MeshError> {
     Ok((raw, is_binary))
 }
 
+/// The bytes after a UTF-8 byte-order mark, which some editors write at the start of a text
+/// file (OBJ, ASCII STL, PLY's header): left in, it hides the first line from the parsers (an
+/// OBJ's first vertex, shifting every index) or makes an ASCII STL look binary. A binary STL
+/// whose header happens to begin with those bytes keeps them: its size says it is binary.
+fn without_bom(bytes: &[u8]) -> &[u8] {
+    let binary_stl_size = bytes.len() >= 84
+        && 84
+            + 50 * u64::from(u32::from_le_bytes([
+                bytes[80], bytes[81], bytes[82], bytes[83],
+            ]))
+            == bytes.len() as u64;
+    match bytes.strip_prefix(b"\xEF\xBB\xBF") {
+        Some(rest) if !binary_stl_size => rest,
+        _ => bytes,
+    }
+}
+
 fn parse_raw(bytes: &[u8], path: &Path, format: MeshFormat) -> Result<Raw, MeshError> {
+    let bytes = without_bom(bytes);
     if bytes.is_empty() {
         return Err(MeshError::Empty {
             path: path.to_path_buf(),
@@ -684,6 +702,7 @@ pub fn parse_stl(bytes: &[u8], path: &Path, unit: LengthUnit) -> Result<LoadedMe
 }
 
 fn stl_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
+    let bytes = without_bom(bytes);
     let p = || path.to_path_buf();
     if bytes.is_empty() {
         return Err(MeshError::Empty { path: p() });

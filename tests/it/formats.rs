@@ -84,6 +84,32 @@ fn check_box(path: &Path) {
 }
 
 #[test]
+fn a_utf8_byte_order_mark_is_skipped_in_obj_and_ascii_stl() {
+    // Issue 32: a BOM before an OBJ's first `v` line dropped that vertex and shifted every
+    // index (a cylinder came out feasible at 0.5 % of its volume), and an ASCII STL with one
+    // was read as binary. Both must load as the same box without it.
+    let dir = tempfile::tempdir().unwrap();
+    let obj: String = BOX_OBJ
+        .lines()
+        .filter(|l| l.starts_with("v ") || l.starts_with("f "))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let mut bom_obj = b"\xEF\xBB\xBF".to_vec();
+    bom_obj.extend_from_slice(obj.as_bytes());
+    check_box(&write_temp(&dir, "bom.obj", &bom_obj));
+    let stl = load_mesh(
+        &write_temp(&dir, "plain.obj", obj.as_bytes()),
+        LengthUnit::Mm,
+    )
+    .unwrap()
+    .mesh
+    .to_ascii_stl("box");
+    let mut bom_stl = b"\xEF\xBB\xBF".to_vec();
+    bom_stl.extend_from_slice(stl.as_bytes());
+    check_box(&write_temp(&dir, "bom.stl", &bom_stl));
+}
+
+#[test]
 fn obj_box_all_groups_one_mesh_volume_and_axis() {
     let dir = tempfile::tempdir().unwrap();
     check_box(&write_temp(&dir, "box.obj", BOX_OBJ.as_bytes()));
