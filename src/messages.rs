@@ -47,10 +47,28 @@ pub(crate) fn toml_message(e: &toml::de::Error, text: &str) -> String {
             if line.is_empty() {
                 format!("line {line_no}: {message}")
             } else {
-                format!("line {line_no} (`{line}`): {message}")
+                format!(
+                    "line {line_no} (`{}`): {message}",
+                    shortened(line, LINE_ECHO_CHARS)
+                )
             }
         }
         None => message,
+    }
+}
+
+/// How much of the offending line a TOML error echoes: a line of 400 KB (issue 32) must not
+/// become a 400 KB message.
+const LINE_ECHO_CHARS: usize = 80;
+
+/// `s` cut to its first `max` characters, saying how long it was, when it is longer.
+fn shortened(s: &str, max: usize) -> String {
+    let n = s.chars().count();
+    if n <= max {
+        s.to_string()
+    } else {
+        let head: String = s.chars().take(max).collect();
+        format!("{head}... ({n} characters)")
     }
 }
 
@@ -151,7 +169,34 @@ fn edit_distance(a: &str, b: &str) -> usize {
 
 #[cfg(test)]
 mod tests {
-    use super::{did_you_mean, edit_distance};
+    use super::{did_you_mean, edit_distance, toml_message};
+
+    #[test]
+    fn a_huge_offending_line_is_echoed_in_part() {
+        // Issue 32: a 400 KB line with an error was echoed whole, a 400 KB message.
+        let huge = format!(
+            "[object]\nmesh = \"a.stl\"\nfriction = 0.3 {}\n",
+            "x".repeat(400_000)
+        );
+        let e = toml::from_str::<toml::Table>(&huge).expect_err("junk after a value");
+        let m = toml_message(&e, &huge);
+        assert!(
+            m.starts_with("line 3 (`friction = 0.3 xxx"),
+            "{}",
+            &m[..m.len().min(200)]
+        );
+        assert!(m.len() < 300, "{} bytes", m.len());
+        assert!(
+            m.contains("(400015 characters)"),
+            "{}",
+            &m[..m.len().min(300)]
+        );
+        // A short line is echoed whole.
+        let short = "[object]\nfriction = 0.3 x\n";
+        let e = toml::from_str::<toml::Table>(short).expect_err("junk after a value");
+        let m = toml_message(&e, short);
+        assert!(m.starts_with("line 2 (`friction = 0.3 x`): "), "{m}");
+    }
 
     #[test]
     fn near_keys_are_suggested_and_far_ones_not() {

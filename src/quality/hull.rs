@@ -479,7 +479,7 @@ pub fn plane_normal(p: &[Wrench; DIM]) -> Option<Wrench> {
 /// The unit normal through `p` and the simplex's thinness: the smallest Gram–Schmidt residual
 /// of its edges from `p[0]`, relative to the longest edge coordinate. Gram–Schmidt in f64 when
 /// the simplex is well shaped; in double-double arithmetic when it is thin (a residual under
-/// 0.1), where f64 would lose the normal's direction across the thin side.
+/// 0.02), where f64 would lose the normal's direction across the thin side.
 fn plane_normal_and_thinness(p: &[Wrench; DIM]) -> Option<(Wrench, f64)> {
     let scale = p
         .iter()
