@@ -14,6 +14,9 @@ use std::path::{Path, PathBuf};
 mod geometry;
 pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
 
+/// The largest length a hand file may give `[mm]`: a hand is hand-sized (issue 32).
+pub const MAX_LENGTH_MM: f64 = 2000.0;
+
 /// The hands built into the binary, by name: found wherever grasp-sim runs, without a path.
 pub const BUNDLED: [(&str, &str); 2] = [
     ("thesis", include_str!("../assets/hands/thesis.toml")),
@@ -302,6 +305,17 @@ impl Hand {
                 return bad(key, format!("must be zero or positive, got {v}"));
             }
         }
+        // A hand is hand-sized: the same 2 m the object size warning takes as the largest
+        // plausible object. Far past it (a 300 m phalanx, issue 32) the physics check's f32
+        // arithmetic turns the motors' limits into NaN and panics.
+        for (key, v) in positive.iter().chain(&non_negative) {
+            if *v > MAX_LENGTH_MM {
+                return bad(
+                    key,
+                    format!("must be at most {MAX_LENGTH_MM} mm (a hand's size), got {v}"),
+                );
+            }
+        }
         for (key, p) in [
             ("phalanx_1", &self.phalanx_1),
             ("phalanx_2", &self.phalanx_2),
@@ -569,7 +583,7 @@ mod tests {
 
     #[test]
     fn out_of_range_values_name_their_key() {
-        let table: [(&[(&str, f64)], &str); 6] = [
+        let table: [(&[(&str, f64)], &str); 8] = [
             (&[("palm.offset_mm", -1.0)], "palm.offset_mm"),
             (&[("fingers.gap_mm", 0.0)], "fingers.gap_mm"),
             (&[("palm.margin_mm", -0.5)], "palm.margin_mm"),
@@ -585,6 +599,8 @@ mod tests {
                 "phalanx_1",
             ),
             (&[("phalanx_1.length_mm", 400.0)], "phalanx_1.length_mm"),
+            (&[("phalanx_2.length_mm", 1e6)], "phalanx_2.length_mm"),
+            (&[("palm.margin_mm", 2500.0)], "palm.margin_mm"),
         ];
         for (overrides, expected) in table {
             match thesis(overrides) {
