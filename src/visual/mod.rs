@@ -83,17 +83,20 @@ pub fn write_report(
     // The three views of the grasp (issue 33): planned and closed hand over the object.
     let mut view_figs: Vec<(String, String)> = Vec::new();
     let mut view_legend = String::new();
-    if let Some(g) = grasp {
+    // The planned hand's link poses, for the views and the planned glTF scene alike.
+    let planned = grasp.map(|g| {
         let theta: Vec<[f64; 2]> = g
             .fingers
             .iter()
             .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
             .collect();
-        let planned = glb::planned_poses(hand, &g.palm.origin, &g.palm.axes, &theta);
+        glb::planned_poses(hand, &g.palm.origin, &g.palm.axes, &theta)
+    });
+    if let Some(planned) = &planned {
         let scene = views::Scene {
             mesh,
             hand,
-            planned: &planned,
+            planned,
             closed: closed.filter(|c| c.len() == planned.len() + 1),
             shift: report
                 .sim
@@ -109,14 +112,8 @@ pub fn write_report(
         std::fs::write(&path, svg).map_err(|e| err(&path, e))?;
     }
     let mut scenes: Vec<&str> = Vec::new();
-    if let Some(g) = grasp {
-        let theta: Vec<[f64; 2]> = g
-            .fingers
-            .iter()
-            .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
-            .collect();
-        let planned = glb::planned_poses(hand, &g.palm.origin, &g.palm.axes, &theta);
-        let mut bodies = glb::hand_bodies(hand, &planned);
+    if let Some(planned) = &planned {
+        let mut bodies = glb::hand_bodies(hand, planned);
         bodies.push(glb::object_body(
             mesh,
             nalgebra::Vector3::zeros(),
