@@ -349,7 +349,7 @@ fn plan_report(
         },
         sorted_indices: graded.sorted_indices.clone(),
         graspable_diameter_mm: graded.range.used(),
-        graspable_diameter_basis: "kinematic".to_string(),
+        graspable_diameter_basis: report::DiameterBasis::Kinematic,
         thesis_largest_diameter_mm: graded.range.max_thesis_mm,
         largest_span_mm: graded.largest_span_mm,
         effective_diameter_mm: graded

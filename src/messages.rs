@@ -1,6 +1,8 @@
 //! Messages shared by the parsers of scenario and hand files: I/O errors in a few stable words,
 //! TOML errors as one line with its line number, and "did you mean" suggestions for mistyped
-//! keys. (Its own module so that `hand` and `scenario` need not import each other.)
+//! keys; and [`plural`] for counts in any message or summary. (Its own module so that `hand`
+//! and `scenario` need not import each other, nor `report`, `visual` and `summarize` import
+//! `batch`.)
 
 /// `[("section.field", value), ...]` for the named fields of `$s`: each key is the field's own
 /// name, as serde reads it from the file, so a message cannot name a key the file does not have.
@@ -10,6 +12,17 @@ macro_rules! keyed {
     };
 }
 pub(crate) use keyed;
+
+/// `n thing` or `n things`.
+///
+/// `pub` (in this private module) only so that `batch` can re-export it for the binary.
+pub fn plural(n: usize, thing: &str) -> String {
+    if n == 1 {
+        format!("1 {thing}")
+    } else {
+        format!("{n} {thing}s")
+    }
+}
 
 /// A short, stable description of an I/O error.
 pub(crate) fn io_message(e: &std::io::Error) -> String {

@@ -136,7 +136,7 @@ impl Summary {
         if let Some(first) = twice.first() {
             s.warnings.push(format!(
                 "{} given more than once (first: {first}); counted each time",
-                crate::batch::plural(twice.len(), "input")
+                crate::messages::plural(twice.len(), "input")
             ));
         }
         Ok(s)
@@ -153,7 +153,11 @@ impl Summary {
                 100.0 * n as f64 / c.objects as f64
             }
         };
-        let _ = writeln!(t, "{name}: {}", crate::batch::plural(c.objects, "object"));
+        let _ = writeln!(
+            t,
+            "{name}: {}",
+            crate::messages::plural(c.objects, "object")
+        );
         let _ = writeln!(
             t,
             "  planned       {} ({:.1} %), ungraspable {} ({:.1} %), errors {} ({:.1} %)",

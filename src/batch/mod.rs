@@ -17,6 +17,8 @@ pub mod isolate;
 pub mod journal;
 pub mod record;
 
+/// Re-exported for the binary (its home is the crate's `messages`).
+pub use crate::messages::plural;
 pub use isolate::{Interrupted, Worker};
 pub use record::{input_hash, Key, Record, RecordError};
 
@@ -543,15 +545,6 @@ pub fn summary(counts: &Counts, ran: usize, seconds: f64, jobs: usize) -> String
         plural(jobs.max(1), "job"),
         plural(errors, "error")
     )
-}
-
-/// `n thing` or `n things`.
-pub fn plural(n: usize, thing: &str) -> String {
-    if n == 1 {
-        format!("1 {thing}")
-    } else {
-        format!("{n} {thing}s")
-    }
 }
 
 #[cfg(test)]

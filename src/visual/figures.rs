@@ -322,7 +322,7 @@ pub fn rejections(report: &crate::report::RunReport) -> String {
         } else {
             format!(
                 "Why no grasp: {} tried, rejected by",
-                crate::batch::plural(p.candidates_tried, "candidate")
+                crate::messages::plural(p.candidates_tried, "candidate")
             )
         },
         "candidates rejected",

@@ -1,0 +1,530 @@
+//! The human summary of a run: the thesis's "Grasp Parameter Set" style where a plan exists,
+//! the physics check, the closing, the quality and the result in one sentence.
+
+use super::{GraspReport, PlanReport, RunReport, SimReport, SimVerdict};
+use crate::messages::plural;
+use crate::sim::Verdict;
+use std::fmt::Write;
+
+impl GraspReport {
+    /// Returns true if and only if `other` is the same grasp: the same axis, rules, approach,
+    /// elevation, pitch and joint angles.
+    pub fn is_same_grasp(&self, other: &GraspReport) -> bool {
+        self.axis_name == other.axis_name
+            && self.rules == other.rules
+            && self.approach_angle_deg == other.approach_angle_deg
+            && self.elevation_index == other.elevation_index
+            && self.palm_pitch_deg == other.palm_pitch_deg
+            && self
+                .fingers
+                .iter()
+                .zip(&other.fingers)
+                .all(|(a, b)| a.theta1_deg == b.theta1_deg && a.theta2_deg == b.theta2_deg)
+    }
+
+    /// The rules in words: `thesis`, or `extended: ` and the relaxations used.
+    pub fn one_line_rules(&self) -> String {
+        let rules = match serde_json::to_value(self.rules) {
+            Ok(serde_json::Value::String(r)) => r,
+            _ => String::new(),
+        };
+        let relaxed: Vec<String> = self
+            .relaxations
+            .iter()
+            .filter_map(|r| match serde_json::to_value(r) {
+                Ok(serde_json::Value::String(r)) => Some(r),
+                _ => None,
+            })
+            .collect();
+        if relaxed.is_empty() {
+            rules
+        } else {
+            format!("{rules}: {}", relaxed.join(", "))
+        }
+    }
+
+    /// The grasp in one line: axis and rules (with relaxations), approach, elevation, pitch,
+    /// joint angles, and the physics check's verdict when it ran on this grasp.
+    pub fn one_line(&self) -> String {
+        let rules = self.one_line_rules();
+        let thetas: Vec<String> = self
+            .fingers
+            .iter()
+            .map(|f| format!("{:.1}/{:.1}", f.theta1_deg, f.theta2_deg))
+            .collect();
+        let check = match &self.check {
+            Some(c) => format!(
+                "; check: {} ({:.2} mm, {:.2} deg)",
+                c.verdict, c.translation_mm, c.rotation_deg
+            ),
+            None => "; not checked".to_string(),
+        };
+        let quality = match &self.quality {
+            Some(q) => format!("; epsilon {:.3} ({} contacts)", q.epsilon, q.source),
+            None => String::new(),
+        };
+        format!(
+            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{check}{quality}",
+            self.axis_name,
+            self.approach_angle_deg,
+            self.elevation_index,
+            self.elevation_mm,
+            fmt_signed(self.palm_pitch_deg, 1),
+            thetas.join(", ")
+        )
+    }
+}
+
+impl RunReport {
+    /// The human summary, in the thesis's "Grasp Parameter Set" style where a plan exists.
+    pub fn summary(&self) -> String {
+        let mut s = String::new();
+        self.write_object(&mut s);
+        self.write_search_range(&mut s);
+        self.write_plan(&mut s);
+        if let Some(g) = &self.plan.grasp {
+            write_grasp_parameter_set(&mut s, g);
+        }
+        self.write_sim(&mut s);
+        if let Some(q) = &self.quality {
+            let _ = writeln!(s, "  Quality     {}", quality_line(q));
+        }
+        let _ = writeln!(s, "  Result      {}", self.result_sentence());
+        self.write_expect(&mut s);
+        s
+    }
+
+    /// The scenario's name, the object, its principal axis, and the grasp's axis when it is
+    /// not the least one.
+    fn write_object(&self, s: &mut String) {
+        let o = &self.object;
+        let _ = writeln!(s, "{}", self.scenario);
+        let _ = writeln!(
+            s,
+            "  Object      {}: {} triangles, volume {:.1} cm^3, mass {:.3} kg, height {:.1} mm",
+            o.mesh,
+            o.triangles,
+            o.volume_mm3 / 1000.0,
+            o.mass_kg,
+            o.height_mm
+        );
+        let a = o.principal_axis;
+        let _ = writeln!(
+            s,
+            "  Principal axis (original frame) ({:.4}, {:.4}, {:.4})",
+            a[0], a[1], a[2]
+        );
+        // The height above is along the least axis; a grasp about another one is planned, and
+        // its elevations below measured, along that one.
+        if let Some(g) = self.plan.grasp.as_ref().filter(|g| g.axis_name != "least") {
+            let _ = writeln!(
+                s,
+                "  Grasp axis  the {} principal axis ({:.4}, {:.4}, {:.4}), original frame: the elevations below are along it",
+                g.axis_name, g.axis[0], g.axis[1], g.axis[2]
+            );
+        }
+    }
+
+    /// The elevation range searched, the graspable diameters, and the sorted palm indices.
+    fn write_search_range(&self, s: &mut String) {
+        let p = &self.plan;
+        // Under the extended rules the range is the whole object widened so that an outer
+        // finger may overhang its ends: not the thesis's Effective Elevation, so not called so.
+        let range_name = match p.grasp.as_ref().map(|g| g.rules) {
+            Some(crate::plan::RuleSet::Thesis) | None => "Effective elevation",
+            Some(_) => "Search elevation (extended rules: outer fingers may overhang the ends)",
+        };
+        let [lo, hi] = p.effective_elevation_mm;
+        // An object shorter than the two finger offsets has no Effective Elevation: its range
+        // would print inverted.
+        let range = if hi >= lo {
+            format!("{lo:.1}..{hi:.1} mm")
+        } else {
+            "none (the object is shorter than the finger width)".to_string()
+        };
+        let _ = writeln!(
+            s,
+            "  {range_name} {range}, {} indexed elevations; graspable diameter {:.1}..{:.1} mm ({}; thesis 9x rule {:.1})",
+            p.indexed_elevations,
+            p.graspable_diameter_mm[0],
+            p.graspable_diameter_mm[1],
+            p.graspable_diameter_basis,
+            p.thesis_largest_diameter_mm
+        );
+        let _ = writeln!(
+            s,
+            "  Sorted palm indices ({}): {}",
+            p.sorted_indices.len(),
+            sorted_indices_head(p)
+        );
+    }
+
+    /// The plan's status (and why, or under which rules), the candidates tried and checked,
+    /// and every grasp collected when there are several.
+    fn write_plan(&self, s: &mut String) {
+        let p = &self.plan;
+        let plan_line = match (&p.reason, &p.grasp) {
+            (Some(r), _) => format!("{} ({r})", p.status),
+            (None, Some(g)) if g.rules != crate::plan::RuleSet::Thesis => format!(
+                "{} under rules beyond the thesis ({}), as the thesis's own found no grasp, or none that held",
+                p.status,
+                g.one_line_rules()
+            ),
+            (None, _) => p.status.to_string(),
+        };
+        let checked = if p.candidates_checked > 0 {
+            format!(", {} checked", p.candidates_checked)
+        } else {
+            String::new()
+        };
+        let _ = writeln!(
+            s,
+            "  Plan        {plan_line}; {} tried{checked}",
+            plural(p.candidates_tried, "candidate")
+        );
+        if p.grasps.len() > 1 {
+            let _ = writeln!(
+                s,
+                "  Candidates  {} collected, in search order (* the one reported below):",
+                p.grasps.len()
+            );
+            for (k, g) in p.grasps.iter().enumerate() {
+                let chosen = p.grasp.as_ref().is_some_and(|c| c.is_same_grasp(g));
+                let _ = writeln!(
+                    s,
+                    "   {}{:>2}. {}",
+                    if chosen { "*" } else { " " },
+                    k + 1,
+                    g.one_line()
+                );
+            }
+        }
+    }
+
+    /// The physics check's line and, when it closed the hand, the closing's lines.
+    fn write_sim(&self, s: &mut String) {
+        let _ = writeln!(s, "  Sim         {}", self.sim_line());
+        if let Some(c) = &self.sim.closing {
+            let _ = writeln!(s, "  Closing     {}", closing_line(c));
+            let set = |f: &crate::sim::FingerClosing,
+                       which: fn(&crate::sim::FingerClosing) -> [f64; 2]| {
+                let [a, b] = which(f);
+                format!("{a:.1}/{b:.1}")
+            };
+            let planned: Vec<String> = c
+                .fingers
+                .iter()
+                .map(|f| format!("{} {}", f.name, set(f, |f| f.planned_deg)))
+                .collect();
+            let closed: Vec<String> = c
+                .fingers
+                .iter()
+                .map(|f| format!("{} {}", f.name, set(f, |f| f.final_deg)))
+                .collect();
+            let _ = writeln!(s, "    theta1/theta2 planned {} deg", planned.join(", "));
+            let _ = writeln!(s, "    theta1/theta2 closed  {} deg", closed.join(", "));
+        }
+    }
+
+    /// The physics check in one line: the verdict, how far the object moved, the steps and
+    /// time, and the payload margin when searched; or why it did not run.
+    fn sim_line(&self) -> String {
+        let sim = &self.sim;
+        match (&sim.verdict, sim.translation_mm) {
+            (SimVerdict::NotRun { reason }, _) => format!("not run ({reason})"),
+            (SimVerdict::Ran(verdict), Some(t)) => format!(
+                "{verdict}: moved {:.2} mm and {:.2} deg relative to the palm {}; {} steps, {:.0} ms{}",
+                t,
+                sim.rotation_deg.unwrap_or(0.0),
+                if *verdict == Verdict::Drop {
+                    "by the end of the hold"
+                } else {
+                    "while held"
+                },
+                sim.steps.unwrap_or(0),
+                sim.wall_ms.unwrap_or(0.0),
+                match sim.payload_margin {
+                    Some(m) if *verdict == Verdict::Hold => format!("; payload margin {m:.2}x"),
+                    Some(_) => "; payload margin none (it does not hold its own weight)".to_string(),
+                    None => String::new(),
+                }
+            ),
+            (SimVerdict::Ran(verdict), None) => verdict.to_string(),
+        }
+    }
+
+    /// Whether the expectations were met, or that none was given.
+    fn write_expect(&self, s: &mut String) {
+        if self.expect.is_given() {
+            let met = match self.expect.met {
+                Some(true) => "met",
+                Some(false) => "NOT MET",
+                None => "not judged",
+            };
+            let _ = writeln!(
+                s,
+                "  Expect      {}: {met} ({})",
+                self.expect.outcome_name(),
+                self.expect.details
+            );
+        } else {
+            let _ = writeln!(s, "  Expect      none given: nothing judged");
+        }
+    }
+
+    /// One plain sentence: which grasp, whether it held, and why not when it did not.
+    pub fn result_sentence(&self) -> String {
+        let p = &self.plan;
+        let Some(g) = &p.grasp else {
+            return format!(
+                "no grasp found: {}",
+                p.reason
+                    .as_deref()
+                    .unwrap_or("the planner found no feasible grasp")
+            );
+        };
+        let grasp = format!(
+            "grasp at approach {:.0} deg, Finger_1 index {} (Z {:.1} mm), palm pitch {} deg",
+            g.approach_angle_deg,
+            g.elevation_index,
+            g.elevation_mm,
+            fmt_signed(g.palm_pitch_deg, 1)
+        );
+        let sim = &self.sim;
+        let moved = format!(
+            "{:.2} mm and {:.2} deg relative to the palm",
+            sim.translation_mm.unwrap_or(0.0),
+            sim.rotation_deg.unwrap_or(0.0)
+        );
+        match &sim.verdict {
+            SimVerdict::Ran(Verdict::Hold) => {
+                format!("{grasp}: HELD under gravity (moved {moved})")
+            }
+            SimVerdict::Ran(Verdict::Slip) => match (penetrated_slip(sim), pushed_slip(sim)) {
+                (None, Some(c)) => format!(
+                    "{grasp}: NOT held as planned: the closing pushed the object {:.1} mm, more \
+                     than max_closing_shift_mm ({} mm), before the fingers caught it, so the \
+                     grasp that held is not the one planned (the object then moved {moved})",
+                    c.shift_mm, c.max_shift_mm
+                ),
+                (Some((depth, limit)), _) => format!(
+                    "{grasp}: NOT held: a finger ended the closing {depth:.2} mm inside the \
+                     object, more than max_penetration_mm ({limit} mm), so the grip is not one a \
+                     real hand makes (the object moved {moved})"
+                ),
+                (None, None) => format!(
+                    "{grasp}: NOT held: the object slipped {moved}, beyond the hold limits{}, but \
+                     stayed in the hand",
+                    sim.limits.map_or(String::new(), |l| format!(
+                        " ({} mm, {} deg)",
+                        l.translation_mm, l.rotation_deg
+                    ))
+                ),
+            },
+            SimVerdict::Ran(Verdict::Drop) => {
+                format!("{grasp}: NOT held: the object fell out of the hand (moved {moved})")
+            }
+            SimVerdict::NotRun { reason } => {
+                format!("{grasp}; not checked in physics ({reason})")
+            }
+        }
+    }
+}
+
+/// For a `slip` that moved within the hold limits in every direction: it is a slip because a
+/// finger ended the closing deeper in the object than the limit. Returns the depth and the
+/// limit `[mm]`.
+fn penetrated_slip(sim: &SimReport) -> Option<(f64, f64)> {
+    let l = sim.limits?;
+    let within = sim.directions.iter().all(|d| {
+        d.verdict != Verdict::Slip
+            || (d.translation_mm <= l.translation_mm && d.rotation_deg <= l.rotation_deg)
+    });
+    let depth = sim
+        .directions
+        .iter()
+        .map(|d| d.closing_penetration_mm)
+        .fold(0.0, f64::max);
+    (within && depth > l.penetration_mm).then_some((depth, l.penetration_mm))
+}
+
+/// For a `slip` that moved within the hold limits in every direction and left no finger too
+/// deep: it is a slip because the closing pushed the object farther than its bound.
+fn pushed_slip(sim: &SimReport) -> Option<&crate::sim::ClosingOutcome> {
+    let l = sim.limits?;
+    let c = sim.closing.as_ref().filter(|c| c.pushed)?;
+    let within = sim.directions.iter().all(|d| {
+        d.verdict != Verdict::Slip
+            || (d.translation_mm <= l.translation_mm && d.rotation_deg <= l.rotation_deg)
+    });
+    within.then_some(c)
+}
+
+/// The summary's closing line (issue 33): how far the closing pushed and turned the object,
+/// which body touched first, and the joint furthest from its plan, e.g. "the closing pushed
+/// the object 23.0 mm; finger_2 stopped 27.0 deg short of its plan".
+pub fn closing_line(c: &crate::sim::ClosingOutcome) -> String {
+    let mut s = format!(
+        "the closing pushed the object {:.1} mm and turned it {:.1} deg{}",
+        c.shift_mm,
+        c.turn_deg,
+        if c.pushed {
+            format!(
+                " (more than max_closing_shift_mm, {} mm: not a hold of the planned grasp)",
+                c.max_shift_mm
+            )
+        } else {
+            String::new()
+        }
+    );
+    if let Some((name, joint, e)) = c.worst_joint() {
+        let how = if e < 0.0 { "short of" } else { "past" };
+        s += &format!(
+            "; {name} joint {joint} stopped {:.1} deg {how} its plan",
+            e.abs()
+        );
+    }
+    let phalanges = 2 * c.fingers.len();
+    s += &format!(
+        "; {} of {phalanges} phalanges end on the object within {} deg of their plan",
+        c.phalanges_on_plan,
+        crate::sim::protocol::WITHIN_PLAN_DEG
+    );
+    match &c.first_touch {
+        Some(t) if t.phalanx == 0 => s += &format!("; the palm touched first, at {:.3} s", t.at_s),
+        Some(t) => {
+            s += &format!(
+                "; {} phalanx {} touched first, at {:.3} s",
+                t.body, t.phalanx, t.at_s
+            )
+        }
+        None => s += "; nothing touched the object",
+    }
+    s
+}
+
+/// The summary's quality line: epsilon and volume, what they were computed from, and why
+/// epsilon is 0 when it is.
+fn quality_line(q: &crate::quality::Quality) -> String {
+    let closure = if q.force_closure {
+        "force closure".to_string()
+    } else {
+        format!(
+            "not force closure: {}",
+            q.note.as_deref().unwrap_or("the origin is not inside")
+        )
+    };
+    let from = match q.source {
+        "sim" => "at the end of closing",
+        _ => "planned",
+    };
+    format!(
+        "epsilon {:.3} ({closure}), volume {:.3e} (L1 grasp wrench space, {} cone edges, mu {}); {} {from}",
+        q.epsilon,
+        q.volume,
+        q.cone_edges,
+        q.friction,
+        plural(q.contacts.len(), "contact")
+    )
+}
+
+/// The first eight sorted palm indices with their elevations, and how many more there are;
+/// `none` when there are none.
+fn sorted_indices_head(p: &PlanReport) -> String {
+    let head: Vec<String> = p
+        .sorted_indices
+        .iter()
+        .take(8)
+        .map(|&i| {
+            format!(
+                "{i} (Z {:.1})",
+                p.index_elevation_mm.first + (i - 1) as f64 * p.index_elevation_mm.step
+            )
+        })
+        .collect();
+    let more = p.sorted_indices.len().saturating_sub(8);
+    format!(
+        "{}{}",
+        if head.is_empty() {
+            "none".to_string()
+        } else {
+            head.join(", ")
+        },
+        if more > 0 {
+            format!(", ... {more} more")
+        } else {
+            String::new()
+        }
+    )
+}
+
+/// The chosen grasp as the thesis's Grasp Parameter Set: per finger its joint angles, the
+/// approach, the palm pitch, Finger_1's elevation, and the palm pose.
+fn write_grasp_parameter_set(s: &mut String, g: &GraspReport) {
+    let _ = writeln!(s, "  Grasp Parameter Set:");
+    let _ = writeln!(s, "    GraspCondition -> Passed");
+    for f in &g.fingers {
+        let _ = writeln!(
+            s,
+            "    {} -> theta1 = {:.1} deg  theta2 = {:.1} deg{}",
+            capitalise(&f.name),
+            f.theta1_deg,
+            f.theta2_deg,
+            if f.tip_contact { "  (tip contact)" } else { "" }
+        );
+    }
+    let _ = writeln!(
+        s,
+        "    ApproachAngle = {:.0} deg  Palm_Pitch_Angle = {} deg",
+        g.approach_angle_deg,
+        fmt_signed(g.palm_pitch_deg, 1)
+    );
+    let _ = writeln!(
+        s,
+        "    Finger_1 Approach Elevation index = {}  Z = {:.1} mm",
+        g.elevation_index, g.elevation_mm
+    );
+    let pp = &g.palm_pose;
+    let _ = writeln!(
+        s,
+        "    Palm pose (original frame): position ({:.2}, {:.2}, {:.2}) mm, quaternion wxyz ({:.4}, {:.4}, {:.4}, {:.4})",
+        pp.position_mm[0], pp.position_mm[1], pp.position_mm[2],
+        pp.quaternion_wxyz[0], pp.quaternion_wxyz[1], pp.quaternion_wxyz[2], pp.quaternion_wxyz[3]
+    );
+}
+
+/// `v` with `digits` decimals, without the sign of a value that rounds to zero ("-0.0").
+pub fn fmt_signed(v: f64, digits: usize) -> String {
+    let s = format!("{v:.digits$}");
+    if s.trim_start_matches('-')
+        .chars()
+        .all(|c| c == '0' || c == '.')
+    {
+        s.trim_start_matches('-').to_string()
+    } else {
+        s
+    }
+}
+
+/// `name` with its first letter in upper case.
+fn capitalise(name: &str) -> String {
+    let mut c = name.chars();
+    match c.next() {
+        Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
+        None => String::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::fmt_signed;
+
+    #[test]
+    fn a_value_that_rounds_to_zero_has_no_sign() {
+        assert_eq!(fmt_signed(-0.0, 2), "0.00");
+        assert_eq!(fmt_signed(-0.004, 2), "0.00");
+        assert_eq!(fmt_signed(-0.006, 2), "-0.01");
+        assert_eq!(fmt_signed(7.25, 1), "7.2");
+        assert_eq!(fmt_signed(-6.2, 1), "-6.2");
+    }
+}
