@@ -8,6 +8,9 @@
 //! is not taken as data: it is skipped with a warning.
 
 use crate::batch::{BatchError, Counts};
+use crate::messages::plural;
+use crate::report::RecordView;
+use crate::sim::Verdict;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
@@ -95,7 +98,7 @@ impl Summary {
                 bytes.len() - complete
             ));
         }
-        let mut values = Vec::new();
+        let mut views = Vec::new();
         let mut seen: BTreeMap<String, usize> = BTreeMap::new();
         for (i, line) in bytes[..complete].split(|&b| b == b'\n').enumerate() {
             if line.iter().all(u8::is_ascii_whitespace) {
@@ -109,25 +112,26 @@ impl Summary {
             let text = std::str::from_utf8(line).map_err(|_| bad("not UTF-8".to_string()))?;
             let v: serde_json::Value =
                 serde_json::from_str(text).map_err(|e| bad(format!("not JSON ({e})")))?;
+            if !v.is_object() {
+                return Err(bad("not a JSON object".to_string()));
+            }
+            let v = RecordView::of(&v);
             let row = row_of(&v).map_err(bad)?;
             *seen.entry(row.input.clone()).or_insert(0) += 1;
-            for d in v["sim"]["directions"].as_array().into_iter().flatten() {
-                let c = s
-                    .directions
-                    .entry(direction_label(&d["gravity"]))
-                    .or_default();
+            for d in &v.sim.directions {
+                let c = s.directions.entry(direction_label(&d.gravity)).or_default();
                 c.checked += 1;
-                match d["verdict"].as_str() {
-                    Some("hold") => c.hold += 1,
-                    Some("slip") => c.slip += 1,
-                    Some("drop") => c.drop += 1,
-                    _ => {}
+                match d.ran() {
+                    Some(Verdict::Hold) => c.hold += 1,
+                    Some(Verdict::Slip) => c.slip += 1,
+                    Some(Verdict::Drop) => c.drop += 1,
+                    None => {}
                 }
             }
             s.rows.push(row);
-            values.push(v);
+            views.push(v);
         }
-        s.counts = Counts::of(&values);
+        s.counts = Counts::of_views(&views);
         let twice: Vec<String> = seen
             .iter()
             .filter(|(_, &n)| n > 1)
@@ -136,7 +140,7 @@ impl Summary {
         if let Some(first) = twice.first() {
             s.warnings.push(format!(
                 "{} given more than once (first: {first}); counted each time",
-                crate::messages::plural(twice.len(), "input")
+                plural(twice.len(), "input")
             ));
         }
         Ok(s)
@@ -153,11 +157,7 @@ impl Summary {
                 100.0 * n as f64 / c.objects as f64
             }
         };
-        let _ = writeln!(
-            t,
-            "{name}: {}",
-            crate::messages::plural(c.objects, "object")
-        );
+        let _ = writeln!(t, "{name}: {}", plural(c.objects, "object"));
         let _ = writeln!(
             t,
             "  planned       {} ({:.1} %), ungraspable {} ({:.1} %), errors {} ({:.1} %)",
@@ -200,6 +200,13 @@ impl Summary {
             "  time          {total_s:.1} s summed over objects ({:.3} s per object)",
             total_s / c.objects.max(1) as f64
         );
+        self.write_slowest(&mut t, slowest);
+        self.write_errors(&mut t);
+        t
+    }
+
+    /// The `slowest` slowest objects, slowest first, each with its outcome.
+    fn write_slowest(&self, t: &mut String, slowest: usize) {
         let mut order: Vec<&Row> = self.rows.iter().collect();
         // Slowest first; equal times in file order (the sort is stable).
         order.sort_by(|a, b| b.wall_ms.total_cmp(&a.wall_ms));
@@ -219,6 +226,10 @@ impl Summary {
                 );
             }
         }
+    }
+
+    /// The first ten errors, and how many more there are.
+    fn write_errors(&self, t: &mut String) {
         let errors: Vec<&Row> = self.rows.iter().filter(|r| !r.error.is_empty()).collect();
         if !errors.is_empty() {
             let _ = writeln!(t, "  errors:");
@@ -229,7 +240,6 @@ impl Summary {
                 let _ = writeln!(t, "    ... and {} more (see the CSV)", errors.len() - 10);
             }
         }
-        t
     }
 
     /// One row per object, in file order, with a header.
@@ -271,11 +281,7 @@ fn csv_field(s: &str) -> String {
 
 /// `-Z (down)` for gravity along an axis (the aligned object frame, the thesis's weight
 /// direction −Z), the rounded vector otherwise.
-fn direction_label(g: &serde_json::Value) -> String {
-    let v: Vec<f64> = g
-        .as_array()
-        .map(|a| a.iter().filter_map(serde_json::Value::as_f64).collect())
-        .unwrap_or_default();
+fn direction_label(v: &[f64]) -> String {
     if v.len() != 3 {
         return "?".to_string();
     }
@@ -290,19 +296,13 @@ fn direction_label(g: &serde_json::Value) -> String {
 }
 
 /// The row of one line.
-fn row_of(v: &serde_json::Value) -> Result<Row, String> {
-    if !v.is_object() {
-        return Err("not a JSON object".to_string());
-    }
-    let scenario = v["scenario"]
-        .as_str()
-        .ok_or("no `scenario` (not a run report from `batch` or `--json`)")?
-        .to_string();
-    let input = v["batch"]["input"]
-        .as_str()
-        .unwrap_or(&scenario)
-        .to_string();
-    if let Some(e) = v.get("error") {
+fn row_of(v: &RecordView) -> Result<Row, String> {
+    let scenario = v
+        .scenario
+        .clone()
+        .ok_or("no `scenario` (not a run report from `batch` or `--json`)")?;
+    let input = v.batch.input.clone().unwrap_or_else(|| scenario.clone());
+    if let Some(e) = &v.error {
         return Ok(Row {
             input,
             scenario,
@@ -314,43 +314,40 @@ fn row_of(v: &serde_json::Value) -> Result<Row, String> {
             directions: String::new(),
             expected: String::new(),
             met: None,
-            wall_ms: v["batch"]["wall_ms"].as_f64().unwrap_or(0.0),
-            error: e.as_str().map_or_else(|| e.to_string(), str::to_string),
+            wall_ms: v.batch.wall_ms.unwrap_or(0.0),
+            error: e.text().to_string(),
         });
     }
-    let status = v["plan"]["status"]
-        .as_str()
-        .ok_or("no `plan.status` (not a run report)")?
-        .to_string();
-    let sim = &v["sim"];
-    let directions: Vec<String> = sim["directions"]
-        .as_array()
-        .into_iter()
-        .flatten()
+    let status = v
+        .plan
+        .status
+        .clone()
+        .ok_or("no `plan.status` (not a run report)")?;
+    let sim = &v.sim;
+    let directions: Vec<String> = sim
+        .directions
+        .iter()
         .map(|d| {
-            let label = direction_label(&d["gravity"]);
+            let label = direction_label(&d.gravity);
             let label = label.trim_end_matches(" (down)");
-            format!("{label} {}", d["verdict"].as_str().unwrap_or("?"))
+            format!("{label} {}", d.verdict.as_deref().unwrap_or("?"))
         })
         .collect();
-    let wall_ms = v["batch"]["wall_ms"].as_f64().unwrap_or_else(|| {
-        let plan: f64 = v["plan"]["timings_ms"]
-            .as_object()
-            .map(|m| m.values().filter_map(serde_json::Value::as_f64).sum())
-            .unwrap_or(0.0);
-        plan + sim["wall_ms"].as_f64().unwrap_or(0.0)
+    let wall_ms = v.batch.wall_ms.unwrap_or_else(|| {
+        let plan: f64 = v.plan.timings_ms.as_ref().map_or(0.0, |t| t.iter().sum());
+        plan + sim.wall_ms.unwrap_or(0.0)
     });
     Ok(Row {
         input,
         scenario,
         status,
-        verdict: sim["verdict"].as_str().unwrap_or("").to_string(),
-        translation_mm: sim["translation_mm"].as_f64(),
-        rotation_deg: sim["rotation_deg"].as_f64(),
-        payload_margin: sim["payload_margin"].as_f64(),
+        verdict: sim.verdict.clone().unwrap_or_default(),
+        translation_mm: sim.translation_mm,
+        rotation_deg: sim.rotation_deg,
+        payload_margin: sim.payload_margin,
         directions: directions.join(" "),
-        expected: v["expect"]["outcome"].as_str().unwrap_or("").to_string(),
-        met: v["expect"]["met"].as_bool(),
+        expected: v.expect.outcome.clone().unwrap_or_default(),
+        met: v.expect.met,
         wall_ms,
         error: String::new(),
     })

@@ -46,7 +46,7 @@ pub struct Interrupted(pub String);
 pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, Interrupted> {
     let t0 = Instant::now();
     let input = item.path().display().to_string();
-    let fail = |message: String, t0: Instant| {
+    let fail = |message: String| {
         Record::from_error(
             &input,
             &format!("{input}: {message}"),
@@ -57,6 +57,43 @@ pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, I
             },
         )
     };
+    let child = match worker_command(item, key, worker).spawn() {
+        Ok(c) => c,
+        Err(e) => {
+            return Ok(fail(format!(
+                "cannot start the worker {}: {e}",
+                worker.program.display()
+            )))
+        }
+    };
+    let ended = wait_for(child, worker.timeout);
+    if ended.timed_out {
+        let t = worker.timeout.unwrap_or_default().as_secs_f64();
+        return Ok(fail(format!(
+            "timed out: still running after {t} s (--object-timeout), stopped"
+        )));
+    }
+    let status = match ended.status {
+        Ok(s) => s,
+        Err(e) => return Ok(fail(format!("lost the worker: {e}"))),
+    };
+    let last_err = last_error_line(&ended.stderr);
+    if status.success() {
+        return Ok(record_printed(&ended.stdout, key, &last_err).unwrap_or_else(fail));
+    }
+    failure(&status, &ended.stderr, &last_err, worker)
+        .map(fail)
+        .map_err(|sig| {
+            Interrupted(format!(
+                "{input}: interrupted ({}); --resume runs it again",
+                signal_name(sig)
+            ))
+        })
+}
+
+/// The worker's command line for `item`: the worker's arguments, then `--input-hash HASH
+/// PATH`, with its output piped, its threads and its memory limited.
+fn worker_command(item: &Item, key: &Key, worker: &Worker) -> Command {
     let mut cmd = Command::new(&worker.program);
     cmd.args(&worker.args)
         .arg("--input-hash")
@@ -71,15 +108,21 @@ pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, I
         cmd.env("RAYON_NUM_THREADS", worker.threads.max(1).to_string());
     }
     limit_child(&mut cmd, worker.memory_limit_mib);
-    let mut child = match cmd.spawn() {
-        Ok(c) => c,
-        Err(e) => {
-            return Ok(fail(
-                format!("cannot start the worker {}: {e}", worker.program.display()),
-                t0,
-            ))
-        }
-    };
+    cmd
+}
+
+/// How a worker ended: its exit status, what it printed, and whether it was killed at the
+/// timeout.
+struct Ended {
+    status: std::io::Result<std::process::ExitStatus>,
+    stdout: Vec<u8>,
+    stderr: String,
+    timed_out: bool,
+}
+
+/// Waits for `child` to close its stdout (it ends), up to `timeout`, killing it then; reads
+/// its stdout and stderr on threads so that neither pipe fills up.
+fn wait_for(mut child: std::process::Child, timeout: Option<Duration>) -> Ended {
     let (tx, rx) = std::sync::mpsc::channel();
     let stdout = child.stdout.take().map(|mut s| {
         std::thread::spawn(move || {
@@ -97,7 +140,7 @@ pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, I
         })
     });
     // The worker's stdout closes when it ends: wait for that, up to the timeout.
-    let timed_out = match worker.timeout {
+    let timed_out = match timeout {
         Some(t) => matches!(
             rx.recv_timeout(t),
             Err(std::sync::mpsc::RecvTimeoutError::Timeout)
@@ -111,10 +154,20 @@ pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, I
         let _ = child.kill();
     }
     let status = child.wait();
-    let out = stdout.and_then(|h| h.join().ok()).unwrap_or_default();
-    let err = stderr.and_then(|h| h.join().ok()).unwrap_or_default();
-    let err = String::from_utf8_lossy(&err);
-    let last_err = err
+    let stdout = stdout.and_then(|h| h.join().ok()).unwrap_or_default();
+    let stderr = stderr.and_then(|h| h.join().ok()).unwrap_or_default();
+    Ended {
+        status,
+        stdout,
+        stderr: String::from_utf8_lossy(&stderr).into_owned(),
+        timed_out,
+    }
+}
+
+/// The last line of a worker's stderr that says something (not a panic's notes about
+/// backtraces), trimmed; empty when there is none.
+fn last_error_line(stderr: &str) -> String {
+    stderr
         .lines()
         .rev()
         .find(|l| {
@@ -125,38 +178,34 @@ pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, I
         })
         .unwrap_or("")
         .trim()
-        .to_string();
-    let oom = err
-        .lines()
-        .find(|l| l.starts_with("memory allocation of"))
-        .map(str::trim);
-    if timed_out {
-        let t = worker.timeout.unwrap_or_default().as_secs_f64();
-        return Ok(fail(
-            format!("timed out: still running after {t} s (--object-timeout), stopped"),
-            t0,
-        ));
+        .to_string()
+}
+
+/// The record a worker that succeeded printed as its last line, or what is wrong with it.
+fn record_printed(stdout: &[u8], key: &Key, last_err: &str) -> Result<Record, String> {
+    let text = String::from_utf8_lossy(stdout);
+    let line = text.lines().rev().find(|l| !l.trim().is_empty());
+    match line.map(Record::parse) {
+        Some(Ok(r)) if r.key == *key => Ok(r),
+        Some(Ok(r)) => Err(format!(
+            "the worker answered for {} ({}), not for this input",
+            r.key.input, r.key.input_hash
+        )),
+        Some(Err(why)) => Err(format!("the worker's line is unreadable: {why}")),
+        None => Err(format!("the worker printed no line ({last_err})")),
     }
-    let status = match status {
-        Ok(s) => s,
-        Err(e) => return Ok(fail(format!("lost the worker: {e}"), t0)),
-    };
-    if status.success() {
-        let text = String::from_utf8_lossy(&out);
-        let line = text.lines().rev().find(|l| !l.trim().is_empty());
-        return Ok(match line.map(Record::parse) {
-            Some(Ok(r)) if r.key == *key => r,
-            Some(Ok(r)) => fail(
-                format!(
-                    "the worker answered for {} ({}), not for this input",
-                    r.key.input, r.key.input_hash
-                ),
-                t0,
-            ),
-            Some(Err(why)) => fail(format!("the worker's line is unreadable: {why}"), t0),
-            None => fail(format!("the worker printed no line ({last_err})"), t0),
-        });
-    }
+}
+
+/// Why a worker that did not succeed failed, in words, from its status and stderr.
+///
+/// # Errors
+/// The signal, when an interrupting signal ended it (it gets no line).
+fn failure(
+    status: &std::process::ExitStatus,
+    stderr: &str,
+    last_err: &str,
+    worker: &Worker,
+) -> Result<String, i32> {
     let with_err = |s: String| {
         if last_err.is_empty() {
             s
@@ -164,40 +213,29 @@ pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, I
             format!("{s}: {last_err}")
         }
     };
-    match signal_of(&status) {
-        Some(sig) if is_interrupt(sig) => Err(Interrupted(format!(
-            "{input}: interrupted ({}); --resume runs it again",
-            signal_name(sig)
-        ))),
-        Some(sig) if oom.is_some() => Ok(fail(
-            format!(
-                "out of memory{} ({}): {}",
-                worker.memory_limit_mib.map_or(String::new(), |m| format!(
-                    " (limit {m} MiB, --object-memory)"
-                )),
-                signal_name(sig),
-                oom.unwrap_or_default()
-            ),
-            t0,
-        )),
-        Some(sig) if is_kill(sig) => Ok(fail(
-            format!(
-                "killed ({}): out of memory? (the kernel's out-of-memory killer sends it)",
-                signal_name(sig)
-            ),
-            t0,
-        )),
-        Some(sig) => Ok(fail(
-            with_err(format!("crashed ({})", signal_name(sig))),
-            t0,
-        )),
-        None => Ok(fail(
-            with_err(format!(
-                "the worker exited with status {}",
-                status.code().unwrap_or(-1)
+    let oom = stderr
+        .lines()
+        .find(|l| l.starts_with("memory allocation of"))
+        .map(str::trim);
+    match signal_of(status) {
+        Some(sig) if is_interrupt(sig) => Err(sig),
+        Some(sig) if oom.is_some() => Ok(format!(
+            "out of memory{} ({}): {}",
+            worker.memory_limit_mib.map_or(String::new(), |m| format!(
+                " (limit {m} MiB, --object-memory)"
             )),
-            t0,
+            signal_name(sig),
+            oom.unwrap_or_default()
         )),
+        Some(sig) if is_kill(sig) => Ok(format!(
+            "killed ({}): out of memory? (the kernel's out-of-memory killer sends it)",
+            signal_name(sig)
+        )),
+        Some(sig) => Ok(with_err(format!("crashed ({})", signal_name(sig)))),
+        None => Ok(with_err(format!(
+            "the worker exited with status {}",
+            status.code().unwrap_or(-1)
+        ))),
     }
 }
 

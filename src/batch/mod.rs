@@ -23,7 +23,9 @@ pub use isolate::{Interrupted, Worker};
 pub use record::{input_hash, Key, Record, RecordError};
 
 use crate::hand::Hand;
+use crate::report::RecordView;
 use crate::scenario::{ObjectSpec, PlannerParams, Scenario, ScenarioError, SimParams};
+use crate::sim::Verdict;
 use crate::{run, Error, RunOptions};
 use rayon::prelude::*;
 use record::BatchInfo;
@@ -479,32 +481,46 @@ pub struct Counts {
 }
 
 impl Counts {
-    /// Counts the outcomes of `lines`.
+    /// Counts the outcomes of `lines`, parsed untyped.
+    ///
+    /// Kept for the binary until it calls [`Counts::of_views`] (`Record::view`).
     pub fn of<'a>(lines: impl IntoIterator<Item = &'a serde_json::Value>) -> Counts {
+        let views: Vec<RecordView> = lines.into_iter().map(RecordView::of).collect();
+        Counts::of_views(&views)
+    }
+
+    /// Counts the outcomes of `lines`.
+    pub fn of_views<'a>(lines: impl IntoIterator<Item = &'a RecordView>) -> Counts {
         let mut c = Counts::default();
         for v in lines {
             c.objects += 1;
-            if v.get("error").is_some() {
+            if v.error.is_some() {
                 c.errors += 1;
                 continue;
             }
-            match v["plan"]["status"].as_str() {
-                Some("feasible") => c.feasible += 1,
-                _ => c.ungraspable += 1,
+            if v.is_feasible() {
+                c.feasible += 1;
+            } else {
+                c.ungraspable += 1;
             }
-            match v["sim"]["verdict"].as_str() {
-                Some("hold") => c.hold += 1,
-                Some("slip") => c.slip += 1,
-                Some("drop") => c.drop += 1,
-                _ => {}
+            match v.sim.ran() {
+                Some(Verdict::Hold) => c.hold += 1,
+                Some(Verdict::Slip) => c.slip += 1,
+                Some(Verdict::Drop) => c.drop += 1,
+                None => {}
             }
-            match v["expect"]["met"].as_bool() {
+            match v.expect.met {
                 Some(true) => c.met += 1,
                 Some(false) => c.not_met += 1,
                 None => c.unjudged += 1,
             }
         }
         c
+    }
+
+    /// Counts the outcomes of `records`.
+    pub fn of_records<'a>(records: impl IntoIterator<Item = &'a Record>) -> Counts {
+        Counts::of_views(records.into_iter().map(|r| &r.view))
     }
 }
 

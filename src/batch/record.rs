@@ -9,7 +9,7 @@
 //! edited since its line was written does not match it and is run again.
 
 use super::Item;
-use crate::report::{to_rounded_json, RunReport};
+use crate::report::{to_rounded_json, ErrorView, RecordView, RunReport};
 use crate::scenario::Scenario;
 use crate::RunOptions;
 use serde::Serialize;
@@ -48,14 +48,17 @@ pub enum RecordError {
 }
 
 /// One object's line, kept as the text written (so a line read back from a file is written
-/// again byte for byte) and as parsed JSON (to count outcomes).
+/// again byte for byte) and as read back ([`RecordView`], to count outcomes).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Record {
     /// What the line belongs to.
     pub key: Key,
     /// The JSON object, one line, no newline.
     pub line: String,
-    /// The same, parsed.
+    /// The same, read back: what the readers use.
+    pub view: RecordView,
+    /// The same, parsed untyped: kept only for the binary's batch bookkeeping until it reads
+    /// [`Record::view`] (then this goes).
     pub value: serde_json::Value,
 }
 
@@ -113,6 +116,7 @@ impl Record {
                 input_hash: batch.input_hash.clone(),
             },
             line,
+            view: RecordView::of(&value),
             value,
         }
     }
@@ -125,26 +129,23 @@ impl Record {
     pub fn parse(line: &str) -> Result<Record, RecordError> {
         let value: serde_json::Value =
             serde_json::from_str(line).map_err(|e| RecordError::NotJson(e.to_string()))?;
-        let field = |name: &'static str| {
-            value["batch"][name]
-                .as_str()
-                .map(str::to_string)
-                .ok_or(RecordError::NoBatchField(name))
-        };
+        let view = RecordView::of(&value);
         let key = Key {
-            input: field("input")?,
-            input_hash: field("input_hash")?,
+            input: (view.batch.input.clone()).ok_or(RecordError::NoBatchField("input"))?,
+            input_hash: (view.batch.input_hash.clone())
+                .ok_or(RecordError::NoBatchField("input_hash"))?,
         };
         Ok(Record {
             key,
             line: line.to_string(),
+            view,
             value,
         })
     }
 
     /// The error, when the object could not be run.
     pub fn error(&self) -> Option<&str> {
-        self.value["error"].as_str()
+        self.view.error.as_ref().and_then(ErrorView::as_str)
     }
 }
 

@@ -4,10 +4,14 @@
 //! check that has not run is reported as such (`"verdict": "not_run"` and its `reason`), never
 //! with invented numbers. Outcomes are enums in Rust whose JSON names are the strings scripts
 //! read (`feasible`, `hold`, `not_run`, `override_angles`, ...).
+//!
+//! [`RecordView`] reads a line back: the one typed view that `batch` (counts, `--resume`,
+//! `--merge`) and `summarize` read.
 
 use crate::scenario::Outcome;
 use crate::sim::Verdict;
-use serde::Serialize;
+use serde::de::DeserializeOwned;
+use serde::{Deserialize, Deserializer, Serialize};
 
 /// Everything one scenario run produced.
 #[derive(Debug, Clone, Serialize)]
@@ -547,4 +551,270 @@ pub struct ExpectReport {
 /// `None` as `"none"`.
 fn outcome_or_none<S: serde::Serializer>(o: &Option<Outcome>, s: S) -> Result<S::Ok, S::Error> {
     s.serialize_str(o.map_or("none", Outcome::as_str))
+}
+
+/// A line of JSON Lines output read back: a run report (`--json`, `batch`), or the
+/// `{"scenario", "error"}` line of an object that could not be run, with what `batch` adds
+/// under `"batch"`. Only the fields the readers (`batch`'s counts, `--resume` and `--merge`,
+/// `summarize`) use.
+///
+/// Read as the readers read untyped JSON before: every field is optional, and a field of
+/// another JSON type than expected reads as absent (so old, partial or hand-edited lines
+/// still read); strings are kept as written, so that a reader can print what it read.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(default)]
+pub struct RecordView {
+    /// `scenario`.
+    #[serde(deserialize_with = "lenient")]
+    pub scenario: Option<String>,
+    /// `error`, present for an object that could not be run (the key's presence marks it,
+    /// whatever its value).
+    #[serde(deserialize_with = "present_error")]
+    pub error: Option<ErrorView>,
+    /// `plan`.
+    #[serde(deserialize_with = "lenient_object")]
+    pub plan: PlanView,
+    /// `sim`.
+    #[serde(deserialize_with = "lenient_object")]
+    pub sim: SimView,
+    /// `expect`.
+    #[serde(deserialize_with = "lenient_object")]
+    pub expect: ExpectView,
+    /// `batch`, on lines written by `batch`.
+    #[serde(deserialize_with = "lenient_object")]
+    pub batch: BatchView,
+}
+
+/// A line's `error`: the text `batch` writes, or (a line written otherwise) another JSON value.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum ErrorView {
+    /// A string: the error in words.
+    Text(String),
+    /// Any other value (`null` included), as its JSON text.
+    NotText(String),
+}
+
+impl ErrorView {
+    /// The error in words: the string, or the other value's JSON text.
+    pub fn text(&self) -> &str {
+        match self {
+            ErrorView::Text(s) | ErrorView::NotText(s) => s,
+        }
+    }
+
+    /// The string, when the error is one.
+    pub fn as_str(&self) -> Option<&str> {
+        match self {
+            ErrorView::Text(s) => Some(s),
+            ErrorView::NotText(_) => None,
+        }
+    }
+}
+
+/// The `plan` fields a reader uses.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(default)]
+pub struct PlanView {
+    /// `plan.status`: `feasible` or `ungraspable`.
+    #[serde(deserialize_with = "lenient")]
+    pub status: Option<String>,
+    /// `plan.timings_ms`, the numbers among its values, in key order (`None` when it is not
+    /// an object).
+    #[serde(deserialize_with = "numbers_of_object")]
+    pub timings_ms: Option<Vec<f64>>,
+}
+
+/// The `sim` fields a reader uses.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(default)]
+pub struct SimView {
+    /// `sim.verdict`: `hold`, `slip`, `drop` or `not_run`.
+    #[serde(deserialize_with = "lenient")]
+    pub verdict: Option<String>,
+    /// `sim.translation_mm`.
+    #[serde(deserialize_with = "lenient")]
+    pub translation_mm: Option<f64>,
+    /// `sim.rotation_deg`.
+    #[serde(deserialize_with = "lenient")]
+    pub rotation_deg: Option<f64>,
+    /// `sim.payload_margin`.
+    #[serde(deserialize_with = "lenient")]
+    pub payload_margin: Option<f64>,
+    /// `sim.wall_ms`.
+    #[serde(deserialize_with = "lenient")]
+    pub wall_ms: Option<f64>,
+    /// `sim.directions` (empty when absent or not a list).
+    #[serde(deserialize_with = "lenient_list")]
+    pub directions: Vec<DirectionView>,
+}
+
+impl SimView {
+    /// The verdict, when the check ran and `verdict` names one.
+    pub fn ran(&self) -> Option<Verdict> {
+        verdict_named(self.verdict.as_deref())
+    }
+}
+
+/// One entry of `sim.directions` as a reader uses it.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(default)]
+pub struct DirectionView {
+    /// `gravity`, the numbers of the list (empty when it is not a list).
+    #[serde(deserialize_with = "numbers_of_list")]
+    pub gravity: Vec<f64>,
+    /// `verdict`.
+    #[serde(deserialize_with = "lenient")]
+    pub verdict: Option<String>,
+}
+
+impl DirectionView {
+    /// The verdict under this direction, when `verdict` names one.
+    pub fn ran(&self) -> Option<Verdict> {
+        verdict_named(self.verdict.as_deref())
+    }
+}
+
+/// The `expect` fields a reader uses.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(default)]
+pub struct ExpectView {
+    /// `expect.outcome`.
+    #[serde(deserialize_with = "lenient")]
+    pub outcome: Option<String>,
+    /// `expect.met` (`None` for null: nothing judged).
+    #[serde(deserialize_with = "lenient")]
+    pub met: Option<bool>,
+}
+
+/// What `batch` adds to each line, as read back.
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(default)]
+pub struct BatchView {
+    /// `batch.input`.
+    #[serde(deserialize_with = "lenient")]
+    pub input: Option<String>,
+    /// `batch.input_hash`.
+    #[serde(deserialize_with = "lenient")]
+    pub input_hash: Option<String>,
+    /// `batch.wall_ms`.
+    #[serde(deserialize_with = "lenient")]
+    pub wall_ms: Option<f64>,
+}
+
+impl RecordView {
+    /// The view of a parsed JSON value (all absent when it is not an object).
+    pub fn of(value: &serde_json::Value) -> RecordView {
+        object_or_default(value.clone())
+    }
+
+    /// Returns true if and only if the plan found a grasp (`plan.status` is `feasible`).
+    pub fn is_feasible(&self) -> bool {
+        self.plan.status.as_deref() == Some(PlanStatus::Feasible.as_str())
+    }
+}
+
+/// The verdict `name` names, if any.
+fn verdict_named(name: Option<&str>) -> Option<Verdict> {
+    [Verdict::Hold, Verdict::Slip, Verdict::Drop]
+        .into_iter()
+        .find(|v| Some(v.as_str()) == name)
+}
+
+/// `T` from `v` when `v` is an object, else `T`'s default (every field absent).
+fn object_or_default<T: DeserializeOwned + Default>(v: serde_json::Value) -> T {
+    if v.is_object() {
+        serde_json::from_value(v).unwrap_or_default()
+    } else {
+        T::default()
+    }
+}
+
+/// A value of type `T`, or `None` for a value of another type.
+fn lenient<'de, D: Deserializer<'de>, T: DeserializeOwned>(d: D) -> Result<Option<T>, D::Error> {
+    Ok(serde_json::from_value(serde_json::Value::deserialize(d)?).ok())
+}
+
+/// A nested object, or its default (every field absent) for a value that is not one.
+fn lenient_object<'de, D: Deserializer<'de>, T: DeserializeOwned + Default>(
+    d: D,
+) -> Result<T, D::Error> {
+    Ok(object_or_default(serde_json::Value::deserialize(d)?))
+}
+
+/// A list of objects, each that is not an object read as the default (every field absent);
+/// empty for a value that is not a list.
+fn lenient_list<'de, D: Deserializer<'de>, T: DeserializeOwned + Default>(
+    d: D,
+) -> Result<Vec<T>, D::Error> {
+    Ok(match serde_json::Value::deserialize(d)? {
+        serde_json::Value::Array(items) => items.into_iter().map(object_or_default).collect(),
+        _ => Vec::new(),
+    })
+}
+
+/// The numbers of a list, others left out; empty for a value that is not a list.
+fn numbers_of_list<'de, D: Deserializer<'de>>(d: D) -> Result<Vec<f64>, D::Error> {
+    Ok(match serde_json::Value::deserialize(d)? {
+        serde_json::Value::Array(items) => items.iter().filter_map(|v| v.as_f64()).collect(),
+        _ => Vec::new(),
+    })
+}
+
+/// The numbers among an object's values, in key order, others left out; `None` for a value
+/// that is not an object.
+fn numbers_of_object<'de, D: Deserializer<'de>>(d: D) -> Result<Option<Vec<f64>>, D::Error> {
+    Ok(match serde_json::Value::deserialize(d)? {
+        serde_json::Value::Object(m) => Some(m.values().filter_map(|v| v.as_f64()).collect()),
+        _ => None,
+    })
+}
+
+/// A present `error`, whatever its value.
+fn present_error<'de, D: Deserializer<'de>>(d: D) -> Result<Option<ErrorView>, D::Error> {
+    Ok(Some(match serde_json::Value::deserialize(d)? {
+        serde_json::Value::String(s) => ErrorView::Text(s),
+        other => ErrorView::NotText(other.to_string()),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(line: &str) -> RecordView {
+        RecordView::of(&serde_json::from_str(line).unwrap())
+    }
+
+    #[test]
+    fn a_record_reads_back_as_the_untyped_readers_read_it() {
+        let v = view(
+            r#"{"scenario":"a","plan":{"status":"feasible","timings_ms":{"load":1.5,"x":"y","align":2}},"sim":{"verdict":"slip","translation_mm":3,"directions":[{"gravity":[0,0,-1],"verdict":"hold"},7]},"expect":{"outcome":"hold","met":false},"batch":{"input":"d/a.toml","input_hash":"sha256:0","wall_ms":12.5}}"#,
+        );
+        assert!(v.is_feasible() && v.error.is_none());
+        assert_eq!(v.plan.timings_ms, Some(vec![2.0, 1.5]));
+        assert_eq!(v.sim.ran(), Some(Verdict::Slip));
+        assert_eq!(v.sim.translation_mm, Some(3.0));
+        assert_eq!(v.sim.directions.len(), 2);
+        assert_eq!(v.sim.directions[0].gravity, [0.0, 0.0, -1.0]);
+        assert_eq!(v.sim.directions[0].ran(), Some(Verdict::Hold));
+        assert_eq!(v.sim.directions[1], DirectionView::default());
+        assert_eq!(v.expect.met, Some(false));
+        assert_eq!(v.batch.input.as_deref(), Some("d/a.toml"));
+        assert_eq!(v.batch.wall_ms, Some(12.5));
+    }
+
+    #[test]
+    fn error_lines_and_odd_fields_read_as_absent_not_as_failures() {
+        let e = view(r#"{"scenario":"m.stl","error":"bad mesh"}"#);
+        assert_eq!(e.error, Some(ErrorView::Text("bad mesh".to_string())));
+        let null = view(r#"{"scenario":"m.stl","error":null}"#);
+        assert_eq!(null.error.as_ref().map(ErrorView::text), Some("null"));
+        assert_eq!(null.error.as_ref().and_then(ErrorView::as_str), None);
+        let odd = view(r#"{"scenario":1,"plan":"feasible","sim":{"verdict":5},"batch":[1]}"#);
+        assert_eq!(odd.scenario, None);
+        assert!(!odd.is_feasible());
+        assert_eq!(odd.sim.verdict, None);
+        assert_eq!(odd.batch, BatchView::default());
+        assert_eq!(view("[1, 2]"), RecordView::default());
+    }
 }

@@ -5,7 +5,7 @@
 //! with invented numbers. Outcomes are enums in Rust whose JSON names are the strings scripts
 //! read (`feasible`, `hold`, `not_run`, `override_angles`, ...).
 //!
-//! - [`contract`]: the report's types, as written to JSON.
+//! - [`contract`]: the report's types, as written to JSON, and [`RecordView`], a line read back.
 //! - [`expect`]: judging a scenario's `[expect]`.
 //! - [`summary`]: the human summary.
 //! - [`json`]: the JSON text, figures rounded.
@@ -16,9 +16,10 @@ pub mod json;
 pub mod summary;
 
 pub use contract::{
-    AlsReport, AxisReport, CandidateCheck, DiameterBasis, ExpectReport, FingerReport, GradesReport,
-    GraspQuality, GraspReport, GraspSource, HoldLimits, IndexScale, ObjectReport, PlanReport,
-    PlanStatus, PoseReport, RunReport, SimReport, SimVerdict, StageTimings,
+    AlsReport, AxisReport, BatchView, CandidateCheck, DiameterBasis, DirectionView, ErrorView,
+    ExpectReport, ExpectView, FingerReport, GradesReport, GraspQuality, GraspReport, GraspSource,
+    HoldLimits, IndexScale, ObjectReport, PlanReport, PlanStatus, PlanView, PoseReport, RecordView,
+    RunReport, SimReport, SimVerdict, SimView, StageTimings,
 };
 pub use json::{
     round_significant, to_rounded_json, to_rounded_json_pretty, JSON_SIGNIFICANT_DIGITS,

@@ -219,19 +219,15 @@ pub fn finger(g: &Grasp, hand: &Hand, mesh: &Mesh, k: usize) -> String {
     let mirror = f.side.sign();
     let s = slice(mesh, &g.palm.finger_plane(f.height_mm));
     let (x, y) = bounds(&s);
-    let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
     let als = &g.fingers[k].centre;
-    let d1 = phalanx1_direction(als.theta1_deg.to_radians());
-    let j2 = j1 + d1 * hand.phalanx_1.length_mm;
-    let e = Rotation2::new((180.0 - als.theta2_deg).to_radians()) * d1;
-    let tip = j2 + e * hand.phalanx_2.length_mm;
-    let xs = [x.0, x.1, j1.x, j2.x, tip.x, hand.palm.offset_mm];
+    let c = FingerChain::new(hand, als.theta1_deg, als.theta2_deg);
+    let xs = [x.0, x.1, c.j1.x, c.j2.x, c.tip.x, hand.palm.offset_mm];
     let ys = [
         mirror * y.0,
         mirror * y.1,
-        j1.y,
-        j2.y,
-        tip.y,
+        c.j1.y,
+        c.j2.y,
+        c.tip.y,
         -hand.palm.half_width_mm,
     ];
     let xr = (
@@ -259,6 +255,40 @@ pub fn finger(g: &Grasp, hand: &Hand, mesh: &Mesh, k: usize) -> String {
     let palm = [(0.0, -hw), (po, -hw), (po, hw), (0.0, hw)];
     p.fill(&palm, PALM, 0.25, "palm-outline");
     p.line((0.0, -hw), (0.0, hw), PALM, 3.0, false, "palm-contact-line");
+    draw_finger_chain(&mut p, hand, &c);
+    p.legend("object (finger plane slice)", OBJECT);
+    p.legend("palm", PALM);
+    p.legend("phalanx search domains", DOMAIN);
+    p.legend("ALS contact lines", FINGER);
+    p.finish()
+}
+
+/// A finger in its centre plane `[mm]`: joint 1, phalanx 1's direction, joint 2, phalanx 2's
+/// direction and the fingertip.
+struct FingerChain {
+    j1: Point2<f64>,
+    d1: Vector2<f64>,
+    j2: Point2<f64>,
+    e: Vector2<f64>,
+    tip: Point2<f64>,
+}
+
+impl FingerChain {
+    /// The chain of `hand`'s finger at joint angles `theta1_deg`, `theta2_deg`.
+    fn new(hand: &Hand, theta1_deg: f64, theta2_deg: f64) -> FingerChain {
+        let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
+        let d1 = phalanx1_direction(theta1_deg.to_radians());
+        let j2 = j1 + d1 * hand.phalanx_1.length_mm;
+        let e = Rotation2::new((180.0 - theta2_deg).to_radians()) * d1;
+        let tip = j2 + e * hand.phalanx_2.length_mm;
+        FingerChain { j1, d1, j2, e, tip }
+    }
+}
+
+/// The finger `c` on `p`: each phalanx's search domain, the centreline, the ALS contact lines
+/// and the joints.
+fn draw_finger_chain(p: &mut Plot, hand: &Hand, c: &FingerChain) {
+    let FingerChain { j1, d1, j2, e, tip } = *c;
     let o = hand.fingers.offset_mm;
     let p1 = &hand.phalanx_1;
     let p2 = &hand.phalanx_2;
@@ -300,11 +330,6 @@ pub fn finger(g: &Grasp, hand: &Hand, mesh: &Mesh, k: usize) -> String {
     p.line((c2a.x, c2a.y), (c2b.x, c2b.y), FINGER, 3.0, false, "als");
     p.dot((j1.x, j1.y), 4.0, PALM, "joint");
     p.dot((j2.x, j2.y), 4.0, PALM, "joint");
-    p.legend("object (finger plane slice)", OBJECT);
-    p.legend("palm", PALM);
-    p.legend("phalanx search domains", DOMAIN);
-    p.legend("ALS contact lines", FINGER);
-    p.finish()
 }
 
 /// For an object with no grasp: what decided it. Each constraint that rejected candidates as a

@@ -1,6 +1,6 @@
 //! report.html: one self-contained page (figures inline, no scripts, fonts or network).
 
-use crate::report::{RunReport, SimVerdict};
+use crate::report::{GraspReport, RunReport, SimVerdict};
 
 fn esc(s: &str) -> String {
     s.replace('&', "&amp;")
@@ -58,6 +58,22 @@ fn parameter_set(report: &RunReport) -> String {
         s.push_str("<th>closed theta1 [deg]</th><th>closed theta2 [deg]</th>");
     }
     s.push_str("</tr>");
+    s.push_str(&finger_rows(g, closing));
+    for (k, v) in pose_rows(g) {
+        s.push_str(&format!(
+            "<tr><th>{}</th><td colspan=\"{cols}\">{}</td></tr>",
+            esc(k),
+            esc(&v)
+        ));
+    }
+    s.push_str("</table>");
+    s
+}
+
+/// One table row per finger: its name, planned joint angles and contact, and with the
+/// `closing` the angles it closed to.
+fn finger_rows(g: &GraspReport, closing: Option<&crate::sim::ClosingOutcome>) -> String {
+    let mut s = String::new();
     for (k, f) in g.fingers.iter().enumerate() {
         s.push_str(&format!(
             "<tr><td>{}</td><td>{:.1}</td><td>{:.1}</td><td>{}</td>",
@@ -77,8 +93,13 @@ fn parameter_set(report: &RunReport) -> String {
         }
         s.push_str("</tr>");
     }
+    s
+}
+
+/// The table's rows after the fingers: approach, pitch, elevation, axis and rules, palm pose.
+fn pose_rows(g: &GraspReport) -> [(&'static str, String); 6] {
     let pp = &g.palm_pose;
-    let rows = [
+    [
         ("Approach angle", format!("{:.0} deg", g.approach_angle_deg)),
         (
             "Palm pitch angle",
@@ -109,16 +130,7 @@ fn parameter_set(report: &RunReport) -> String {
                 pp.quaternion_wxyz[3]
             ),
         ),
-    ];
-    for (k, v) in rows {
-        s.push_str(&format!(
-            "<tr><th>{}</th><td colspan=\"{cols}\">{}</td></tr>",
-            esc(k),
-            esc(&v)
-        ));
-    }
-    s.push_str("</table>");
-    s
+    ]
 }
 
 /// The page for one scenario's run: the verdict in words, the Grasp Parameter Set as a table,
@@ -147,6 +159,35 @@ pub fn page(
          .figs{display:flex;flex-wrap:wrap;gap:16px}.fig{border:1px solid #ccc;padding:4px}\
          .verdict{font-size:20px;font-weight:bold}</style></head><body>",
     );
+    s.push_str(&headline(report));
+    let (view_figs, legend) = views;
+    if !view_figs.is_empty() {
+        s.push_str("<h2>The grasp in three views</h2><div class=\"figs\">");
+        for (name, svg) in view_figs {
+            s.push_str(&format!("<div class=\"fig\" id=\"{}\">", esc(name)));
+            s.push_str(svg);
+            s.push_str("</div>");
+        }
+        s.push_str(&format!("</div><p class=\"legend\">{}</p>", esc(legend)));
+    }
+    s.push_str("<h2>Grasp Parameter Set</h2>");
+    s.push_str(&parameter_set(report));
+    s.push_str(&scene_links(scenes));
+    s.push_str("<details><summary>Full summary</summary><pre>");
+    s.push_str(&esc(&report.summary()));
+    s.push_str("</pre></details><h2>Figures</h2><div class=\"figs\">");
+    for (name, svg) in figures {
+        s.push_str(&format!("<div class=\"fig\" id=\"{}\">", esc(name)));
+        s.push_str(svg);
+        s.push_str("</div>");
+    }
+    s.push_str("</div></body></html>\n");
+    s
+}
+
+/// The page's heading, the verdict in words, and the plan's status with the expectation.
+fn headline(report: &RunReport) -> String {
+    let mut s = String::new();
     s.push_str(&format!("<h1>grasp-sim: {}</h1>", esc(&report.scenario)));
     s.push_str(&format!(
         "<p class=\"verdict\">{}</p>",
@@ -169,20 +210,13 @@ pub fn page(
             "no expectation given: nothing judged".to_string()
         }
     ));
-    let (view_figs, legend) = views;
-    if !view_figs.is_empty() {
-        s.push_str("<h2>The grasp in three views</h2><div class=\"figs\">");
-        for (name, svg) in view_figs {
-            s.push_str(&format!("<div class=\"fig\" id=\"{}\">", esc(name)));
-            s.push_str(svg);
-            s.push_str("</div>");
-        }
-        s.push_str(&format!("</div><p class=\"legend\">{}</p>", esc(legend)));
-    }
-    s.push_str("<h2>Grasp Parameter Set</h2>");
-    s.push_str(&parameter_set(report));
+    s
+}
+
+/// The links to the 3D scenes written, each saying what it shows; or that there are none.
+fn scene_links(scenes: &[&str]) -> String {
     if scenes.is_empty() {
-        s.push_str("<p>3D scenes: none (no grasp to show).</p>");
+        "<p>3D scenes: none (no grasp to show).</p>".to_string()
     } else {
         let links: Vec<String> = scenes
             .iter()
@@ -195,19 +229,9 @@ pub fn page(
                 format!("<a href=\"{f}\">{f}</a> ({what})")
             })
             .collect();
-        s.push_str(&format!(
+        format!(
             "<p>3D scenes: {}; they open in any glTF viewer.</p>",
             links.join(", ")
-        ));
+        )
     }
-    s.push_str("<details><summary>Full summary</summary><pre>");
-    s.push_str(&esc(&report.summary()));
-    s.push_str("</pre></details><h2>Figures</h2><div class=\"figs\">");
-    for (name, svg) in figures {
-        s.push_str(&format!("<div class=\"fig\" id=\"{}\">", esc(name)));
-        s.push_str(svg);
-        s.push_str("</div>");
-    }
-    s.push_str("</div></body></html>\n");
-    s
 }

@@ -7,6 +7,7 @@ pub mod html;
 pub mod svg;
 pub mod views;
 
+use crate::export::ExportError;
 use crate::hand::Hand;
 use crate::mesh::Mesh;
 use crate::plan::search::Grasp;
@@ -36,50 +37,12 @@ pub fn write_report(
     mesh: &Mesh,
     hand: &Hand,
     simulated: Option<SimulatedPoses>,
-) -> Result<Vec<String>, crate::export::ExportError> {
+) -> Result<Vec<String>, ExportError> {
     let closed = simulated.map(|s| s.closed);
     let simulated = simulated.map(|s| s.end);
-    let err = |path: &Path, e: std::io::Error| crate::export::ExportError {
-        path: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
-    let mut figs: Vec<(String, String)> = vec![
-        (
-            "effective_elevation".to_string(),
-            figures::effective_elevation(graded),
-        ),
-        (
-            "grades_curvature".to_string(),
-            figures::grades(graded, "curvature"),
-        ),
-        (
-            "grades_diameter".to_string(),
-            figures::grades(graded, "diameter"),
-        ),
-        (
-            "grades_combined".to_string(),
-            figures::grades(graded, "combined"),
-        ),
-        ("grades_palm".to_string(), figures::grades(graded, "palm")),
-    ];
-    if grasp.is_none() {
-        figs.push(("rejections".to_string(), figures::rejections(report)));
-    }
-    if let Some(g) = grasp {
-        figs.push(("palm".to_string(), figures::palm(g, hand)));
-        figs.push(("finger_planes".to_string(), figures::finger_planes(g, hand)));
-        for (k, f) in hand.finger_list.iter().enumerate() {
-            figs.push((
-                format!("finger_{}", f.name.trim_start_matches("finger_")),
-                figures::finger(g, hand, mesh, k),
-            ));
-        }
-    }
-    for (name, svg) in &figs {
-        let path = dir.join(format!("{name}.svg"));
-        std::fs::write(&path, svg).map_err(|e| err(&path, e))?;
-    }
+    std::fs::create_dir_all(dir).map_err(|e| export_error(dir, e))?;
+    let figs = stage_figures(report, graded, grasp, mesh, hand);
+    write_svgs(dir, &figs)?;
     // The three views of the grasp (issue 33): planned and closed hand over the object.
     let mut view_figs: Vec<(String, String)> = Vec::new();
     let mut view_legend = String::new();
@@ -107,36 +70,105 @@ pub fn write_report(
         view_legend = views::page_legend(&scene);
         view_figs = views::render(&scene);
     }
-    for (name, svg) in &view_figs {
-        let path = dir.join(format!("{name}.svg"));
-        std::fs::write(&path, svg).map_err(|e| err(&path, e))?;
-    }
-    let mut scenes: Vec<&str> = Vec::new();
-    if let Some(planned) = &planned {
-        let mut bodies = glb::hand_bodies(hand, planned);
-        bodies.push(glb::object_body(
-            mesh,
-            nalgebra::Vector3::zeros(),
-            nalgebra::UnitQuaternion::identity(),
-        ));
-        let path = dir.join("grasp_planned.glb");
-        std::fs::write(&path, glb::glb(&bodies)).map_err(|e| err(&path, e))?;
-        scenes.push("grasp_planned.glb");
-        if let Some(poses) = simulated.filter(|p| p.len() == planned.len() + 1) {
-            let mut bodies = glb::hand_bodies(hand, &poses[..planned.len()]);
-            let (t, r) = poses[planned.len()];
-            bodies.push(glb::object_body(mesh, t, r));
-            let path = dir.join("grasp_simulated.glb");
-            std::fs::write(&path, glb::glb(&bodies)).map_err(|e| err(&path, e))?;
-            scenes.push("grasp_simulated.glb");
-        }
-    }
-    // A re-run into an old folder must not leave a scene (or a figure) this run did not make.
+    write_svgs(dir, &view_figs)?;
+    let scenes = match &planned {
+        Some(planned) => write_scenes(dir, mesh, hand, planned, simulated)?,
+        None => Vec::new(),
+    };
     let written: Vec<String> = figs
         .iter()
         .chain(&view_figs)
         .map(|(n, _)| format!("{n}.svg"))
         .collect();
+    remove_stale(dir, &written, &scenes)?;
+    let path = dir.join("report.html");
+    let page = html::page(report, &figs, &scenes, (&view_figs, &view_legend));
+    std::fs::write(&path, page).map_err(|e| export_error(&path, e))?;
+    Ok(figs.into_iter().chain(view_figs).map(|(n, _)| n).collect())
+}
+
+/// The error of writing `path`.
+fn export_error(path: &Path, e: std::io::Error) -> ExportError {
+    ExportError {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    }
+}
+
+/// The stage figures, named: the Effective Elevation and the four grades; then the palm, the
+/// finger planes and each finger for a grasp, or the rejections without one.
+fn stage_figures(
+    report: &RunReport,
+    graded: &GradedDomain,
+    grasp: Option<&Grasp>,
+    mesh: &Mesh,
+    hand: &Hand,
+) -> Vec<(String, String)> {
+    let mut figs: Vec<(String, String)> = vec![(
+        "effective_elevation".to_string(),
+        figures::effective_elevation(graded),
+    )];
+    for which in ["curvature", "diameter", "combined", "palm"] {
+        figs.push((format!("grades_{which}"), figures::grades(graded, which)));
+    }
+    if grasp.is_none() {
+        figs.push(("rejections".to_string(), figures::rejections(report)));
+    }
+    if let Some(g) = grasp {
+        figs.push(("palm".to_string(), figures::palm(g, hand)));
+        figs.push(("finger_planes".to_string(), figures::finger_planes(g, hand)));
+        for (k, f) in hand.finger_list.iter().enumerate() {
+            figs.push((
+                format!("finger_{}", f.name.trim_start_matches("finger_")),
+                figures::finger(g, hand, mesh, k),
+            ));
+        }
+    }
+    figs
+}
+
+/// Writes each figure as `dir/<name>.svg`.
+fn write_svgs(dir: &Path, figs: &[(String, String)]) -> Result<(), ExportError> {
+    for (name, svg) in figs {
+        let path = dir.join(format!("{name}.svg"));
+        std::fs::write(&path, svg).map_err(|e| export_error(&path, e))?;
+    }
+    Ok(())
+}
+
+/// Writes the planned glTF scene and, when the physics check left every body's pose, the
+/// simulated one; returns their file names.
+fn write_scenes(
+    dir: &Path,
+    mesh: &Mesh,
+    hand: &Hand,
+    planned: &[crate::sim::BodyPose],
+    simulated: Option<&[crate::sim::BodyPose]>,
+) -> Result<Vec<&'static str>, ExportError> {
+    let mut scenes = Vec::new();
+    let mut bodies = glb::hand_bodies(hand, planned);
+    bodies.push(glb::object_body(
+        mesh,
+        nalgebra::Vector3::zeros(),
+        nalgebra::UnitQuaternion::identity(),
+    ));
+    let path = dir.join("grasp_planned.glb");
+    std::fs::write(&path, glb::glb(&bodies)).map_err(|e| export_error(&path, e))?;
+    scenes.push("grasp_planned.glb");
+    if let Some(poses) = simulated.filter(|p| p.len() == planned.len() + 1) {
+        let mut bodies = glb::hand_bodies(hand, &poses[..planned.len()]);
+        let (t, r) = poses[planned.len()];
+        bodies.push(glb::object_body(mesh, t, r));
+        let path = dir.join("grasp_simulated.glb");
+        std::fs::write(&path, glb::glb(&bodies)).map_err(|e| export_error(&path, e))?;
+        scenes.push("grasp_simulated.glb");
+    }
+    Ok(scenes)
+}
+
+/// Removes the figures and scenes an earlier run left in `dir` that this run did not make
+/// (`written` figures, `scenes`): a re-run into an old folder must not show them.
+fn remove_stale(dir: &Path, written: &[String], scenes: &[&str]) -> Result<(), ExportError> {
     for stale in [
         "grasp_planned.glb",
         "grasp_simulated.glb",
@@ -153,11 +185,8 @@ pub fn write_report(
         let path = dir.join(stale);
         let made = written.iter().any(|w| w == stale) || scenes.contains(&stale);
         if !made && path.exists() {
-            std::fs::remove_file(&path).map_err(|e| err(&path, e))?;
+            std::fs::remove_file(&path).map_err(|e| export_error(&path, e))?;
         }
     }
-    let path = dir.join("report.html");
-    let page = html::page(report, &figs, &scenes, (&view_figs, &view_legend));
-    std::fs::write(&path, page).map_err(|e| err(&path, e))?;
-    Ok(figs.into_iter().chain(view_figs).map(|(n, _)| n).collect())
+    Ok(())
 }

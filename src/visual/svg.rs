@@ -211,9 +211,38 @@ impl Plot {
     /// coordinates is clipped to the frame, so nothing spills over the titles.
     pub fn finish(&self) -> String {
         let mut s = String::new();
-        let (w, h0) = (self.width, self.height);
-        let band = legend_band(&self.legend, w);
-        let h = h0 + band.height;
+        let band = legend_band(&self.legend, self.width);
+        self.write_title_and_legend(&mut s, &band);
+        let _ = writeln!(s, "<g transform=\"translate(0 {:.0})\">", band.height);
+        // The frame in pixels, within the plot's own height (below the legend band).
+        let frame = (
+            self.margin.0,
+            self.width - self.margin.1,
+            self.margin.2,
+            self.height - self.margin.3,
+        );
+        self.write_frame_and_ticks(&mut s, frame);
+        self.write_axis_labels(&mut s, frame);
+        let (l, r, t, b) = frame;
+        // A clip id unique to this figure (the page inlines several SVGs, and ids are global
+        // there), derived from the title so that the output is deterministic.
+        let id = format!("frame-{:016x}", fnv1a(self.title.as_bytes()));
+        let _ = writeln!(
+            s,
+            "<clipPath id=\"{id}\"><rect x=\"{l:.1}\" y=\"{t:.1}\" width=\"{:.1}\" height=\"{:.1}\"/></clipPath>",
+            r - l,
+            b - t
+        );
+        let _ = writeln!(s, "<g clip-path=\"url(#{id})\">");
+        s.push_str(&self.body);
+        s.push_str("</g>\n</g>\n</svg>\n");
+        s
+    }
+
+    /// The document's opening tag (its height with the legend `band`), the white background,
+    /// the title, and the legend entries.
+    fn write_title_and_legend(&self, s: &mut String, band: &LegendBand) {
+        let (w, h) = (self.width, self.height + band.height);
         let _ = writeln!(
             s,
             "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w:.0}\" height=\"{h:.0}\" viewBox=\"0 0 {w:.0} {h:.0}\">"
@@ -235,15 +264,11 @@ impl Plot {
                 esc(label)
             );
         }
-        let _ = writeln!(s, "<g transform=\"translate(0 {:.0})\">", band.height);
-        let h = h0;
-        // Frame, ticks and grid.
-        let (l, r, t, b) = (
-            self.margin.0,
-            w - self.margin.1,
-            self.margin.2,
-            h - self.margin.3,
-        );
+    }
+
+    /// The plot frame (`left, right, top, bottom` in pixels), with a grid line and a label at
+    /// each tick of both axes.
+    fn write_frame_and_ticks(&self, s: &mut String, (l, r, t, b): (f64, f64, f64, f64)) {
         let _ = writeln!(
             s,
             "<rect x=\"{l:.1}\" y=\"{t:.1}\" width=\"{:.1}\" height=\"{:.1}\" fill=\"none\" stroke=\"black\"/>",
@@ -275,11 +300,15 @@ impl Plot {
             );
             v += sy;
         }
+    }
+
+    /// The x axis's label under the frame and the y axis's, turned, left of it.
+    fn write_axis_labels(&self, s: &mut String, (l, r, t, b): (f64, f64, f64, f64)) {
         let _ = writeln!(
             s,
             "<text x=\"{:.0}\" y=\"{:.0}\" font-size=\"12\" font-family=\"sans-serif\" text-anchor=\"middle\">{}</text>",
             (l + r) / 2.0,
-            h - 12.0,
+            self.height - 12.0,
             esc(&self.labels.0)
         );
         let _ = writeln!(
@@ -289,19 +318,6 @@ impl Plot {
             (t + b) / 2.0,
             esc(&self.labels.1)
         );
-        // A clip id unique to this figure (the page inlines several SVGs, and ids are global
-        // there), derived from the title so that the output is deterministic.
-        let id = format!("frame-{:016x}", fnv1a(self.title.as_bytes()));
-        let _ = writeln!(
-            s,
-            "<clipPath id=\"{id}\"><rect x=\"{l:.1}\" y=\"{t:.1}\" width=\"{:.1}\" height=\"{:.1}\"/></clipPath>",
-            r - l,
-            b - t
-        );
-        let _ = writeln!(s, "<g clip-path=\"url(#{id})\">");
-        s.push_str(&self.body);
-        s.push_str("</g>\n</g>\n</svg>\n");
-        s
     }
 }
 

@@ -177,6 +177,7 @@ pub fn render(scene: &Scene) -> Vec<(String, String)> {
         .collect()
 }
 
+/// One view of the scene as SVG.
 fn render_one(scene: &Scene, view: &View) -> String {
     let planned = to_mm(scene.planned);
     let palm_rotation = planned.first().map_or(UnitQuaternion::identity(), |p| p.1);
@@ -190,58 +191,11 @@ fn render_one(scene: &Scene, view: &View) -> String {
         .map_or((Point3::origin(), UnitQuaternion::identity()), |c| {
             c[n_hand]
         });
-    let mut faces: Vec<Face> = Vec::new();
     // The object, where the closing left it (at its planned place when not checked).
-    let place = |p: &Point3<f64>, pose: &BodyPose| pose.0 + pose.1 * p.coords;
-    let moved: Vec<Point3<f64>> = scene
-        .mesh
-        .vertices
-        .iter()
-        .map(|p| place(p, &object_pose))
-        .collect();
-    for t in &scene.mesh.triangles {
-        let [a, b, c] = t.map(|i| {
-            moved
-                .get(i as usize)
-                .copied()
-                .unwrap_or_else(Point3::origin)
-        });
-        let n = (b - a).cross(&(c - a));
-        let Some(n) = n.try_normalize(1e-12) else {
-            continue;
-        };
-        faces.push(Face {
-            points: vec![proj.page(&a), proj.page(&b), proj.page(&c)],
-            depth: proj.depth(&Point3::from((a.coords + b.coords + c.coords) / 3.0)),
-            fill: shade(&n, &light, [0.82, 0.82, 0.78]),
-            opacity: 1.0,
-        });
-    }
+    let mut faces = object_faces(scene.mesh, &object_pose, &proj, &light);
     // The hand where the closing left it (or as planned when not checked), filled.
     let hand_poses = closed.as_ref().map_or(&planned[..], |c| &c[..n_hand]);
-    for (body, b) in &boxes {
-        let Some(pose) = hand_poses.get(*body) else {
-            continue;
-        };
-        let c = corners(b, pose);
-        let base = if *body == 0 {
-            [0.35, 0.55, 0.9]
-        } else {
-            [0.9, 0.4, 0.3]
-        };
-        for f in BOX_FACES {
-            let pts: Vec<Point3<f64>> = f.iter().map(|&i| c[i]).collect();
-            let n = (pts[1] - pts[0]).cross(&(pts[2] - pts[0]));
-            let n = n.try_normalize(1e-12).unwrap_or_else(Vector3::z);
-            let centre = pts.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / 4.0;
-            faces.push(Face {
-                points: pts.iter().map(|p| proj.page(p)).collect(),
-                depth: proj.depth(&Point3::from(centre)),
-                fill: shade(&n, &light, base),
-                opacity: 0.92,
-            });
-        }
-    }
+    faces.extend(hand_faces(&boxes, hand_poses, &proj, &light));
     // Far to near; a stable sort keeps input order on ties, so the page is the same each run.
     faces.sort_by(|a, b| b.depth.total_cmp(&a.depth));
     // The planned hand's edges, and the object's silhouette where the closing started from.
@@ -261,6 +215,72 @@ fn render_one(scene: &Scene, view: &View) -> String {
         }
     }
     draw(scene, view, &faces, &dashed)
+}
+
+/// The object's triangles posed by `pose`, projected and shaded (degenerate ones left out).
+fn object_faces(
+    mesh: &Mesh,
+    pose: &BodyPose,
+    proj: &Projection,
+    light: &Vector3<f64>,
+) -> Vec<Face> {
+    let place = |p: &Point3<f64>| pose.0 + pose.1 * p.coords;
+    let moved: Vec<Point3<f64>> = mesh.vertices.iter().map(place).collect();
+    let mut faces = Vec::with_capacity(mesh.triangles.len());
+    for t in &mesh.triangles {
+        let [a, b, c] = t.map(|i| {
+            moved
+                .get(i as usize)
+                .copied()
+                .unwrap_or_else(Point3::origin)
+        });
+        let n = (b - a).cross(&(c - a));
+        let Some(n) = n.try_normalize(1e-12) else {
+            continue;
+        };
+        faces.push(Face {
+            points: vec![proj.page(&a), proj.page(&b), proj.page(&c)],
+            depth: proj.depth(&Point3::from((a.coords + b.coords + c.coords) / 3.0)),
+            fill: shade(&n, light, [0.82, 0.82, 0.78]),
+            opacity: 1.0,
+        });
+    }
+    faces
+}
+
+/// The faces of the hand's `boxes` at `poses`, projected and shaded: the palm blue, the
+/// phalanges red.
+fn hand_faces(
+    boxes: &[(usize, HandBox)],
+    poses: &[BodyPose],
+    proj: &Projection,
+    light: &Vector3<f64>,
+) -> Vec<Face> {
+    let mut faces = Vec::new();
+    for (body, b) in boxes {
+        let Some(pose) = poses.get(*body) else {
+            continue;
+        };
+        let c = corners(b, pose);
+        let base = if *body == 0 {
+            [0.35, 0.55, 0.9]
+        } else {
+            [0.9, 0.4, 0.3]
+        };
+        for f in BOX_FACES {
+            let pts: Vec<Point3<f64>> = f.iter().map(|&i| c[i]).collect();
+            let n = (pts[1] - pts[0]).cross(&(pts[2] - pts[0]));
+            let n = n.try_normalize(1e-12).unwrap_or_else(Vector3::z);
+            let centre = pts.iter().fold(Vector3::zeros(), |s, p| s + p.coords) / 4.0;
+            faces.push(Face {
+                points: pts.iter().map(|p| proj.page(p)).collect(),
+                depth: proj.depth(&Point3::from(centre)),
+                fill: shade(&n, light, base),
+                opacity: 0.92,
+            });
+        }
+    }
+    faces
 }
 
 /// The mesh's silhouette edges seen along `look` (at its planned place): edges between a face
@@ -293,37 +313,63 @@ fn silhouette(mesh: &Mesh, look: &Vector3<f64>) -> Vec<(Point3<f64>, Point3<f64>
         .collect()
 }
 
+/// The page's size `[px]` and its fit of the drawing: view coordinates `[mm]` to pixels.
+struct Page {
+    w: f64,
+    h: f64,
+    top: f64,
+    bottom: f64,
+    scale: f64,
+    centre: (f64, f64),
+}
+
+impl Page {
+    /// The page that fits every face and dashed line, centred (a unit square when there is
+    /// nothing to draw).
+    fn fitting(faces: &[Face], dashed: &[Segment]) -> Page {
+        let (mut lo, mut hi) = (
+            (f64::INFINITY, f64::INFINITY),
+            (f64::NEG_INFINITY, f64::NEG_INFINITY),
+        );
+        let mut grow = |p: &(f64, f64)| {
+            lo = (lo.0.min(p.0), lo.1.min(p.1));
+            hi = (hi.0.max(p.0), hi.1.max(p.1));
+        };
+        faces.iter().flat_map(|f| &f.points).for_each(&mut grow);
+        dashed.iter().for_each(|(a, b, _)| {
+            grow(a);
+            grow(b);
+        });
+        if !(lo.0.is_finite() && hi.0.is_finite()) {
+            lo = (-1.0, -1.0);
+            hi = (1.0, 1.0);
+        }
+        let (w, h): (f64, f64) = (420.0, 440.0);
+        let (top, bottom): (f64, f64) = (30.0, 48.0);
+        let span = (hi.0 - lo.0).max(hi.1 - lo.1).max(1e-6);
+        Page {
+            w,
+            h,
+            top,
+            bottom,
+            scale: (w - 20.0).min(h - top - bottom) / span,
+            centre: ((lo.0 + hi.0) / 2.0, (lo.1 + hi.1) / 2.0),
+        }
+    }
+
+    /// The pixel of view point `p` (page y down).
+    fn px(&self, p: &(f64, f64)) -> (f64, f64) {
+        (
+            self.w / 2.0 + (p.0 - self.centre.0) * self.scale,
+            self.top + (self.h - self.top - self.bottom) / 2.0 - (p.1 - self.centre.1) * self.scale,
+        )
+    }
+}
+
 /// The SVG page: title, the faces, the dashed lines, a 10 mm scale bar and the legend.
 fn draw(scene: &Scene, view: &View, faces: &[Face], dashed: &[Segment]) -> String {
-    let (mut lo, mut hi) = (
-        (f64::INFINITY, f64::INFINITY),
-        (f64::NEG_INFINITY, f64::NEG_INFINITY),
-    );
-    let mut grow = |p: &(f64, f64)| {
-        lo = (lo.0.min(p.0), lo.1.min(p.1));
-        hi = (hi.0.max(p.0), hi.1.max(p.1));
-    };
-    faces.iter().flat_map(|f| &f.points).for_each(&mut grow);
-    dashed.iter().for_each(|(a, b, _)| {
-        grow(a);
-        grow(b);
-    });
-    if !(lo.0.is_finite() && hi.0.is_finite()) {
-        lo = (-1.0, -1.0);
-        hi = (1.0, 1.0);
-    }
-    let (w, h): (f64, f64) = (420.0, 440.0);
-    let (top, bottom): (f64, f64) = (30.0, 48.0);
-    let span = (hi.0 - lo.0).max(hi.1 - lo.1).max(1e-6);
-    let scale = (w - 20.0).min(h - top - bottom) / span;
-    let cx = (lo.0 + hi.0) / 2.0;
-    let cy = (lo.1 + hi.1) / 2.0;
-    let px = |p: &(f64, f64)| {
-        (
-            w / 2.0 + (p.0 - cx) * scale,
-            top + (h - top - bottom) / 2.0 - (p.1 - cy) * scale,
-        )
-    };
+    let page = Page::fitting(faces, dashed);
+    let (w, h) = (page.w, page.h);
     let mut s = String::new();
     let _ = write!(
         s,
@@ -341,7 +387,7 @@ fn draw(scene: &Scene, view: &View, faces: &[Face], dashed: &[Segment]) -> Strin
             .points
             .iter()
             .map(|p| {
-                let (x, y) = px(p);
+                let (x, y) = page.px(p);
                 format!("{x:.1},{y:.1}")
             })
             .collect();
@@ -359,7 +405,7 @@ fn draw(scene: &Scene, view: &View, faces: &[Face], dashed: &[Segment]) -> Strin
         "</g><g fill=\"none\" stroke-width=\"1.2\" stroke-dasharray=\"4 3\">"
     );
     for (a, b, colour) in dashed {
-        let (a, b) = (px(a), px(b));
+        let (a, b) = (page.px(a), page.px(b));
         let _ = write!(
             s,
             "<line x1=\"{:.1}\" y1=\"{:.1}\" x2=\"{:.1}\" y2=\"{:.1}\" stroke=\"{colour}\"/>",
@@ -368,8 +414,8 @@ fn draw(scene: &Scene, view: &View, faces: &[Face], dashed: &[Segment]) -> Strin
     }
     let _ = write!(s, "</g>");
     // A 10 mm scale bar.
-    let bar = 10.0 * scale;
-    let y = h - bottom + 14.0;
+    let bar = 10.0 * page.scale;
+    let y = h - page.bottom + 14.0;
     let _ = write!(
         s,
         "<line x1=\"8\" y1=\"{y:.1}\" x2=\"{:.1}\" y2=\"{y:.1}\" stroke=\"black\" stroke-width=\"2\"/><text x=\"{:.1}\" y=\"{:.1}\" font-size=\"11\">10 mm</text>",
