@@ -78,10 +78,7 @@ impl Summary {
     /// [`BatchError::Io`] when it cannot be read; [`BatchError::NotARecord`] for a complete
     /// line that is not a run report or an error line (naming its line number).
     pub fn read(path: &Path) -> Result<Summary, BatchError> {
-        let bytes = std::fs::read(path).map_err(|e| BatchError::Io {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+        let bytes = std::fs::read(path).map_err(|e| BatchError::io(path, e))?;
         Summary::parse(path, &bytes)
     }
 

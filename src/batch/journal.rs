@@ -30,7 +30,7 @@ pub struct ReadRecords {
 /// [`BatchError::Io`] when the file cannot be read, [`BatchError::NotARecord`] for a complete
 /// line that is not a batch record.
 pub fn read_records(path: &Path) -> Result<ReadRecords, BatchError> {
-    let bytes = std::fs::read(path).map_err(|e| BatchError::io(path, &e))?;
+    let bytes = std::fs::read(path).map_err(|e| BatchError::io(path, e))?;
     parse_records(path, &bytes)
 }
 
@@ -78,13 +78,13 @@ impl Journal {
             .append(true)
             .create(true)
             .open(path)
-            .map_err(|e| BatchError::io(path, &e))?;
+            .map_err(|e| BatchError::io(path, e))?;
         lock(&file, path)?;
-        let bytes = std::fs::read(path).map_err(|e| BatchError::io(path, &e))?;
+        let bytes = std::fs::read(path).map_err(|e| BatchError::io(path, e))?;
         let read = parse_records(path, &bytes)?;
         if read.partial_bytes > 0 {
             file.set_len((bytes.len() - read.partial_bytes) as u64)
-                .map_err(|e| BatchError::io(path, &e))?;
+                .map_err(|e| BatchError::io(path, e))?;
         }
         Ok((
             Journal {
@@ -106,7 +106,7 @@ impl Journal {
         let mut file = self.file.lock().unwrap_or_else(|p| p.into_inner());
         file.write_all(&buf)
             .and_then(|()| file.sync_data())
-            .map_err(|e| BatchError::io(&self.path, &e))
+            .map_err(|e| BatchError::io(&self.path, e))
     }
 
     /// Replaces the file with `bytes` (the records in input order), atomically, and releases
@@ -142,7 +142,7 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), BatchError> {
         .and_then(|()| std::fs::rename(&tmp, path))
         .map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
-            BatchError::io(path, &e)
+            BatchError::io(path, e)
         })
 }
 

@@ -37,12 +37,16 @@ use std::time::Instant;
 #[derive(Debug, thiserror::Error)]
 pub enum BatchError {
     /// The file cannot be read or written.
-    #[error("{}: {message}", path.display())]
+    ///
+    /// Its message names the file; the I/O error is its source, so that a report of the error
+    /// chain (anyhow's `{:#}`, as the binary prints errors) reads `<file>: <the I/O error>`.
+    #[error("{}", path.display())]
     Io {
         /// The file.
         path: PathBuf,
         /// What went wrong.
-        message: String,
+        #[source]
+        source: std::io::Error,
     },
     /// A complete line that is not a batch record.
     #[error("{}: line {line} is not a batch record: {why}", path.display())]
@@ -66,10 +70,11 @@ pub enum BatchError {
 }
 
 impl BatchError {
-    fn io(path: &Path, e: &std::io::Error) -> BatchError {
+    /// The error `source` of reading or writing `path`.
+    pub(crate) fn io(path: &Path, source: std::io::Error) -> BatchError {
         BatchError::Io {
             path: path.to_path_buf(),
-            message: e.to_string(),
+            source,
         }
     }
 }

@@ -5,8 +5,8 @@
 //! A line is the run report (DESIGN.md §6) or `{"scenario", "error"}` for an object that could
 //! not be run, plus `"batch": {"input", "input_hash", "wall_ms"}`. The hash covers the scenario
 //! file's text, the scenario as parsed (so the hand file and, for a bare mesh, the template and
-//! units are in it), the mesh file's bytes, the run options and the grasp-sim version: an input
-//! edited since its line was written does not match it and is run again.
+//! units are in it), the mesh file's bytes, the run options (as JSON) and the grasp-sim
+//! version: an input edited since its line was written does not match it and is run again.
 
 use super::Item;
 use crate::report::{to_rounded_json, ErrorView, RecordView, RunReport};
@@ -149,6 +149,51 @@ impl Record {
     }
 }
 
+/// The run options that decide a result, as hashed: every field of [`RunOptions`] but
+/// `folder` (where the outputs go does not change what is computed), the paths as their bytes
+/// (so that any path, UTF-8 or not, serializes). A field added to `RunOptions` that changes
+/// results belongs here.
+#[derive(Serialize)]
+struct HashedOptions<'a> {
+    no_sim: bool,
+    payload: bool,
+    quality: bool,
+    candidates: usize,
+    max_checked: Option<usize>,
+    export_mjcf: Option<&'a [u8]>,
+    export_urdf: Option<&'a [u8]>,
+    report: Option<&'a [u8]>,
+}
+
+/// `options` as hashed: [`HashedOptions`] as JSON.
+fn options_json<'a>(options: &'a RunOptions) -> Vec<u8> {
+    let RunOptions {
+        no_sim,
+        payload,
+        quality,
+        candidates,
+        max_checked,
+        ref export_mjcf,
+        ref export_urdf,
+        ref report,
+        folder: _,
+    } = *options;
+    let bytes =
+        |p: &'a Option<std::path::PathBuf>| p.as_ref().map(|p| p.as_os_str().as_encoded_bytes());
+    let hashed = HashedOptions {
+        no_sim,
+        payload,
+        quality,
+        candidates,
+        max_checked,
+        export_mjcf: bytes(export_mjcf),
+        export_urdf: bytes(export_urdf),
+        report: bytes(report),
+    };
+    // Booleans, numbers and lists of bytes: serializing them cannot fail.
+    serde_json::to_vec(&hashed).unwrap_or_default()
+}
+
 /// The hash of everything that decides an item's result (see the module docs), as
 /// `sha256:<hex>`.
 pub fn input_hash(item: &Item, template: &Scenario, options: &RunOptions) -> String {
@@ -159,7 +204,7 @@ pub fn input_hash(item: &Item, template: &Scenario, options: &RunOptions) -> Str
         h.update(bytes);
     };
     part("grasp-sim", env!("CARGO_PKG_VERSION").as_bytes());
-    part("options", format!("{options:?}").as_bytes());
+    part("options", &options_json(options));
     if let Item::Scenario(p) = item {
         match std::fs::read(p) {
             Ok(text) => part("scenario file", &text),
