@@ -298,6 +298,12 @@ mod tests {
             ..RunOptions::default()
         };
         assert_ne!(h2, input_hash(&item, &template, &no_sim));
+        // Where the outputs go does not decide the result.
+        let elsewhere = RunOptions {
+            folder: Some("elsewhere".to_string()),
+            ..RunOptions::default()
+        };
+        assert_eq!(h2, input_hash(&item, &template, &elsewhere));
         let mut inch = template.clone();
         inch.object.units = crate::mesh::LengthUnit::Inch;
         assert_ne!(h2, input_hash(&item, &inch, &opts));
