@@ -10,6 +10,8 @@
 //! and the HeightStep) is built once per distinct pair of those; a grasp that two settings both
 //! produce is simulated once (its physics does not depend on how it was found).
 
+pub mod command;
+
 use crate::batch::{scenario_for, Item};
 use crate::mesh::AlignedObject;
 use crate::plan::{self, Domain};
