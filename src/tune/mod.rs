@@ -308,7 +308,13 @@ struct Prepared {
 }
 
 /// A simulated grasp: verdict, translation, payload margin of a hold, and the outcome.
-type Simulated = (Verdict, f64, Option<f64>, sim::SimOutcome);
+#[derive(Clone)]
+struct Simulated {
+    /// The check's outcome.
+    outcome: sim::SimOutcome,
+    /// The payload margin, for a grasp that held.
+    payload_margin: Option<f64>,
+}
 
 /// Simulated grasps by (axis, fingerprint).
 type SimCache = HashMap<(crate::mesh::GraspAxis, Vec<u64>), Simulated>;
@@ -330,7 +336,10 @@ fn simulate(
     let out = sim::check(&case);
     counters.sim_runs += 1;
     let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
-    let o = (out.verdict, out.translation_mm, margin, out);
+    let o = Simulated {
+        outcome: out,
+        payload_margin: margin,
+    };
     sims.insert(key, o.clone());
     o
 }
@@ -543,9 +552,9 @@ fn object_result(
     ObjectResult {
         scenario: p.scenario.name.clone(),
         status,
-        verdict: outcome.map(|o| o.0),
-        translation_mm: outcome.map(|o| o.1),
-        payload_margin: outcome.and_then(|o| o.2),
+        verdict: outcome.map(|o| o.outcome.verdict),
+        translation_mm: outcome.map(|o| o.outcome.translation_mm),
+        payload_margin: outcome.and_then(|o| o.payload_margin),
         reason,
     }
 }
@@ -609,11 +618,7 @@ fn run_planned(
         let key = (a.axis, fingerprint(&pose));
         let (sims, counters) = &mut *cache.borrow_mut();
         let o = simulate(p, &pose, &shape, key, sims, counters);
-        sim::SimOutcome {
-            verdict: o.0,
-            translation_mm: o.1,
-            ..o.3
-        }
+        o.outcome
     };
     let mut t = StageTimings::default();
     let selection = crate::select::select(
