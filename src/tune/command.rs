@@ -32,6 +32,19 @@ pub struct Request {
 /// # Errors
 /// A bad template or input list, an output that cannot be written, or every setting invalid.
 pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
+    let settings = super::grid_size(&request.sweeps);
+    if settings > super::MAX_SETTINGS {
+        let sizes: Vec<String> = request
+            .sweeps
+            .iter()
+            .map(|s| s.values.len().to_string())
+            .collect();
+        anyhow::bail!(
+            "--param: the grid has {settings} settings ({}); at most {} are run, so sweep fewer values",
+            sizes.join(" x "),
+            super::MAX_SETTINGS
+        );
+    }
     let template = match &request.template {
         Some(p) => Scenario::load(p)?,
         None => batch::default_template(),

@@ -194,6 +194,17 @@ impl std::str::FromStr for Sweep {
     }
 }
 
+/// The most settings a tuning grid may have: each is a plan and a physics check per object, and
+/// the grid is held in memory (three sweeps of 1000 values each would be 10⁹ settings).
+pub const MAX_SETTINGS: usize = 10_000;
+
+/// How many settings the sweeps make (their values' product, saturating).
+pub fn grid_size(sweeps: &[Sweep]) -> usize {
+    sweeps
+        .iter()
+        .fold(1usize, |n, s| n.saturating_mul(s.values.len()))
+}
+
 /// Every combination of the sweeps' values, the first sweep varying slowest.
 pub fn grid(sweeps: &[Sweep]) -> Vec<Vec<f64>> {
     let mut out = vec![Vec::new()];
