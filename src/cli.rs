@@ -146,6 +146,12 @@ pub struct Cli {
     #[arg(long, value_name = "DIRECTIONS", value_enum)]
     pub gravity: Option<Gravity>,
 
+    /// Stop waiting for an input after this many seconds: its line is an error and the next
+    /// input runs (a backstop; no input the planner's budget admits comes near it).
+    #[arg(long, value_name = "SECONDS", value_parser = positive_seconds,
+          default_value_t = grasp_sim::pipeline::inputs::DEFAULT_TIME_LIMIT_S)]
+    pub time_limit: f64,
+
     #[command(subcommand)]
     pub command: Option<Command>,
 }

@@ -97,6 +97,7 @@ fn run_inputs(cli: cli::Cli) -> anyhow::Result<u8> {
         units: cli.units.into(),
         gravity: cli.gravity.map(GravityMode::from),
         json: cli.json,
+        time_limit: Some(std::time::Duration::from_secs_f64(cli.time_limit)),
     };
     let mut out = std::io::stdout().lock();
     inputs::run_inputs(&cli.scenarios, &command_line, &mut out, &spinner)

@@ -23,6 +23,24 @@ pub struct CommandLine {
     pub gravity: Option<GravityMode>,
     /// JSON Lines instead of the summary.
     pub json: bool,
+    /// The longest one input may run (`None`: no bound).
+    pub time_limit: Option<std::time::Duration>,
+}
+
+/// The default time bound per input: far above what any input the planner's budget admits
+/// takes (tens of seconds for a 250k-triangle scan with the physics check), a backstop against
+/// an input that would run for ever.
+pub const DEFAULT_TIME_LIMIT_S: f64 = 600.0;
+
+/// Why an input has no report.
+#[derive(Debug)]
+enum Failure {
+    /// Bad input.
+    Error(super::Error),
+    /// A panic inside the run (a bug): the input's line says so and the others still run.
+    Panicked(String),
+    /// No result within the time bound.
+    TimedOut(std::time::Duration),
 }
 
 /// Starts a progress display for one scenario's run and returns what ends it (or nothing).
@@ -59,18 +77,19 @@ pub fn run_inputs(
                 cl.units.name()
             );
         }
-        let ran = batch::scenario_for(&item, &template).and_then(|mut s| {
+        let ran = batch::scenario_for(&item, &template).map(|mut s| {
             if let Some(g) = cl.gravity {
                 s.sim.gravity = g;
             }
             let options = names.options_for(&s, path, &cl.options);
             let finish = spinner(&s, &options);
-            let r = run(&s, &options).map(|r| (r, options.folder));
+            let r = run_bounded(s, options, cl.time_limit);
             if let Some(finish) = finish {
                 finish();
             }
             r
         });
+        let ran = ran.map_err(Failure::Error).and_then(|r| r);
         match ran {
             Ok((report, folder)) => {
                 print_report(&report, folder.as_deref(), cl, out)?;
@@ -78,13 +97,75 @@ pub fn run_inputs(
                     status = status.max(1);
                 }
             }
-            Err(e) => {
+            Err(Failure::Error(e)) => {
                 eprintln!("grasp-sim: error: {}", error_line(&item, path, &e));
+                status = 2;
+            }
+            Err(Failure::Panicked(why)) => {
+                eprintln!("grasp-sim: error: {}: panicked: {why}", path.display());
+                status = 2;
+            }
+            Err(Failure::TimedOut(limit)) => {
+                eprintln!(
+                    "grasp-sim: error: {}: no result within {} s, the time bound per input (--time-limit)",
+                    path.display(),
+                    limit.as_secs_f64()
+                );
                 status = 2;
             }
         }
     }
     Ok(status)
+}
+
+/// Runs one scenario on a thread of its own, waiting at most `limit`: a panic becomes the
+/// input's error, and a run past the bound is left behind (it ends with the process) while the
+/// next input runs. The thread has a large stack, for deeply nested input files.
+fn run_bounded(
+    scenario: Scenario,
+    options: RunOptions,
+    limit: Option<std::time::Duration>,
+) -> Result<(crate::report::RunReport, Option<String>), Failure> {
+    let (send, receive) = std::sync::mpsc::channel();
+    let worker = std::thread::Builder::new()
+        .name(format!("input {}", scenario.name))
+        .stack_size(256 << 20)
+        .spawn(move || {
+            let r = run(&scenario, &options).map(|r| (r, options.folder));
+            let _ = send.send(r);
+        });
+    let worker = match worker {
+        Ok(w) => w,
+        Err(e) => return Err(Failure::Panicked(format!("cannot start a thread: {e}"))),
+    };
+    let received = match limit {
+        Some(limit) => receive.recv_timeout(limit).map_err(|e| match e {
+            std::sync::mpsc::RecvTimeoutError::Timeout => Some(limit),
+            std::sync::mpsc::RecvTimeoutError::Disconnected => None,
+        }),
+        None => receive.recv().map_err(|_| None),
+    };
+    match received {
+        Ok(r) => {
+            let _ = worker.join();
+            r.map_err(Failure::Error)
+        }
+        Err(Some(limit)) => Err(Failure::TimedOut(limit)),
+        // The sender went away without a result: the run panicked.
+        Err(None) => Err(Failure::Panicked(match worker.join() {
+            Err(payload) => panic_message(payload.as_ref()),
+            Ok(()) => "(no result)".to_string(),
+        })),
+    }
+}
+
+/// A panic's message, where it has one.
+fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "(no message)".to_string())
 }
 
 /// The names seen so far: two inputs of one name (every file of a YCB-style set is

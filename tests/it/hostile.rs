@@ -41,3 +41,31 @@ fn a_tune_grid_too_large_in_product_is_refused() {
     );
     assert_eq!(std::fs::read_dir(out_dir.path()).unwrap().count(), 0);
 }
+
+/// An input past the time bound per input is an error line, and the next input still runs:
+/// with a bound of a millisecond every input here is past it, each named on its own line.
+#[test]
+fn an_input_past_the_time_bound_is_an_error_line_and_the_next_still_runs() {
+    let out = grasp_sim()
+        .args(["--no-sim", "--time-limit", "0.001"])
+        .args(["scenarios/cup.toml", "scenarios/cylinder_d40.toml"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    let lines: Vec<&str> = err.lines().collect();
+    assert_eq!(lines.len(), 2, "{err}");
+    for (line, name) in lines.iter().zip(["cup.toml", "cylinder_d40.toml"]) {
+        assert!(
+            line.contains(name) && line.contains("no result within 0.001 s"),
+            "{line}"
+        );
+    }
+    assert!(out.stdout.is_empty());
+    // The default bound is far above a normal run: the same inputs run and print.
+    let out = grasp_sim()
+        .args(["--no-sim", "scenarios/cup.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(0));
+}
