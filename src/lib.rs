@@ -432,7 +432,13 @@ fn run_sim(
     let p = &scenario.sim;
     let (pose, source, done) = match (&p.override_angles, grasp) {
         (Some(angles), _) => {
-            match sim::SimHand::from_override(&aligned.mesh, &scenario.hand, graded, p, angles) {
+            match select::override_pose(
+                &aligned.mesh,
+                &scenario.hand,
+                graded,
+                p.override_index,
+                angles,
+            ) {
                 Ok(pose) => (pose, GraspSource::OverrideAngles, None),
                 Err(e) => return Ok((SimReport::not_run(&e.to_string()), None, None)),
             }
@@ -490,15 +496,7 @@ fn checked_report(
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
         start: Some(sim::scene::start(case)),
-        collider: Some(match shape.coarsened_from {
-            Some(from) => format!(
-                "{} ({} parts, rebuilt from its face planes where parry would merge bent faces: {from} vertices to {})",
-                shape.kind,
-                shape.parts,
-                shape.shape.as_convex_polyhedron().map_or(0, |c| c.points().len())
-            ),
-            None => format!("{} ({} parts)", shape.kind, shape.parts),
-        }),
+        collider: Some(sim::ColliderReport::of(shape)),
         mass_kg: Some(case.mass_kg),
         grasp_source: Some(source),
         payload_margin: options

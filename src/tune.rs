@@ -572,7 +572,13 @@ fn run_override(
         .clone();
     let mut t = StageTimings::default();
     let graded = plan::grade_built(domain, hand, params, p.scenario.object.friction, &mut t);
-    let pose = SimHand::from_override(&aligned.mesh, hand, &graded, &p.scenario.sim, angles);
+    let pose = crate::select::override_pose(
+        &aligned.mesh,
+        hand,
+        &graded,
+        p.scenario.sim.override_index,
+        angles,
+    );
     let outcome = pose.ok().map(|pose| {
         let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
         let shape = p.object.shape(aligned);

@@ -110,7 +110,8 @@ fn the_same_scenario_gives_the_same_sim_numbers() {
 fn rapier_tolerances_are_pinned_at_hand_scale() {
     // At rapier's default length unit (1 m) the allowed penetration would be 5 mm and the
     // prediction distance 20 mm: most of a 40 mm object. grasp-sim sets a 1 cm unit.
-    use grasp_sim::sim::scene::{build, Case, ObjectShape, SimHand};
+    use grasp_sim::sim::scene::{build, Case, SimHand};
+    use grasp_sim::sim::ObjectShape;
     let (_d, s) = scenario_with("cylinder_d40.stl", "");
     let mesh = grasp_sim::objects::cylinder(40.0, 124.0);
     let shape = ObjectShape::from_mesh(&mesh, grasp_sim::mesh::mass_properties(&mesh).volume_mm3);
@@ -186,7 +187,7 @@ fn hold_slip_and_drop_are_told_apart() {
     // It has come to rest on the hand by 0.5 s: the fast protocol decides the slip then rather
     // than holding to the end (`fast_and_full_protocols_agree_on_the_bundled_scenarios`
     // compares its numbers with the full hold's).
-    assert_eq!(d.decided_by, "rest");
+    assert_eq!(d.decided_by, grasp_sim::sim::DecidedBy::Rest);
     assert!(d.decided_at_s < 1.0, "decided at {} s", d.decided_at_s);
     let mut drops = Vec::new();
     for name in ["sim_cup_weak_motors", "sim_d40_slippery_heavy"] {
@@ -588,7 +589,7 @@ fn a_drop_clear_of_the_hand_is_the_full_protocols_drop() {
     let mut clear = 0;
     for (a, b) in full.directions.iter().zip(&fast.directions) {
         assert_eq!(a.verdict, b.verdict, "gravity {:?}", a.gravity);
-        if b.decided_by == "clear_of_hand" {
+        if b.decided_by == grasp_sim::sim::DecidedBy::ClearOfHand {
             clear += 1;
             let d = (a.translation_mm - b.translation_mm).abs();
             assert!(
