@@ -216,8 +216,10 @@ fn select_grasps(
         sim::check(&object.case(scenario, &pose, &shape))
     };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
-    let checks_candidates = !options.no_sim && scenario.sim.override_angles.is_none();
-    let max_checked = options.max_checked.unwrap_or(scenario.sim.max_checked);
+    let checks_candidates = !options.no_sim && scenario.sim.input.override_angles.is_none();
+    let max_checked = options
+        .max_checked
+        .unwrap_or(scenario.sim.selection.max_checked);
     select::select(
         object.mesh(),
         &object.props,
@@ -430,13 +432,13 @@ fn run_sim(
         return Ok((SimReport::not_run("--no-sim"), None, None));
     }
     let p = &scenario.sim;
-    let (pose, source, done) = match (&p.override_angles, grasp) {
+    let (pose, source, done) = match (&p.input.override_angles, grasp) {
         (Some(angles), _) => {
             match select::override_pose(
                 &aligned.mesh,
                 &scenario.hand,
                 graded,
-                p.override_index,
+                p.input.override_index,
                 angles,
             ) {
                 Ok(pose) => (pose, GraspSource::OverrideAngles, None),
@@ -506,10 +508,10 @@ fn checked_report(
         closing: Some(out.closing),
         directions: out.directions,
         limits: Some(report::HoldLimits {
-            translation_mm: case.params.hold_translation_mm,
-            rotation_deg: case.params.hold_rotation_deg,
-            penetration_mm: case.params.max_penetration_mm,
-            closing_shift_mm: case.params.max_closing_shift_mm,
+            translation_mm: case.params.hold.hold_translation_mm,
+            rotation_deg: case.params.hold.hold_rotation_deg,
+            penetration_mm: case.params.hold.max_penetration_mm,
+            closing_shift_mm: case.params.hold.max_closing_shift_mm,
         }),
     }
 }

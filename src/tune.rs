@@ -502,7 +502,7 @@ fn run_object(
             s.name.apply(&mut params, *v);
         }
         let valid = validate_planner(&params, &p.scenario.hand, p.scenario.object.friction);
-        results.push(match (valid, &p.scenario.sim.override_angles) {
+        results.push(match (valid, &p.scenario.sim.input.override_angles) {
             (Err((key, why)), _) => {
                 object_result(p, ObjectStatus::Invalid, None, Some(format!("{key} {why}")))
             }
@@ -576,7 +576,7 @@ fn run_override(
         &aligned.mesh,
         hand,
         &graded,
-        p.scenario.sim.override_index,
+        p.scenario.sim.input.override_index,
         angles,
     );
     let outcome = pose.ok().map(|pose| {
@@ -628,7 +628,7 @@ fn run_planned(
             planner: params,
             friction: p.scenario.object.friction,
             collect: candidates,
-            max_checked: Some(p.scenario.sim.max_checked.max(1)),
+            max_checked: Some(p.scenario.sim.selection.max_checked.max(1)),
             check: &check,
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,

@@ -71,16 +71,16 @@ pub(super) struct Closing {
 /// or, with `close_until_stalled`, until the hand and the object have stopped ([`STALL`]).
 pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
     let params = case.params;
-    let stall = params.close_until_stalled.then_some(&STALL);
-    let dt = params.timestep_s;
-    let close_steps = (params.close_duration_s / dt).round() as usize;
+    let stall = params.closing.close_until_stalled.then_some(&STALL);
+    let dt = params.solver.timestep_s;
+    let close_steps = (params.closing.close_duration_s / dt).round() as usize;
     let (p0, q0) = relative(scene);
     let mut first_contact = FirstContacts::new(scene.fingers.len());
     // Joint 1 closes for at most half the closing time, joint 2 for the rest.
     let phases = [close_steps / 2, close_steps - close_steps / 2];
     let mut steps = 0;
     // `together`: fingers held where they touched, until all have or the hand has stopped.
-    let mut waiting = params.approach == super::params::Approach::Together;
+    let mut waiting = params.closing.approach == super::params::Approach::Together;
     let mut held = vec![false; scene.fingers.len()];
     for (phase, max_steps) in phases.into_iter().enumerate() {
         if phase == 1 {
@@ -325,7 +325,7 @@ fn closing_outcome(
         .flat_map(|f| (0..2).map(move |j| f.touching[j] && f.error_deg[j].abs() <= WITHIN_PLAN_DEG))
         .filter(|on| *on)
         .count();
-    let max_shift_mm = case.params.max_closing_shift_mm;
+    let max_shift_mm = case.params.hold.max_closing_shift_mm;
     ClosingOutcome {
         shift_mm,
         turn_deg,

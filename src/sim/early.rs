@@ -32,12 +32,12 @@ impl EarlyDecision {
     /// The rule with the scenario's `rest_window_s` and `rest_safety`.
     pub fn from_params(params: &SimParams) -> EarlyDecision {
         EarlyDecision {
-            window_s: params.rest_window_s,
-            safety: params.rest_safety,
+            window_s: params.early.rest_window_s,
+            safety: params.early.rest_safety,
             report_mm: 0.5,
             report_deg: 0.5,
             report_fraction: 0.1,
-            margin: params.rest_margin,
+            margin: params.early.rest_margin,
         }
     }
 }
@@ -150,13 +150,13 @@ impl EarlyDecision {
         if !self.reportable(&s) {
             return None;
         }
-        if s.now_mm + s.more_mm <= self.margin * params.hold_translation_mm
-            && s.now_deg + s.more_deg <= self.margin * params.hold_rotation_deg
+        if s.now_mm + s.more_mm <= self.margin * params.hold.hold_translation_mm
+            && s.now_deg + s.more_deg <= self.margin * params.hold.hold_rotation_deg
         {
             return Some(Verdict::Hold);
         }
-        let beyond = s.now_mm - s.more_mm >= params.hold_translation_mm / self.margin
-            || s.now_deg - s.more_deg >= params.hold_rotation_deg / self.margin;
+        let beyond = s.now_mm - s.more_mm >= params.hold.hold_translation_mm / self.margin
+            || s.now_deg - s.more_deg >= params.hold.hold_rotation_deg / self.margin;
         (beyond || penetrated).then_some(Verdict::Slip)
     }
 }

@@ -63,8 +63,8 @@ pub(super) fn hold(
     is_revolution: bool,
     early: Option<&EarlyDecision>,
 ) -> (DirectionOutcome, usize) {
-    let dt = params.timestep_s;
-    let hold_steps = (params.duration_s / dt).round() as usize;
+    let dt = params.solver.timestep_s;
+    let hold_steps = (params.hold.duration_s / dt).round() as usize;
     let Closing { p0, pc, qc, .. } = closing.clone();
     let joint_errors_deg = closing.joint_errors_deg.clone();
     let joint_error_deg = joint_errors_deg
@@ -113,7 +113,7 @@ pub(super) fn hold(
         let hand_still = holds_itself && hand_speed(scene) < HAND_REST_M_S;
         if hand_still && hand_was_still {
             if let Some((p_end, err_mm)) = clear_of_hand(scene, g, params, hold_steps - steps) {
-                if (p_end - pc).norm() - err_mm > params.hold_translation_mm / rule.margin {
+                if (p_end - pc).norm() - err_mm > params.hold.hold_translation_mm / rule.margin {
                     decided = Some(Decision::ClearOfHand(steps, p_end));
                     break;
                 }
@@ -123,7 +123,7 @@ pub(super) fn hold(
         let remaining_s = (hold_steps - steps) as f64 * dt;
         // A grasp the closing left too deep in the object, or pushed too far, is `slip`
         // whatever it does while on the hand.
-        let penetrated = closing.penetration_mm > params.max_penetration_mm;
+        let penetrated = closing.penetration_mm > params.hold.max_penetration_mm;
         match rule.decide(
             &samples,
             &frame,
@@ -164,9 +164,9 @@ pub(super) fn hold(
     let judged_rotation = judged(rotation_deg, tilt_deg);
     let verdict = if decided_by.is_drop() {
         Verdict::Drop
-    } else if translation_mm <= params.hold_translation_mm
-        && judged_rotation <= params.hold_rotation_deg
-        && closing.penetration_mm <= params.max_penetration_mm
+    } else if translation_mm <= params.hold.hold_translation_mm
+        && judged_rotation <= params.hold.hold_rotation_deg
+        && closing.penetration_mm <= params.hold.max_penetration_mm
         && !closing.outcome.pushed
     {
         Verdict::Hold
@@ -248,7 +248,7 @@ fn hand_holds_itself(scene: &Scene, params: &SimParams) -> bool {
     scene.fingers.iter().all(|f| {
         let (m1, l1) = reach(f.phalanx1);
         let (m2, l2) = reach(f.phalanx2);
-        params.torque_limit_nm >= 4.0 * m2 * G * l2
-            && params.joint1_lock_torque_nm >= 4.0 * (m1 + m2) * G * (l1 + l2)
+        params.fingers.torque_limit_nm >= 4.0 * m2 * G * l2
+            && params.fingers.joint1_lock_torque_nm >= 4.0 * (m1 + m2) * G * (l1 + l2)
     })
 }

@@ -214,10 +214,10 @@ pub fn finger_torque_limits(hand: &Hand, params: &SimParams) -> Vec<f64> {
         .iter()
         .map(|f| {
             let own = count(f.side);
-            if params.balanced_squeeze && fewest > 0 && own > 0 {
-                params.torque_limit_nm * fewest as f64 / own as f64
+            if params.fingers.balanced_squeeze && fewest > 0 && own > 0 {
+                params.fingers.torque_limit_nm * fewest as f64 / own as f64
             } else {
-                params.torque_limit_nm
+                params.fingers.torque_limit_nm
             }
         })
         .collect()
@@ -313,7 +313,7 @@ pub fn start(case: &Case) -> Start {
         origin = pose.origin_mm + pose.axes[0] * backoff;
     }
     let mut penetration = overlap_mm(&object.shape, &(origin, r_palm), &palm);
-    let margin0 = params.open_margin_deg;
+    let margin0 = params.closing.open_margin_deg;
     let mut margins = vec![margin0];
     margins.extend(
         (1..)
@@ -434,10 +434,10 @@ pub fn build(case: &Case) -> Scene {
         object_collider,
         hand_colliders,
         fingers,
-        lock_torque: params.joint1_lock_torque_nm as f32,
+        lock_torque: params.fingers.joint1_lock_torque_nm as f32,
         motor_gains: (
-            params.motor_stiffness_nm_per_rad as f32,
-            params.motor_damping_nms_per_rad as f32,
+            params.fingers.motor_stiffness_nm_per_rad as f32,
+            params.fingers.motor_damping_nms_per_rad as f32,
         ),
         reach_m: reach_mm(hand) * convert::M_PER_MM,
         object_radius_m: object_radius_m(object),
@@ -449,7 +449,7 @@ fn new_world(params: &SimParams) -> PhysicsWorld {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::ZERO;
     let ip = &mut world.integration_parameters;
-    ip.dt = params.timestep_s as f32;
+    ip.dt = params.solver.timestep_s as f32;
     // rapier's tolerances scale with length_unit (allowed linear error 5e-3 × unit, prediction
     // distance 2e-2 × unit); at the default of 1 m they would be 5 mm and 20 mm, a sizeable part
     // of a 40 mm object. 1 cm makes them 0.05 mm and 0.2 mm (pinned by a test).
@@ -457,9 +457,9 @@ fn new_world(params: &SimParams) -> PhysicsWorld {
     // A grasp is a closed loop of stiff contacts and joints (palm, phalanges, object): rapier's
     // default of one PGS sweep per substep leaves the object creeping under the squeeze (the
     // convergence study in docs/SIM.md); more sweeps per substep settle it.
-    ip.num_solver_iterations = params.solver_iterations;
-    ip.num_internal_pgs_iterations = params.pgs_iterations;
-    ip.num_internal_stabilization_iterations = params.stabilization_iterations;
+    ip.num_solver_iterations = params.solver.solver_iterations;
+    ip.num_internal_pgs_iterations = params.solver.pgs_iterations;
+    ip.num_internal_stabilization_iterations = params.solver.stabilization_iterations;
     // Contact softness is a natural frequency relative to the bodies' effective mass. rapier's
     // default (30 Hz; 60 Hz against fixed bodies) is a spring of about 430 N/m against a 12 g
     // phalanx: a 1 N·m finger squeezing at 30 mm (33 N) would sink centimetres into the object.
@@ -475,7 +475,7 @@ fn new_world(params: &SimParams) -> PhysicsWorld {
     // of stale contacts between steps.
     ip.friction_model = FrictionModel::Coulomb;
     ip.contact_recycling = false;
-    let hz = params.contact_stiffness_hz as f32;
+    let hz = params.solver.contact_stiffness_hz as f32;
     ip.contact_softness = SpringCoefficients::new(hz, 10.0);
     ip.static_contact_softness = SpringCoefficients::new(hz, 10.0);
     world
@@ -518,7 +518,7 @@ fn insert_finger(
     let f = at.finger;
     let [t1, t2] = at.theta_deg;
     let [open1, open2] = at.open_bend_rad;
-    let density = params.finger_density_kg_m3 as f32;
+    let density = params.fingers.finger_density_kg_m3 as f32;
     let limits = |range: [f64; 2]| [bend(range[1]) as f32, bend(range[0]) as f32];
     let limits1 = limits(hand.joints.theta1_range_deg);
     let limits2 = limits(hand.joints.theta2_range_deg);
@@ -531,8 +531,8 @@ fn insert_finger(
             .motor_model(MotorModel::ForceBased)
             .motor_position(
                 target,
-                params.motor_stiffness_nm_per_rad as f32,
-                params.motor_damping_nms_per_rad as f32,
+                params.fingers.motor_stiffness_nm_per_rad as f32,
+                params.fingers.motor_damping_nms_per_rad as f32,
             )
             .motor_max_force(at.torque_nm as f32)
             .contacts_enabled(false)
@@ -552,8 +552,8 @@ fn insert_finger(
         }
         body
     };
-    let squeeze = params.squeeze_deg.to_radians();
-    let squeeze2 = params.squeeze2_deg.to_radians();
+    let squeeze = params.fingers.squeeze_deg.to_radians();
+    let squeeze2 = params.fingers.squeeze2_deg.to_radians();
     // Body, colliders, joint, in this order for each phalanx: rapier's state (and so the run)
     // depends on the order of insertion.
     let b1 = phalanx(world, convert::pose(&j1, &r1), &[p1]);

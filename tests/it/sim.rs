@@ -312,10 +312,8 @@ fn the_closing_ends_when_the_hand_and_the_object_stop() {
     // object have stopped; the fixed schedule closes for the whole 0.5 s. On D40 both end in
     // the same grip: joint angles within a tenth of a degree, and both hold.
     use grasp_sim::scenario::SimParams;
-    let fixed = SimParams {
-        close_until_stalled: false,
-        ..Default::default()
-    };
+    let mut fixed = SimParams::default();
+    fixed.closing.close_until_stalled = false;
     let (stalled, fixed) = (
         d40_case(SimParams::default(), grasp_sim::sim::check),
         d40_case(fixed, grasp_sim::sim::check),
@@ -337,7 +335,7 @@ fn the_closing_ends_when_the_hand_and_the_object_stop() {
     assert_eq!(a.verdict, Verdict::Hold);
     assert_eq!(b.verdict, Verdict::Hold);
     // The steps reported are the closing's and the hold's: the closing saved is saved.
-    let dt = SimParams::default().timestep_s;
+    let dt = SimParams::default().solver.timestep_s;
     let steps = |d: &grasp_sim::sim::DirectionOutcome| {
         ((d.closed_at_s + d.decided_at_s) / dt).round() as usize
     };
@@ -402,7 +400,7 @@ fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
             })
             .collect()
     };
-    let remaining = |n: usize| params.duration_s - n as f64 * SAMPLE_S;
+    let remaining = |n: usize| params.hold.duration_s - n as f64 * SAMPLE_S;
     // The verdict by motion after `n` samples, for a grasp the closing left clear (`deep`:
     // deeper than `max_penetration_mm`).
     let by = |samples: &[(Vector3<f64>, UnitQuaternion<f64>)], n: usize, deep: bool| {
