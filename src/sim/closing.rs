@@ -79,14 +79,14 @@ pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
     // Joint 1 closes for at most half the closing time, joint 2 for the rest.
     let phases = [close_steps / 2, close_steps - close_steps / 2];
     let mut steps = 0;
-    // `together`: fingers held where they touched, until all have or the hand has stopped.
-    let mut waiting = params.closing.approach == super::params::Approach::Together;
-    let mut held = vec![false; scene.fingers.len()];
+    let mut together = Together {
+        waiting: params.closing.approach == super::params::Approach::Together,
+        held: vec![false; scene.fingers.len()],
+    };
     for (phase, max_steps) in phases.into_iter().enumerate() {
         if phase == 1 {
-            if waiting {
-                release_held(scene, &mut held);
-                waiting = false;
+            if together.waiting {
+                together.release(scene);
             }
             scene.release_joint2();
         }
@@ -96,27 +96,16 @@ pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
             steps += 1;
             let now = touching(scene);
             first_contact.update(&now, steps as f64 * dt);
-            if waiting {
-                for (k, t) in now.fingers.iter().enumerate() {
-                    if (t[0] || t[1]) && !held[k] {
-                        scene.hold_joint1(k, true);
-                        held[k] = true;
-                    }
-                }
-                if held.iter().all(|h| *h) {
-                    release_held(scene, &mut held);
-                    waiting = false;
-                    quiet_steps = 0;
-                }
+            if together.hold_touching(scene, &now) {
+                quiet_steps = 0;
             }
             let Some(rule) = stall else { continue };
             if rule.quiet(motion(scene)) {
                 quiet_steps += 1;
                 if quiet_steps as f64 * dt >= rule.window_s {
-                    if waiting {
+                    if together.waiting {
                         // A finger that stopped without touching: the others squeeze now.
-                        release_held(scene, &mut held);
-                        waiting = false;
+                        together.release(scene);
                         quiet_steps = 0;
                         continue;
                     }
@@ -127,11 +116,24 @@ pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
             }
         }
     }
+    closed(scene, case, (p0, q0), &first_contact, steps)
+}
+
+/// Where the closing left the hand and the object after `steps`, from the object's pose
+/// relative to the palm at the start, `(p0, q0)`, and the first contacts.
+fn closed(
+    scene: &Scene,
+    case: &Case,
+    (p0, q0): (Vector3<f64>, UnitQuaternion<f64>),
+    first_contact: &FirstContacts,
+    steps: usize,
+) -> Closing {
+    let dt = case.params.solver.timestep_s;
     let (pc, qc) = relative(scene);
     let joint_errors_deg = joint_errors(scene);
     let outcome = closing_outcome(
         case,
-        &first_contact,
+        first_contact,
         &touching(scene),
         &gaps_mm(scene),
         &joint_errors_deg,
@@ -180,6 +182,42 @@ fn gaps_mm(scene: &Scene) -> Vec<[f64; 2]> {
         .iter()
         .map(|f| [gap(f.phalanx1), gap(f.phalanx2)])
         .collect()
+}
+
+/// The `together` approach (`[sim] approach`): fingers held where they touched, until all have
+/// or the hand has stopped.
+struct Together {
+    /// True while fingers wait for the others (always false under `squeeze`).
+    waiting: bool,
+    /// Per finger, true if and only if it is held.
+    held: Vec<bool>,
+}
+
+impl Together {
+    /// While waiting, holds every finger that touches the object `now` and is not held yet;
+    /// once all are held, sends them on together. Returns true if and only if it did now.
+    fn hold_touching(&mut self, scene: &mut Scene, now: &Touching) -> bool {
+        if !self.waiting {
+            return false;
+        }
+        for (k, t) in now.fingers.iter().enumerate() {
+            if (t[0] || t[1]) && !self.held[k] {
+                scene.hold_joint1(k, true);
+                self.held[k] = true;
+            }
+        }
+        if self.held.iter().all(|h| *h) {
+            self.release(scene);
+            return true;
+        }
+        false
+    }
+
+    /// Sends every held finger on to its squeeze target, and stops waiting.
+    fn release(&mut self, scene: &mut Scene) {
+        release_held(scene, &mut self.held);
+        self.waiting = false;
+    }
 }
 
 /// Sends every held finger's joint 1 on to its squeeze target.

@@ -282,6 +282,25 @@ fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
             })
         })
         .collect();
+    let kept = kept_planes(&true_planes, &v64, &centre);
+    let corners = plane_corners(&kept, &true_planes, &centre)?;
+    let rebuilt = SharedShape::convex_hull(&corners)?;
+    let poly = rebuilt.as_convex_polyhedron()?;
+    if poly.points().len() < 4 || bent_face_m(poly) > MERGED_FACE_TOLERANCE_M {
+        return None;
+    }
+    holds_all(poly, &v64).then_some((rebuilt, vertices.len()))
+}
+
+/// The face planes of the hull `(area, unit normal, offset from the centre)` that
+/// [`coarsened_hull`] keeps, largest face first: each only if its normal is at least
+/// [`MIN_FACE_ANGLE_RAD`] from every plane kept and the whole hull (`v64`, about `centre`) is on
+/// its inner side.
+fn kept_planes(
+    true_planes: &[(f64, Vector3<f64>, f64)],
+    v64: &[Vector3<f64>],
+    centre: &Vector3<f64>,
+) -> Vec<(Vector3<f64>, f64)> {
     let mut planes: Vec<(f64, Vector3<f64>, f64)> =
         true_planes.iter().copied().filter(|p| p.2 > 0.0).collect();
     planes.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.2.total_cmp(&b.2)));
@@ -298,6 +317,19 @@ fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
             kept.push((n, d));
         }
     }
+    kept
+}
+
+/// The corners of the intersection of the `kept` half-spaces (about `centre`) `[m]`, found
+/// through the polar dual: each triangle of the convex hull of the planes' poles is a corner
+/// where its three planes meet; a corner that stands off the true hull (`true_planes`) by more
+/// than [`MAX_OUTER_STANDOFF_M`] is left out. `None` if the poles have no hull.
+fn plane_corners(
+    kept: &[(Vector3<f64>, f64)],
+    true_planes: &[(f64, Vector3<f64>, f64)],
+    centre: &Vector3<f64>,
+) -> Option<Vec<Vector>> {
+    use rapier3d::parry::transformation::try_convex_hull;
     // The poles n / d; each triangle of their hull is a vertex of the intersection.
     let poles: Vec<Vector> = kept
         .iter()
@@ -341,15 +373,15 @@ fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
             corners.push(Vector::new(p.x as f32, p.y as f32, p.z as f32));
         }
     }
-    let rebuilt = SharedShape::convex_hull(&corners)?;
-    let poly = rebuilt.as_convex_polyhedron()?;
-    if poly.points().len() < 4 || bent_face_m(poly) > MERGED_FACE_TOLERANCE_M {
-        return None;
-    }
-    // It must hold the whole true hull (no corner lost to the skips above): every vertex inside
-    // every face plane parry made.
+    Some(corners)
+}
+
+/// Returns true if and only if `poly` holds every point of `v64` `[m]` (no corner lost to the
+/// skips of [`plane_corners`]): every point inside every face plane parry made, to
+/// [`SUPPORT_TOLERANCE_M`].
+fn holds_all(poly: &rapier3d::parry::shape::ConvexPolyhedron, v64: &[Vector3<f64>]) -> bool {
     let ids = poly.vertices_adj_to_face();
-    let inside = poly.faces().iter().all(|f| {
+    poly.faces().iter().all(|f| {
         let a = poly.points()[ids[f.first_vertex_or_edge as usize] as usize];
         let a = Vector3::new(f64::from(a.x), f64::from(a.y), f64::from(a.z));
         let n = Vector3::new(
@@ -358,8 +390,7 @@ fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
             f64::from(f.normal.z),
         );
         v64.iter().all(|x| n.dot(&(x - a)) <= SUPPORT_TOLERANCE_M)
-    });
-    inside.then_some((rebuilt, vertices.len()))
+    })
 }
 
 /// The object's centre of mass `[m]` and inertia tensor about it `[kg·m²]`, aligned frame, as the

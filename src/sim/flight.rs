@@ -151,20 +151,15 @@ pub(super) fn clear_of_hand(
     let remaining_s = total as f64 * h;
     let margin = 2.0 * HAND_REST_M_S * remaining_s + f64::from(ip.prediction_distance());
     let v_max = f64::from(ip.max_linear_velocity());
-    // The bound on the object's angular speed in free flight.
-    let mprops = &obj.mass_properties().local_mprops;
-    let inertia = v3(mprops.principal_inertia());
-    let frame = obj.position().rotation * mprops.principal_inertia_local_frame;
-    let w_local = v3(frame.inverse() * obj.angvel());
-    let i_min = inertia.min().max(f64::MIN_POSITIVE);
-    // rapier's gyroscopic step keeps |L| (it rescales the angular momentum to its length before
-    // the step) but not the energy, which grows for a spin near the largest axis: the bound is
-    // |L| / I_min, with 1 % for f32 rounding.
-    let l = inertia.component_mul(&w_local).norm();
-    let omega = 1.01 * l / i_min;
+    let omega = spin_bound(obj);
     let r_obj = scene.object_radius_m;
     let com0 = v3(obj.center_of_mass());
-    let pose0 = *obj_collider.position();
+    let flyer = Flyer {
+        collider: obj_collider,
+        pose0: *obj_collider.position(),
+        com0,
+        r_obj,
+    };
     let hand: Vec<(&Collider, Pose)> = scene
         .hand_colliders
         .iter()
@@ -176,25 +171,8 @@ pub(super) fn clear_of_hand(
     let mut k = 0usize;
     for _ in 0..10_000 {
         // (a) and (b) at substep k.
-        let shift = x - com0;
-        let mut at = pose0;
-        at.translation += Vector::new(shift.x as f32, shift.y as f32, shift.z as f32);
         let turned = omega * k as f64 * h * r_obj;
-        let centre = Vector::new(x.x as f32, x.y as f32, x.z as f32);
-        let mut lower = f64::INFINITY;
-        for (c, pose) in &hand {
-            let d_sphere = f64::from(c.shape().distance_to_point(pose, centre, true)) - r_obj;
-            let d_shape = if turned < r_obj {
-                let d =
-                    rapier3d::parry::query::distance(&at, obj_collider.shape(), pose, c.shape())
-                        .ok()?;
-                // parry's convex distance stops within about 1.1e-3 of the true one, from above.
-                f64::from(d.distance) * (1.0 - 2e-3) - turned
-            } else {
-                f64::NEG_INFINITY
-            };
-            lower = lower.min(d_sphere.max(d_shape));
-        }
+        let lower = flyer.lower_bound(&hand, &x, turned)?;
         let gap = lower - margin;
         if gap <= 0.0 {
             return None;
@@ -207,12 +185,7 @@ pub(super) fn clear_of_hand(
         // rapier updates the velocity before the position: over n substeps that leads the
         // continuous motion by up to ½·g·h·Δ.
         let b = v.norm() + omega * r_obj + 0.5 * g_norm * h;
-        let dt_safe = if g_norm > 0.0 {
-            (-b + (b * b + 2.0 * g_norm * gap).sqrt()) / g_norm
-        } else {
-            gap / b.max(f64::MIN_POSITIVE)
-        };
-        let n = ((dt_safe / h).floor() as usize).min(total - k);
+        let n = ((safe_advance_s(b, g_norm, gap) / h).floor() as usize).min(total - k);
         if n == 0 {
             return None;
         }
@@ -230,4 +203,78 @@ pub(super) fn clear_of_hand(
     let origin_off = (v3(obj.position().translation) - com0).norm();
     let err_mm = (omega * remaining_s).min(2.0) * origin_off / convert::M_PER_MM;
     Some((flight_end_mm(scene, x - com0), err_mm))
+}
+
+/// The bound on the object's angular speed in free flight `[rad/s]`: rapier's gyroscopic step
+/// keeps |L| (it rescales the angular momentum to its length before the step) but not the
+/// energy, which grows for a spin near the largest axis: the bound is |L| / I_min, with 1 % for
+/// f32 rounding.
+fn spin_bound(obj: &RigidBody) -> f64 {
+    let v3 = |v: Vector| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z));
+    let mprops = &obj.mass_properties().local_mprops;
+    let inertia = v3(mprops.principal_inertia());
+    let frame = obj.position().rotation * mprops.principal_inertia_local_frame;
+    let w_local = v3(frame.inverse() * obj.angvel());
+    let i_min = inertia.min().max(f64::MIN_POSITIVE);
+    let l = inertia.component_mul(&w_local).norm();
+    1.01 * l / i_min
+}
+
+/// The object in free flight as [`clear_of_hand`] bounds its distance to the hand: its collider
+/// at the decision, carried with its centre of mass.
+struct Flyer<'a> {
+    /// The object's collider, at its pose at the decision.
+    collider: &'a Collider,
+    /// That pose.
+    pose0: Pose,
+    /// Its centre of mass at the decision `[m]`.
+    com0: Vector3<f64>,
+    /// Radius about the centre of mass of a sphere that holds it `[m]`.
+    r_obj: f64,
+}
+
+impl Flyer<'_> {
+    /// A lower bound on the distance from the object, its centre of mass at `x` `[m]` and
+    /// turned since the decision by at most `turned` `[m]` at any point, to the `hand`
+    /// colliders `[m]`: per collider, the larger of (a) the distance from the object at its
+    /// orientation at the decision less `turned` and (b) the distance from the centre of mass
+    /// less the radius that holds it. `None` if parry cannot measure a distance.
+    fn lower_bound(
+        &self,
+        hand: &[(&Collider, Pose)],
+        x: &Vector3<f64>,
+        turned: f64,
+    ) -> Option<f64> {
+        let r_obj = self.r_obj;
+        let shift = x - self.com0;
+        let mut at = self.pose0;
+        at.translation += Vector::new(shift.x as f32, shift.y as f32, shift.z as f32);
+        let centre = Vector::new(x.x as f32, x.y as f32, x.z as f32);
+        let mut lower = f64::INFINITY;
+        for (c, pose) in hand {
+            let d_sphere = f64::from(c.shape().distance_to_point(pose, centre, true)) - r_obj;
+            let d_shape = if turned < r_obj {
+                let d =
+                    rapier3d::parry::query::distance(&at, self.collider.shape(), pose, c.shape())
+                        .ok()?;
+                // parry's convex distance stops within about 1.1e-3 of the true one, from above.
+                f64::from(d.distance) * (1.0 - 2e-3) - turned
+            } else {
+                f64::NEG_INFINITY
+            };
+            lower = lower.min(d_sphere.max(d_shape));
+        }
+        Some(lower)
+    }
+}
+
+/// The longest time `[s]` over which a motion starting at speed bound `b` `[m/s]` and
+/// accelerating at `g_norm` `[m/s²]` covers at most `gap` `[m]`: the root of
+/// ½·g·Δ² + b·Δ = gap (Δ = gap / b without gravity).
+fn safe_advance_s(b: f64, g_norm: f64, gap: f64) -> f64 {
+    if g_norm > 0.0 {
+        (-b + (b * b + 2.0 * g_norm * gap).sqrt()) / g_norm
+    } else {
+        gap / b.max(f64::MIN_POSITIVE)
+    }
 }

@@ -65,21 +65,13 @@ pub(super) fn hold(
 ) -> (DirectionOutcome, usize) {
     let dt = params.solver.timestep_s;
     let hold_steps = (params.hold.duration_s / dt).round() as usize;
-    let Closing { p0, pc, qc, .. } = closing.clone();
-    let joint_errors_deg = closing.joint_errors_deg.clone();
-    let joint_error_deg = joint_errors_deg
-        .iter()
-        .flatten()
-        .copied()
-        .fold(0.0f64, |w, e| if e.abs() > w.abs() { e } else { w });
     let g = gravity * G;
     scene.world.gravity = Vector::new(g.x as f32, g.y as f32, g.z as f32);
-    let judged = |full: f64, tilt: f64| if is_revolution { tilt } else { full };
     let sample_every = ((SAMPLE_S / dt).round() as usize).max(1);
     let tracing = TRACES.with(|t| t.borrow().is_some());
     let frame = RestFrame {
-        pc,
-        qc,
+        pc: closing.pc,
+        qc: closing.qc,
         is_revolution,
         sample_dt: sample_every as f64 * dt,
     };
@@ -88,8 +80,14 @@ pub(super) fn hold(
     let mut fine = Vec::new();
     let fine_every = (sample_every / 4).max(1);
     let mut decided: Option<Decision> = None;
-    let mut hand_was_still = false;
-    let holds_itself = hand_holds_itself(scene, params);
+    let mut watch = early.map(|rule| EarlyWatch {
+        rule,
+        frame,
+        g,
+        hold_steps,
+        holds_itself: hand_holds_itself(scene, params),
+        hand_was_still: false,
+    });
     let mut steps = 0;
     while steps < hold_steps {
         scene.world.step();
@@ -102,42 +100,113 @@ pub(super) fn hold(
             continue;
         }
         samples.push(relative(scene));
-        let Some(rule) = early else { continue };
+        let Some(w) = watch.as_mut() else { continue };
+        decided = w.decide(scene, params, closing, &samples, steps);
+        if decided.is_some() {
+            break;
+        }
+    }
+    let outcome = direction_outcome(scene, gravity, params, closing, &frame, decided, hold_steps);
+    if tracing && early.is_none() {
+        TRACES.with(|t| {
+            if let Some(v) = t.borrow_mut().as_mut() {
+                v.push(HoldTrace {
+                    frame,
+                    samples,
+                    fine,
+                    fine_dt: fine_every as f64 * dt,
+                    duration_s: hold_steps as f64 * dt,
+                    outcome: outcome.clone(),
+                });
+            }
+        });
+    }
+    (outcome, steps)
+}
+
+/// The early decision of one hold under the `fast` protocol: the rest rule and the drop tests,
+/// and whether the hand was at rest at the previous sample.
+struct EarlyWatch<'a> {
+    /// The rest rule.
+    rule: &'a EarlyDecision,
+    /// What the samples are measured against.
+    frame: RestFrame,
+    /// Gravity `[m/s²]`.
+    g: Vector3<f64>,
+    /// The hold's length in steps.
+    hold_steps: usize,
+    /// [`hand_holds_itself`]: only then is [`clear_of_hand`] tried.
+    holds_itself: bool,
+    /// The hand was at rest at the previous sample.
+    hand_was_still: bool,
+}
+
+impl EarlyWatch<'_> {
+    /// What decides the direction at `steps` into the hold, with `samples` so far, if anything
+    /// does: a drop out of reach, a drop clear of the resting hand, or the rest rule.
+    fn decide(
+        &mut self,
+        scene: &Scene,
+        params: &SimParams,
+        closing: &Closing,
+        samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
+        steps: usize,
+    ) -> Option<Decision> {
+        let (rule, g, hold_steps) = (self.rule, self.g, self.hold_steps);
         // Drop: the object has left the hand's reach and its free flight never brings it back.
         if let Some(p_end) = out_of_reach(scene, g, params, hold_steps - steps) {
-            decided = Some(Decision::OutOfReach(steps, p_end));
-            break;
+            return Some(Decision::OutOfReach(steps, p_end));
         }
         // Drop: the hand has come to rest, nothing touches it, and the object's free flight
         // never meets it again.
-        let hand_still = holds_itself && hand_speed(scene) < HAND_REST_M_S;
-        if hand_still && hand_was_still {
+        let hand_still = self.holds_itself && hand_speed(scene) < HAND_REST_M_S;
+        if hand_still && self.hand_was_still {
             if let Some((p_end, err_mm)) = clear_of_hand(scene, g, params, hold_steps - steps) {
-                if (p_end - pc).norm() - err_mm > params.hold.hold_translation_mm / rule.margin {
-                    decided = Some(Decision::ClearOfHand(steps, p_end));
-                    break;
+                if (p_end - closing.pc).norm() - err_mm
+                    > params.hold.hold_translation_mm / rule.margin
+                {
+                    return Some(Decision::ClearOfHand(steps, p_end));
                 }
             }
         }
-        hand_was_still = hand_still;
-        let remaining_s = (hold_steps - steps) as f64 * dt;
+        self.hand_was_still = hand_still;
+        let remaining_s = (hold_steps - steps) as f64 * params.solver.timestep_s;
         // A grasp the closing left too deep in the object, or pushed too far, is `slip`
         // whatever it does while on the hand.
         let penetrated = closing.penetration_mm > params.hold.max_penetration_mm;
         match rule.decide(
-            &samples,
-            &frame,
+            samples,
+            &self.frame,
             remaining_s,
             params,
             penetrated || closing.outcome.pushed,
         ) {
             Some(Verdict::Hold) => {}
             Some(_) if touches_hand(scene) => {}
-            _ => continue,
+            _ => return None,
         }
-        decided = Some(Decision::Rest(steps));
-        break;
+        Some(Decision::Rest(steps))
     }
+}
+
+/// The outcome of a hold that ended now, `decided` early or after `hold_steps`.
+fn direction_outcome(
+    scene: &Scene,
+    gravity: Vector3<f64>,
+    params: &SimParams,
+    closing: &Closing,
+    frame: &RestFrame,
+    decided: Option<Decision>,
+    hold_steps: usize,
+) -> DirectionOutcome {
+    let dt = params.solver.timestep_s;
+    let (p0, pc, qc) = (closing.p0, closing.pc, closing.qc);
+    let joint_errors_deg = closing.joint_errors_deg.clone();
+    let joint_error_deg = joint_errors_deg
+        .iter()
+        .flatten()
+        .copied()
+        .fold(0.0f64, |w, e| if e.abs() > w.abs() { e } else { w });
     let (pe, qe) = relative(scene);
     let (rotation_deg, tilt_deg) = rotations(&qc, &qe);
     let at_decision_mm = (pe - pc).norm();
@@ -161,7 +230,11 @@ pub(super) fn hold(
             (hold_steps as f64 * dt, DecidedBy::End)
         }
     };
-    let judged_rotation = judged(rotation_deg, tilt_deg);
+    let judged_rotation = if frame.is_revolution {
+        tilt_deg
+    } else {
+        rotation_deg
+    };
     let verdict = if decided_by.is_drop() {
         Verdict::Drop
     } else if translation_mm <= params.hold.hold_translation_mm
@@ -175,7 +248,7 @@ pub(super) fn hold(
     } else {
         Verdict::Drop
     };
-    let outcome = DirectionOutcome {
+    DirectionOutcome {
         gravity: [gravity.x, gravity.y, gravity.z],
         verdict,
         translation_mm,
@@ -193,22 +266,7 @@ pub(super) fn hold(
         decided_at_s,
         decided_by,
         translation_at_decision_mm: at_decision_mm,
-    };
-    if tracing && early.is_none() {
-        TRACES.with(|t| {
-            if let Some(v) = t.borrow_mut().as_mut() {
-                v.push(HoldTrace {
-                    frame,
-                    samples,
-                    fine,
-                    fine_dt: fine_every as f64 * dt,
-                    duration_s: hold_steps as f64 * dt,
-                    outcome: outcome.clone(),
-                });
-            }
-        });
     }
-    (outcome, steps)
 }
 
 /// How a direction was decided before the end of the hold.

@@ -281,6 +281,41 @@ fn overlap_mm(object: &SharedShape, frame: &BodyPose, boxes: &[HandBox]) -> f64 
         .fold(0.0, f64::max)
 }
 
+/// The palm's origin `[mm]` backed off the object along palm x by the depth found, plus the
+/// tolerance, until clear (a few rounds: moving off one part can meet another only in a
+/// concave object), and how far it was backed off `[mm]`.
+fn backed_off(pose: &SimHand, object: &ObjectShape, palm: &[HandBox]) -> (Point3<f64>, f64) {
+    let r_palm = palm_rotation(&pose.axes);
+    let mut origin = pose.origin_mm;
+    let mut backoff = 0.0;
+    for _ in 0..10 {
+        let d = overlap_mm(&object.shape, &(origin, r_palm), palm);
+        if d <= START_TOLERANCE_MM {
+            break;
+        }
+        backoff += d + START_TOLERANCE_MM;
+        origin = pose.origin_mm + pose.axes[0] * backoff;
+    }
+    (origin, backoff)
+}
+
+/// The margins a finger may start open by `[deg]`, in the order they are tried: `margin0`, then
+/// wider in 5° steps up to 90°, then narrower down to 0.
+fn open_margins(margin0: f64) -> Vec<f64> {
+    let mut margins = vec![margin0];
+    margins.extend(
+        (1..)
+            .map(|k| margin0 + 5.0 * f64::from(k))
+            .take_while(|m| *m <= 90.0),
+    );
+    margins.extend(
+        (1..)
+            .map(|k| margin0 - 5.0 * f64::from(k))
+            .take_while(|m| *m >= 0.0),
+    );
+    margins
+}
+
 /// The start of the check for `case` (see [`Start`]).
 pub fn start(case: &Case) -> Start {
     let Case {
@@ -300,31 +335,10 @@ pub fn start(case: &Case) -> Start {
         bend(hand.joints.theta2_range_deg[1]),
         bend(hand.joints.theta2_range_deg[0]),
     ];
-    // The palm: backed off by the depth found, plus the tolerance, until clear (a few rounds:
-    // moving off one part can meet another only in a concave object).
-    let mut origin = pose.origin_mm;
-    let mut backoff = 0.0;
-    for _ in 0..10 {
-        let d = overlap_mm(&object.shape, &(origin, r_palm), &palm);
-        if d <= START_TOLERANCE_MM {
-            break;
-        }
-        backoff += d + START_TOLERANCE_MM;
-        origin = pose.origin_mm + pose.axes[0] * backoff;
-    }
+    let (origin, backoff) = backed_off(pose, object, &palm);
     let mut penetration = overlap_mm(&object.shape, &(origin, r_palm), &palm);
     let margin0 = params.closing.open_margin_deg;
-    let mut margins = vec![margin0];
-    margins.extend(
-        (1..)
-            .map(|k| margin0 + 5.0 * f64::from(k))
-            .take_while(|m| *m <= 90.0),
-    );
-    margins.extend(
-        (1..)
-            .map(|k| margin0 - 5.0 * f64::from(k))
-            .take_while(|m| *m >= 0.0),
-    );
+    let margins = open_margins(margin0);
     let mut open_bend = Vec::new();
     let mut open_margin = Vec::new();
     for (f, [t1, t2]) in hand.finger_list.iter().zip(&pose.theta_deg) {
@@ -524,18 +538,8 @@ fn insert_finger(
     let limits2 = limits(hand.joints.theta2_range_deg);
     let motor = |target: f64, limits: [f32; 2]| (target as f32).clamp(limits[0], limits[1]);
     let revolute = |anchor: &Vector3<f64>, limits: [f32; 2], target: f32| {
-        RevoluteJointBuilder::new(Vector::new(0.0, 0.0, f.side.sign() as f32))
-            .local_anchor1(convert::vector_m(anchor))
-            .local_anchor2(Vector::ZERO)
-            .limits(limits)
-            .motor_model(MotorModel::ForceBased)
-            .motor_position(
-                target,
-                params.fingers.motor_stiffness_nm_per_rad as f32,
-                params.fingers.motor_damping_nms_per_rad as f32,
-            )
-            .motor_max_force(at.torque_nm as f32)
-            .contacts_enabled(false)
+        let axis = Vector::new(0.0, 0.0, f.side.sign() as f32);
+        revolute_joint(axis, anchor, limits, target, params, at.torque_nm)
     };
     let (p1, p2) = hand.phalanx_boxes(f.side);
     let [(j1, r1), (j2, r2)] = hand.finger_poses(f, &at.palm_pose, [open1, open2]);
@@ -582,6 +586,32 @@ fn insert_finger(
         joint2_target: motor(bend(t2) + squeeze2, limits2),
         joint1_target: motor(bend(t1) + squeeze, limits1),
     }
+}
+
+/// A finger joint: revolute about `axis` (the parent's frame) at `anchor` `[mm]` on the parent,
+/// within `limits` `[rad]`, with a force-based position motor towards `target` `[rad]` at the
+/// scenario's stiffness and damping, capped at `torque_nm`; the two phalanges it joins do not
+/// collide.
+fn revolute_joint(
+    axis: Vector,
+    anchor: &Vector3<f64>,
+    limits: [f32; 2],
+    target: f32,
+    params: &SimParams,
+    torque_nm: f64,
+) -> RevoluteJointBuilder {
+    RevoluteJointBuilder::new(axis)
+        .local_anchor1(convert::vector_m(anchor))
+        .local_anchor2(Vector::ZERO)
+        .limits(limits)
+        .motor_model(MotorModel::ForceBased)
+        .motor_position(
+            target,
+            params.fingers.motor_stiffness_nm_per_rad as f32,
+            params.fingers.motor_damping_nms_per_rad as f32,
+        )
+        .motor_max_force(torque_nm as f32)
+        .contacts_enabled(false)
 }
 
 /// A multibody places its links from its joint coordinates, which start at zero (every
