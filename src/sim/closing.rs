@@ -437,3 +437,36 @@ fn joint_errors(scene: &Scene) -> Vec<[f64; 2]> {
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_stall_rule_needs_every_speed_below_its_bound() {
+        // 0.02 rad/s for the joints, 0.5 mm/s and 0.01 rad/s for the object.
+        assert!(STALL.quiet((0.019, 0.49, 0.009)));
+        assert!(!STALL.quiet((0.02, 0.0, 0.0)));
+        assert!(!STALL.quiet((0.0, 0.5, 0.0)));
+        assert!(!STALL.quiet((0.0, 0.0, 0.01)));
+    }
+
+    #[test]
+    fn the_first_touch_is_the_earliest_the_palm_first_on_a_tie() {
+        let names = ["finger_1".to_string(), "thumb".to_string()];
+        let touch = |palm, fingers: Vec<[bool; 2]>| Touching { palm, fingers };
+        let mut first = FirstContacts::new(2);
+        assert_eq!(first.first(&names), None);
+        first.update(&touch(false, vec![[false, false], [false, true]]), 0.10);
+        // A later touch of the same phalanx keeps its first time.
+        first.update(&touch(false, vec![[true, false], [false, true]]), 0.15);
+        assert_eq!(first.fingers, vec![[Some(0.15), None], [None, Some(0.10)]]);
+        let t = first.first(&names).unwrap();
+        assert_eq!((t.body.as_str(), t.phalanx, t.at_s), ("thumb", 2, 0.10));
+        // The palm at the same time as a finger comes first.
+        let mut tie = FirstContacts::new(2);
+        tie.update(&touch(true, vec![[true, false], [false, false]]), 0.2);
+        let t = tie.first(&names).unwrap();
+        assert_eq!((t.body.as_str(), t.phalanx), ("palm", 0));
+    }
+}

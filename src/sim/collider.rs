@@ -502,4 +502,35 @@ mod tests {
             assert!(c.z >= -1e-6 && c.z <= 0.120 + 1e-6, "{} m", c.z);
         }
     }
+
+    #[test]
+    fn the_collider_report_is_the_sentence_it_was() {
+        let plain = ColliderReport {
+            kind: ColliderKind::ConvexDecomposition,
+            parts: 12,
+            rebuilt: None,
+        };
+        assert_eq!(
+            serde_json::to_string(&plain).unwrap(),
+            "\"convex_decomposition (12 parts)\""
+        );
+        let rebuilt = ColliderReport {
+            kind: ColliderKind::ConvexHull,
+            parts: 1,
+            rebuilt: Some(RebuiltHull {
+                from_vertices: 1024,
+                to_vertices: 296,
+            }),
+        };
+        assert_eq!(
+            rebuilt.to_string(),
+            "convex_hull (1 parts, rebuilt from its face planes where parry would merge bent \
+             faces: 1024 vertices to 296)"
+        );
+        // From a shape: the prism's plain hull.
+        let prism = crate::objects::prism(40.0, 100.0, 80.0);
+        let v = crate::mesh::mass_properties(&prism).volume_mm3;
+        let r = ColliderReport::of(&ObjectShape::from_mesh(&prism, v));
+        assert_eq!(r.to_string(), "convex_hull (1 parts)");
+    }
 }

@@ -168,3 +168,125 @@ pub(super) fn rotations(qc: &UnitQuaternion<f64>, q: &UnitQuaternion<f64>) -> (f
     let tilt = (qc * Vector3::z()).angle(&(q * Vector3::z())).to_degrees();
     (full, tilt)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The default rule: a 0.2 s window, projected at twice its speed, within 0.8 of the
+    /// thresholds (5 mm, 5°).
+    fn rule() -> (EarlyDecision, SimParams) {
+        let params = SimParams::default();
+        (EarlyDecision::from_params(&params), params)
+    }
+
+    /// Measured against the identity, a sample every 1/48 s (a 10-sample window).
+    fn frame(is_revolution: bool) -> RestFrame {
+        RestFrame {
+            pc: Vector3::zeros(),
+            qc: UnitQuaternion::identity(),
+            is_revolution,
+            sample_dt: SAMPLE_S,
+        }
+    }
+
+    /// `n` samples of an object at rest at `p` `[mm]`.
+    fn at_rest(n: usize, p: Vector3<f64>) -> Vec<(Vector3<f64>, UnitQuaternion<f64>)> {
+        vec![(p, UnitQuaternion::identity()); n]
+    }
+
+    #[test]
+    fn nothing_is_decided_before_a_whole_window_has_been_sampled() {
+        let (r, params) = rule();
+        let f = frame(false);
+        // round(0.2 s / (1/48 s)) = 10 samples, plus the one the window starts from.
+        let still = Vector3::new(1.0, 0.0, 0.0);
+        assert_eq!(r.decide(&at_rest(10, still), &f, 1.0, &params, false), None);
+        assert_eq!(
+            r.decide(&at_rest(11, still), &f, 1.0, &params, false),
+            Some(Verdict::Hold)
+        );
+    }
+
+    #[test]
+    fn at_rest_the_distance_from_the_closed_pose_decides() {
+        let (r, params) = rule();
+        let f = frame(false);
+        let decide = |x: f64, penetrated| {
+            r.decide(
+                &at_rest(20, Vector3::new(x, 0.0, 0.0)),
+                &f,
+                1.5,
+                &params,
+                penetrated,
+            )
+        };
+        // Within 0.8 × 5 mm: hold; beyond 5 mm / 0.8 = 6.25 mm: slip; between: undecided.
+        assert_eq!(decide(3.9, false), Some(Verdict::Hold));
+        assert_eq!(decide(4.1, false), None);
+        assert_eq!(decide(6.2, false), None);
+        assert_eq!(decide(6.3, false), Some(Verdict::Slip));
+        // A grasp the closing left too deep is `slip` wherever it rests.
+        assert_eq!(decide(4.1, true), Some(Verdict::Slip));
+        // ... but one within the thresholds is still decided `hold` by motion.
+        assert_eq!(decide(1.0, true), Some(Verdict::Hold));
+    }
+
+    #[test]
+    fn motion_is_projected_to_the_end_of_the_hold() {
+        let (r, _) = rule();
+        let f = frame(false);
+        // 1 mm/s along x, from 2 mm: over the 10-sample window (0.2083 s) the object moves
+        // 0.2083 mm, so with 1 s left the bound is 2 × (1 mm/s × 1 s + 0.2083 mm) = 2.417 mm.
+        let samples: Vec<_> = (0..=20)
+            .map(|i| {
+                let x = 2.0 + i as f64 * SAMPLE_S;
+                (Vector3::new(x, 0.0, 0.0), UnitQuaternion::identity())
+            })
+            .collect();
+        let s = r.settling(&samples, &f, 1.0).unwrap();
+        let window_s = 10.0 * SAMPLE_S;
+        let now = 2.0 + 20.0 * SAMPLE_S;
+        assert!((s.now_mm - now).abs() < 1e-12, "{} mm", s.now_mm);
+        let expected = 2.0 * (1.0 + window_s);
+        assert!(
+            (s.more_mm - expected).abs() < 1e-9,
+            "further motion {} mm, expected {expected}",
+            s.more_mm
+        );
+        assert_eq!((s.now_deg, s.more_deg), (0.0, 0.0));
+        // 2.4 mm more cannot be reported as the full protocol's within 0.5 mm or 10 % (0.24 mm).
+        assert!(!r.reportable(&s));
+        // With 0.05 s left, 2 × (0.05 + 0.2083) = 0.517 mm is still over 0.5 mm; with none
+        // left, the spread alone, 2 × 0.2083 = 0.417 mm, is within it.
+        assert!(!r.reportable(&r.settling(&samples, &f, 0.05).unwrap()));
+        assert!(r.reportable(&r.settling(&samples, &f, 0.0).unwrap()));
+    }
+
+    #[test]
+    fn a_body_of_revolution_is_judged_by_the_tilt_of_its_axis() {
+        let spin = UnitQuaternion::from_axis_angle(&Vector3::z_axis(), 10f64.to_radians());
+        let tip = UnitQuaternion::from_axis_angle(&Vector3::x_axis(), 10f64.to_radians());
+        let id = UnitQuaternion::identity();
+        let (full, tilt) = rotations(&id, &spin);
+        assert!(
+            (full - 10.0).abs() < 1e-9 && tilt.abs() < 1e-6,
+            "{full} {tilt}"
+        );
+        let (full, tilt) = rotations(&id, &tip);
+        assert!((full - 10.0).abs() < 1e-9 && (tilt - 10.0).abs() < 1e-9);
+        assert!(frame(true).judged(&id, &spin).abs() < 1e-6);
+        assert!((frame(false).judged(&id, &spin) - 10.0).abs() < 1e-9);
+        // Spun 10° at rest: a hold for a cylinder, beyond 5° / 0.8 and a slip for a box.
+        let (r, params) = rule();
+        let spun = vec![(Vector3::zeros(), spin); 20];
+        assert_eq!(
+            r.decide(&spun, &frame(true), 1.0, &params, false),
+            Some(Verdict::Hold)
+        );
+        assert_eq!(
+            r.decide(&spun, &frame(false), 1.0, &params, false),
+            Some(Verdict::Slip)
+        );
+    }
+}

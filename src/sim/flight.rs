@@ -278,3 +278,45 @@ fn safe_advance_s(b: f64, g_norm: f64, gap: f64) -> f64 {
         gap / b.max(f64::MIN_POSITIVE)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_free_flight_substep_updates_the_velocity_first_then_caps_it() {
+        let g = Vector3::new(0.0, 0.0, -9.81);
+        let (mut x, mut v) = (Vector3::zeros(), Vector3::zeros());
+        let speed = flight_substep(&mut x, &mut v, g, 0.01, 100.0);
+        // v = g·h, then x = v·h: the position already moves in the first substep.
+        assert!((speed - 0.0981).abs() < 1e-15, "{speed}");
+        assert!(
+            (v.z + 0.0981).abs() < 1e-15 && (x.z + 0.000981).abs() < 1e-15,
+            "{x} {v}"
+        );
+        // Beyond the cap the speed is returned uncapped, the velocity scaled down to it.
+        let (mut x, mut v) = (Vector3::zeros(), Vector3::new(200.0, 0.0, 0.0));
+        let speed = flight_substep(&mut x, &mut v, Vector3::zeros(), 0.01, 100.0);
+        assert_eq!(speed, 200.0);
+        assert!(
+            (v.x - 100.0).abs() < 1e-12 && (x.x - 1.0).abs() < 1e-12,
+            "{x} {v}"
+        );
+    }
+
+    #[test]
+    fn the_safe_advance_covers_exactly_the_gap() {
+        // Without gravity, gap / speed: 0.1 m at 2 m/s is 0.05 s.
+        assert!((safe_advance_s(2.0, 0.0, 0.1) - 0.05).abs() < 1e-15);
+        // With it, the root of ½·g·Δ² + b·Δ = gap: (−1 + √(1 + 2 × 9.81 × 0.1)) / 9.81 s.
+        let dt = safe_advance_s(1.0, 9.81, 0.1);
+        assert!((dt - 0.073_501).abs() < 1e-6, "{dt} s");
+        let covered = 0.5 * 9.81 * dt * dt + dt;
+        assert!(
+            (covered - 0.1).abs() < 1e-12,
+            "covers {covered} m, expected 0.1"
+        );
+        // At rest without gravity nothing closes the gap: the advance is unbounded.
+        assert!(safe_advance_s(0.0, 0.0, 0.1) > 1e300);
+    }
+}

@@ -238,3 +238,58 @@ impl ClosingOutcome {
         worst
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decided_by_serialises_as_its_name() {
+        for d in [
+            DecidedBy::End,
+            DecidedBy::Rest,
+            DecidedBy::OutOfReach,
+            DecidedBy::ClearOfHand,
+        ] {
+            let json = serde_json::to_string(&d).unwrap();
+            assert_eq!(json, format!("\"{}\"", d.as_str()));
+        }
+        assert_eq!(DecidedBy::OutOfReach.as_str(), "out_of_reach");
+        assert_eq!(DecidedBy::ClearOfHand.to_string(), "clear_of_hand");
+        assert!(DecidedBy::OutOfReach.is_drop() && DecidedBy::ClearOfHand.is_drop());
+        assert!(!DecidedBy::Rest.is_drop() && !DecidedBy::End.is_drop());
+    }
+
+    #[test]
+    fn the_worst_joint_is_the_largest_error_either_way() {
+        let finger = |name: &str, error_deg| FingerClosing {
+            name: name.to_string(),
+            planned_deg: [90.0, 90.0],
+            final_deg: [90.0, 90.0],
+            error_deg,
+            touching: [true, true],
+            gap_mm: [0.0, 0.0],
+            first_contact_s: [None, None],
+        };
+        let c = ClosingOutcome {
+            shift_mm: 0.0,
+            turn_deg: 0.0,
+            duration_s: 0.1,
+            max_shift_mm: 5.0,
+            pushed: false,
+            first_touch: None,
+            palm_touching: false,
+            fingers: vec![finger("finger_1", [1.0, -3.5]), finger("thumb", [3.0, 2.0])],
+            phalanges_on_plan: 4,
+        };
+        assert_eq!(c.worst_joint(), Some(("finger_1", 2, -3.5)));
+        assert_eq!(
+            ClosingOutcome {
+                fingers: vec![],
+                ..c
+            }
+            .worst_joint(),
+            None
+        );
+    }
+}

@@ -233,22 +233,13 @@ impl Default for SelectionParams {
 }
 
 /// Where the grasp comes from: the planner, or joint angles fixed by the scenario.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct InputParams {
     /// Skip the planner and close the fingers to these `[θ1, θ2]` per finger `[deg]`, with the
     /// palm upright at Finger_1's `override_index` (a sim-only scenario).
     pub override_angles: Option<Vec<[f64; 2]>>,
     /// Finger_1's elevation index for `override_angles` (default: the middle of the domain).
     pub override_index: Option<usize>,
-}
-
-impl Default for InputParams {
-    fn default() -> Self {
-        InputParams {
-            override_angles: None,
-            override_index: None,
-        }
-    }
 }
 
 /// How the fingers' joint 1 close (`[sim] approach`, docs/SIM.md "What the closing does").
@@ -561,5 +552,99 @@ impl FingerParams {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_flat_sim_table_fills_the_groups() {
+        let p: SimParams = toml::from_str(
+            "torque_limit_nm = 0.5\nrest_margin = 0.5\nmax_checked = 3\napproach = \"together\"\n\
+             override_angles = [[90.0, 80.0]]",
+        )
+        .unwrap();
+        assert_eq!(p.fingers.torque_limit_nm, 0.5);
+        assert_eq!(p.early.rest_margin, 0.5);
+        assert_eq!(p.selection.max_checked, 3);
+        assert_eq!(p.closing.approach, Approach::Together);
+        assert_eq!(p.input.override_angles, Some(vec![[90.0, 80.0]]));
+        // Everything else at its default.
+        let mut expected = SimParams::default();
+        expected.fingers.torque_limit_nm = 0.5;
+        expected.early.rest_margin = 0.5;
+        expected.selection.max_checked = 3;
+        expected.closing.approach = Approach::Together;
+        expected.input.override_angles = Some(vec![[90.0, 80.0]]);
+        assert_eq!(p, expected);
+        assert_eq!(
+            toml::from_str::<SimParams>("").unwrap(),
+            SimParams::default()
+        );
+    }
+
+    #[test]
+    fn messages_and_debug_text_are_the_flat_tables() {
+        let err = toml::from_str::<SimParams>("torque_limt_nm = 1.0").unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains(
+                "unknown field `torque_limt_nm`, expected one of `gravity`, `protocol`, \
+                 `rest_window_s`"
+            ),
+            "{msg}"
+        );
+        let err = toml::from_str::<SimParams>("duration_s = \"long\"").unwrap_err();
+        assert!(err.to_string().contains("expected f64"), "{err}");
+        let debug = format!("{:?}", SimParams::default());
+        assert!(
+            debug.starts_with(
+                "SimParams { gravity: Down, protocol: Fast, rest_window_s: 0.2, rest_safety: 2.0,"
+            ),
+            "{debug}"
+        );
+        assert!(
+            debug.ends_with("balanced_squeeze: true, approach: Squeeze }"),
+            "{debug}"
+        );
+    }
+
+    #[test]
+    fn validation_reports_the_first_key_in_the_old_order() {
+        let check = |toml: &str| {
+            toml::from_str::<SimParams>(toml)
+                .unwrap()
+                .validate(3)
+                .map_err(|(key, _)| key)
+        };
+        assert_eq!(check(""), Ok(()));
+        // duration_s before timestep_s before the counts before the damping.
+        assert_eq!(
+            check("duration_s = 0.0\ntimestep_s = 0.0\nmax_checked = 0"),
+            Err("sim.duration_s")
+        );
+        assert_eq!(
+            check("max_checked = 0\nmotor_damping_nms_per_rad = -1.0"),
+            Err("sim.max_checked")
+        );
+        assert_eq!(check("timestep_s = 0.5"), Err("sim.timestep_s"));
+        assert_eq!(check("rest_margin = 1.5"), Err("sim.rest_margin"));
+        assert_eq!(check("override_index = 2"), Err("sim.override_index"));
+        assert_eq!(
+            check("override_angles = [[90.0, 90.0]]\nsqueeze2_deg = -1.0"),
+            Err("sim.override_angles")
+        );
+        assert_eq!(check("squeeze2_deg = -1.0"), Err("sim.squeeze2_deg"));
+        let mut p = SimParams::default();
+        p.solver.timestep_s = 0.5;
+        assert_eq!(
+            p.validate(3),
+            Err((
+                "sim.timestep_s",
+                "must be at most 0.05 s and a tenth of duration_s, got 0.5".to_string()
+            ))
+        );
     }
 }
