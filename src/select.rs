@@ -331,3 +331,43 @@ fn choose(candidates: &[Candidate]) -> Option<usize> {
 fn ms(t: std::time::Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1000.0
 }
+
+/// Why a scenario's `[sim] override_angles` cannot be checked.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OverrideError {
+    /// The graded domain has no indexed elevation to put the palm on.
+    #[error("override_angles: the object has no indexed elevation")]
+    NoElevation,
+    /// The palm could not be placed at the chosen elevation.
+    #[error("override_angles: palm placement failed: {0:?}")]
+    PalmPlacement(plan::palm::PalmRejection),
+}
+
+/// The hand pose for a scenario whose joint angles are fixed by `[sim] override_angles`: the
+/// palm at approach 0 and pitch 0 on indexed elevation `override_index` (default: the middle
+/// one) of the graded domain. (Placed here, not in sim/, so that the physics check does not
+/// call the planner: issue 31.)
+///
+/// # Errors
+/// [`OverrideError`]: why the grasp cannot be checked.
+pub fn override_pose(
+    mesh: &Mesh,
+    hand: &Hand,
+    graded: &GradedDomain,
+    override_index: Option<usize>,
+    angles: &[[f64; 2]],
+) -> Result<crate::sim::SimHand, OverrideError> {
+    let n = graded.domain.elevations.len();
+    if n == 0 {
+        return Err(OverrideError::NoElevation);
+    }
+    let index = override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
+    let z1 = graded.domain.elevations[index - 1];
+    let palm =
+        plan::palm::place_palm(mesh, hand, z1, 0.0, 0.0).map_err(OverrideError::PalmPlacement)?;
+    Ok(crate::sim::SimHand {
+        origin_mm: palm.origin,
+        axes: palm.axes,
+        theta_deg: angles.to_vec(),
+    })
+}

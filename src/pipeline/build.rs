@@ -174,15 +174,7 @@ pub(super) fn checked_report(
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
         start: Some(sim::scene::start(case)),
-        collider: Some(match shape.coarsened_from {
-            Some(from) => format!(
-                "{} ({} parts, rebuilt from its face planes where parry would merge bent faces: {from} vertices to {})",
-                shape.kind,
-                shape.parts,
-                shape.shape.as_convex_polyhedron().map_or(0, |c| c.points().len())
-            ),
-            None => format!("{} ({} parts)", shape.kind, shape.parts),
-        }),
+        collider: Some(sim::ColliderReport::of(shape)),
         mass_kg: Some(case.mass_kg),
         grasp_source: Some(source),
         payload_margin: options
@@ -192,10 +184,10 @@ pub(super) fn checked_report(
         closing: Some(out.closing),
         directions: out.directions,
         limits: Some(report::HoldLimits {
-            translation_mm: case.params.hold_translation_mm,
-            rotation_deg: case.params.hold_rotation_deg,
-            penetration_mm: case.params.max_penetration_mm,
-            closing_shift_mm: case.params.max_closing_shift_mm,
+            translation_mm: case.params.hold.hold_translation_mm,
+            rotation_deg: case.params.hold.hold_rotation_deg,
+            penetration_mm: case.params.hold.max_penetration_mm,
+            closing_shift_mm: case.params.hold.max_closing_shift_mm,
         }),
     }
 }

@@ -284,8 +284,10 @@ fn select_grasps(
         check_grasp(scenario, object, a, g)
     };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
-    let checks_candidates = !options.no_sim && scenario.sim.override_angles.is_none();
-    let max_checked = options.max_checked.unwrap_or(scenario.sim.max_checked);
+    let checks_candidates = !options.no_sim && scenario.sim.input.override_angles.is_none();
+    let max_checked = options
+        .max_checked
+        .unwrap_or(scenario.sim.selection.max_checked);
     select::select(
         object.mesh(),
         &object.props,
@@ -334,12 +336,16 @@ fn sim_pose(
     grasp: Option<(&plan::search::Grasp, Option<sim::SimOutcome>)>,
 ) -> Posed {
     let p = &scenario.sim;
-    match (&p.override_angles, grasp) {
-        (Some(angles), _) => {
-            sim::SimHand::from_override(&aligned.mesh, &scenario.hand, graded, p, angles)
-                .map(|pose| (pose, GraspSource::OverrideAngles, None))
-                .map_err(|e| e.to_string())
-        }
+    match (&p.input.override_angles, grasp) {
+        (Some(angles), _) => select::override_pose(
+            &aligned.mesh,
+            &scenario.hand,
+            graded,
+            p.input.override_index,
+            angles,
+        )
+        .map(|pose| (pose, GraspSource::OverrideAngles, None))
+        .map_err(|e| e.to_string()),
         (None, Some((g, done))) => Ok((sim::SimHand::from_grasp(g), GraspSource::Planner, done)),
         (None, None) => Err("no feasible grasp to check".to_string()),
     }

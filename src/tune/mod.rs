@@ -524,7 +524,7 @@ fn run_object(
             s.name.apply(&mut params, *v);
         }
         let valid = validate_planner(&params, &p.scenario.hand, p.scenario.object.friction);
-        results.push(match (valid, &p.scenario.sim.override_angles) {
+        results.push(match (valid, &p.scenario.sim.input.override_angles) {
             (Err((key, why)), _) => {
                 object_result(p, ObjectStatus::Invalid, None, Some(format!("{key} {why}")))
             }
@@ -594,7 +594,13 @@ fn run_override(
         .clone();
     let mut t = StageTimings::default();
     let graded = plan::grade_built(domain, hand, params, p.scenario.object.friction, &mut t);
-    let pose = SimHand::from_override(&aligned.mesh, hand, &graded, &p.scenario.sim, angles);
+    let pose = crate::select::override_pose(
+        &aligned.mesh,
+        hand,
+        &graded,
+        p.scenario.sim.input.override_index,
+        angles,
+    );
     let outcome = pose.ok().map(|pose| {
         let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
         let shape = p.object.shape(aligned);
@@ -640,7 +646,7 @@ fn run_planned(
             planner: params,
             friction: p.scenario.object.friction,
             collect: candidates,
-            max_checked: Some(p.scenario.sim.max_checked.max(1)),
+            max_checked: Some(p.scenario.sim.selection.max_checked.max(1)),
             check: &check,
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,
