@@ -2,13 +2,15 @@
 //! thesis "Kinematic Enveloping Grasp Planning Method for Robotic Dexterous Hands and
 //! Three-Dimensional Objects" (McMaster University), checked in a rapier3d physics scene.
 //!
-//! Data flow (each stage a plain function, so tests, benches and the tuner can call one alone):
+//! Data flow (each stage a plain function, so tests, benches and the tuner can call one alone;
+//! [`pipeline`] runs them for one input, and the command line, `batch` and `tune` call it):
 //!
 //! ```text
 //! scenario.toml → scenario::Scenario → prepared::PreparedObject (mesh::load_mesh, mass, collider)
 //!   → select::select: for each rule set (thesis, extended, pinch) and axis: mesh::align →
 //!     plan (stages 1–3 on slice::slice, then the search) → each candidate's sim check
 //!   → quality (optional) → report::RunReport (JSON, summary; expectations judged)
+//!   → pipeline::write_outputs (--report, --export-mjcf, --export-urdf)
 //! ```
 //!
 //! Units: the mesh, slicer and planner work in millimetres and degrees in the aligned object frame

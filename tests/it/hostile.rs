@@ -43,11 +43,12 @@ fn a_tune_grid_too_large_in_product_is_refused() {
 }
 
 /// An input past the time bound per input is an error line, and the next input still runs:
-/// with a bound of a millisecond every input here is past it, each named on its own line.
+/// with a bound of a millisecond every input here (the six-direction check with the payload
+/// search, seconds each) is past it, each named on its own line.
 #[test]
 fn an_input_past_the_time_bound_is_an_error_line_and_the_next_still_runs() {
     let out = grasp_sim()
-        .args(["--no-sim", "--time-limit", "0.001"])
+        .args(["--gravity", "six", "--payload", "--time-limit", "0.001"])
         .args(["scenarios/cup.toml", "scenarios/cylinder_d40.toml"])
         .output()
         .unwrap();
