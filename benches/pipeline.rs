@@ -182,12 +182,12 @@ fn bench_sim(c: &mut Criterion) {
             false,
         ),
     ] {
-        let params = SimParams {
+        let mut params = SimParams {
             gravity,
             protocol,
-            close_until_stalled: stalled,
             ..SimParams::default()
         };
+        params.closing.close_until_stalled = stalled;
         g.bench_function(name, |b| {
             let case = Case {
                 hand: &hand,

@@ -57,7 +57,7 @@ fn decide(
         if remaining <= 1e-9 {
             return None;
         }
-        let penetrated = t.outcome.closing_penetration_mm > params.max_penetration_mm;
+        let penetrated = t.outcome.closing_penetration_mm > params.hold.max_penetration_mm;
         let Some(verdict) = rule.decide(&t.samples[..=i], &t.frame, remaining, params, penetrated)
         else {
             continue;
@@ -121,11 +121,11 @@ fn main() {
                 let line = serde_json::json!({
                     "name": s.name, "gravity": o.gravity, "verdict": o.verdict.as_str(),
                     "translation_mm": o.translation_mm, "rotation_deg": o.rotation_deg,
-                    "penetrated": o.closing_penetration_mm > s.sim.max_penetration_mm,
+                    "penetrated": o.closing_penetration_mm > s.sim.hold.max_penetration_mm,
                     "duration_s": t.duration_s, "sample_dt": t.fine_dt,
-                    "thresholds": [s.sim.hold_translation_mm, s.sim.hold_rotation_deg],
-                    "safety": s.sim.rest_safety,
-                    "margin": s.sim.rest_margin, "window_s": s.sim.rest_window_s,
+                    "thresholds": [s.sim.hold.hold_translation_mm, s.sim.hold.hold_rotation_deg],
+                    "safety": s.sim.early.rest_safety,
+                    "margin": s.sim.early.rest_margin, "window_s": s.sim.early.rest_window_s,
                     "rule_every": (t.frame.sample_dt / t.fine_dt).round() as usize,
                     "pc": [t.frame.pc.x, t.frame.pc.y, t.frame.pc.z], "qc": q(&t.frame.qc),
                     "revolution": t.frame.is_revolution,
@@ -157,7 +157,7 @@ fn main() {
                 // A rest within the thresholds is a `hold` by motion, and the full verdict may
                 // also be `slip` for a penetration, which both protocols share.
                 let expected = if by_motion == Verdict::Hold
-                    && o.closing_penetration_mm > s.sim.max_penetration_mm
+                    && o.closing_penetration_mm > s.sim.hold.max_penetration_mm
                 {
                     Verdict::Slip
                 } else {

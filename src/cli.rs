@@ -1,7 +1,92 @@
 //! Command-line flags, as typed (clap derive).
 
-use clap::{Parser, Subcommand};
+use clap::{Parser, Subcommand, ValueEnum};
+use grasp_sim::mesh::LengthUnit;
+use grasp_sim::scenario::GravityMode;
 use std::path::PathBuf;
+
+/// A length unit named on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Units {
+    /// Millimetres.
+    Mm,
+    /// Centimetres.
+    Cm,
+    /// Metres.
+    M,
+    /// Inches.
+    Inch,
+}
+
+impl From<Units> for LengthUnit {
+    fn from(u: Units) -> LengthUnit {
+        match u {
+            Units::Mm => LengthUnit::Mm,
+            Units::Cm => LengthUnit::Cm,
+            Units::M => LengthUnit::M,
+            Units::Inch => LengthUnit::Inch,
+        }
+    }
+}
+
+impl Units {
+    /// The name as typed (`mm`, `cm`, `m`, `inch`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Units::Mm => "mm",
+            Units::Cm => "cm",
+            Units::M => "m",
+            Units::Inch => "inch",
+        }
+    }
+}
+
+/// The gravity directions named on the command line.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Gravity {
+    /// The aligned object's −Z.
+    Down,
+    /// ±X, ±Y, ±Z in turn.
+    Six,
+}
+
+impl From<Gravity> for GravityMode {
+    fn from(g: Gravity) -> GravityMode {
+        match g {
+            Gravity::Down => GravityMode::Down,
+            Gravity::Six => GravityMode::Six,
+        }
+    }
+}
+
+/// The flags that decide what a run computes for each input (the main command, `batch` and its
+/// workers share them).
+#[derive(Debug, Clone, Copy, clap::Args)]
+pub struct RunFlags {
+    /// Plan only; skip the physics check.
+    #[arg(long)]
+    pub no_sim: bool,
+
+    /// Also find the payload margin: the largest mass multiplier (up to 64) that still holds.
+    #[arg(long)]
+    pub payload: bool,
+
+    /// Also compute the analytic grasp quality (Ferrari-Canny epsilon and volume of the grasp
+    /// wrench space, L1 and L-infinity, docs/QUALITY.md) of every grasp reported: about 30-40 ms
+    /// per grasp from the check's contacts, 0.1-0.2 s from the planned ones.
+    #[arg(long)]
+    pub quality: bool,
+}
+
+impl From<RunFlags> for grasp_sim::RunFlags {
+    fn from(f: RunFlags) -> grasp_sim::RunFlags {
+        grasp_sim::RunFlags {
+            no_sim: f.no_sim,
+            payload: f.payload,
+            quality: f.quality,
+        }
+    }
+}
 
 /// Plan enveloping grasps for a three-fingered hand and check them in a physics scene.
 ///
@@ -22,26 +107,15 @@ pub struct Cli {
 
     /// Length unit of bare meshes given on the command line (scenarios say theirs in
     /// `[object] units`).
-    #[arg(long, value_name = "UNIT", default_value = "mm", value_parser = ["mm", "cm", "m", "inch"])]
-    pub units: String,
+    #[arg(long, value_name = "UNIT", value_enum, default_value_t = Units::Mm)]
+    pub units: Units,
 
     /// Print one JSON object per scenario (JSON Lines) instead of the summary.
     #[arg(long)]
     pub json: bool,
 
-    /// Plan only; skip the physics check.
-    #[arg(long)]
-    pub no_sim: bool,
-
-    /// Also find the payload margin: the largest mass multiplier (up to 64) that still holds.
-    #[arg(long)]
-    pub payload: bool,
-
-    /// Also compute the analytic grasp quality (Ferrari-Canny epsilon and volume of the grasp
-    /// wrench space, L1 and L-infinity, docs/QUALITY.md) of every grasp reported: about 30-40 ms
-    /// per grasp from the check's contacts, 0.1-0.2 s from the planned ones.
-    #[arg(long)]
-    pub quality: bool,
+    #[command(flatten)]
+    pub flags: RunFlags,
 
     /// Write each planned grasp as an MJCF scene for MuJoCo into DIR/<scenario>/ (scene.xml,
     /// the object's STL, protocol.json for scripts/mujoco_replay.py).
@@ -69,8 +143,14 @@ pub struct Cli {
     /// Gravity directions of the physics check, for every input: `down` (the aligned object's
     /// −Z) or `six` (±X, ±Y, ±Z in turn, each from the one closing); default: each scenario's
     /// `[sim] gravity`, `down` for a bare mesh.
-    #[arg(long, value_name = "DIRECTIONS", value_parser = ["down", "six"])]
-    pub gravity: Option<String>,
+    #[arg(long, value_name = "DIRECTIONS", value_enum)]
+    pub gravity: Option<Gravity>,
+
+    /// Stop waiting for an input after this many seconds: its line is an error and the next
+    /// input runs (a backstop; no input the planner's budget admits comes near it).
+    #[arg(long, value_name = "SECONDS", value_parser = positive_seconds,
+          default_value_t = grasp_sim::pipeline::inputs::DEFAULT_TIME_LIMIT_S)]
+    pub time_limit: f64,
 
     #[command(subcommand)]
     pub command: Option<Command>,
@@ -116,47 +196,16 @@ pub enum Command {
         #[arg(long)]
         template: Option<PathBuf>,
         /// As `batch --units`.
-        #[arg(long, value_parser = ["mm", "cm", "m", "inch"])]
-        units: Option<String>,
-        /// As `batch --no-sim`.
-        #[arg(long)]
-        no_sim: bool,
-        /// As `batch --payload`.
-        #[arg(long)]
-        payload: bool,
-        /// As `batch --quality`.
-        #[arg(long)]
-        quality: bool,
+        #[arg(long, value_enum)]
+        units: Option<Units>,
+        /// As `batch`'s.
+        #[command(flatten)]
+        flags: RunFlags,
     },
     /// Sweep planner parameters over a grid and rank the settings by simulated outcomes (hold
     /// rate, then mean payload margin, then mean translation); writes tune.csv, tune.json and
     /// score_<param>.svg into --out.
-    Tune {
-        /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply, .urdf).
-        #[arg(required = true, value_name = "DIR | SCENARIO")]
-        inputs: Vec<PathBuf>,
-        // Help: NAME=START:END:STEP, repeatable, and the names of tune::TunedParam.
-        #[arg(
-            long = "param",
-            required = true,
-            value_name = "NAME=START:END:STEP",
-            value_parser = grasp_sim::tune::parse_sweep,
-            help = format!("NAME=START:END:STEP, repeatable ({})", grasp_sim::tune::TunedParam::names())
-        )]
-        params: Vec<grasp_sim::tune::Sweep>,
-        /// Output folder.
-        #[arg(long, value_name = "DIR")]
-        out: PathBuf,
-        /// Plan up to N grasps per object and keep the best by simulation.
-        #[arg(long, value_name = "N", default_value_t = 1)]
-        candidates: usize,
-        /// Scenario used for bare meshes (default: the thesis hand and defaults).
-        #[arg(long, value_name = "SCENARIO")]
-        template: Option<PathBuf>,
-        /// Worker threads (default: all cores).
-        #[arg(long, value_name = "N")]
-        jobs: Option<usize>,
-    },
+    Tune(TuneArgs),
     /// Write the thesis objects as binary STL (deterministic: the same bytes every time).
     GenAssets {
         /// Output folder.
@@ -180,8 +229,8 @@ pub struct BatchArgs {
     #[arg(long, value_name = "SCENARIO")]
     pub template: Option<PathBuf>,
     /// Length unit of bare meshes (overrides the template's).
-    #[arg(long, value_name = "UNIT", value_parser = ["mm", "cm", "m", "inch"])]
-    pub units: Option<String>,
+    #[arg(long, value_name = "UNIT", value_enum)]
+    pub units: Option<Units>,
     /// Write the JSON lines to this file instead of stdout (written whole, or not at all;
     /// with --resume, appended as objects finish).
     #[arg(long, value_name = "FILE")]
@@ -218,23 +267,80 @@ pub struct BatchArgs {
     /// Run only the K-th of N contiguous blocks of the inputs (e.g. a Slurm array task).
     #[arg(long, value_name = "K/N", value_parser = grasp_sim::batch::parse_shard)]
     pub shard: Option<grasp_sim::batch::Shard>,
-    /// Plan only.
-    #[arg(long)]
-    pub no_sim: bool,
-    /// Also find each grasp's payload margin.
-    #[arg(long)]
-    pub payload: bool,
-
-    /// Also compute the analytic grasp quality (Ferrari-Canny epsilon and volume of the grasp
-    /// wrench space, L1 and L-infinity, docs/QUALITY.md) of every grasp reported: about 30-40 ms
-    /// per grasp from the check's contacts, 0.1-0.2 s from the planned ones.
-    #[arg(long)]
-    pub quality: bool,
+    /// What each object's run computes.
+    #[command(flatten)]
+    pub flags: RunFlags,
 }
 
 fn positive_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(t) if t > 0.0 && t.is_finite() => Ok(t),
         _ => Err(format!("`{s}` is not a positive number of seconds")),
+    }
+}
+
+/// `grasp-sim tune` flags.
+#[derive(Debug, clap::Args)]
+pub struct TuneArgs {
+    /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply, .urdf).
+    #[arg(required = true, value_name = "DIR | SCENARIO")]
+    pub inputs: Vec<PathBuf>,
+    // Help: NAME=START:END:STEP, repeatable, and the names of tune::TunedParam.
+    #[arg(
+        long = "param",
+        required = true,
+        value_name = "NAME=START:END:STEP",
+        value_parser = grasp_sim::tune::parse_sweep,
+        help = format!("NAME=START:END:STEP, repeatable ({})", grasp_sim::tune::TunedParam::names())
+    )]
+    pub params: Vec<grasp_sim::tune::Sweep>,
+    /// Output folder.
+    #[arg(long, value_name = "DIR")]
+    pub out: PathBuf,
+    /// Plan up to N grasps per object and keep the best by simulation.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub candidates: usize,
+    /// Scenario used for bare meshes (default: the thesis hand and defaults).
+    #[arg(long, value_name = "SCENARIO")]
+    pub template: Option<PathBuf>,
+    /// Worker threads (default: all cores).
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+}
+
+impl TuneArgs {
+    /// The library's request for these flags.
+    pub fn request(self) -> grasp_sim::tune::command::Request {
+        grasp_sim::tune::command::Request {
+            inputs: self.inputs,
+            sweeps: self.params,
+            out: self.out,
+            candidates: self.candidates,
+            template: self.template,
+            jobs: self.jobs,
+        }
+    }
+}
+
+impl BatchArgs {
+    /// The library's request for these flags.
+    pub fn request(self) -> grasp_sim::batch::command::Request {
+        grasp_sim::batch::command::Request {
+            inputs: self.inputs,
+            worker: grasp_sim::batch::command::WorkerArgs {
+                template: self.template,
+                units: self.units.map(Into::into),
+                flags: self.flags.into(),
+            },
+            out: self.out,
+            resume: self.resume,
+            retry_errors: self.retry_errors,
+            object_timeout: self.object_timeout,
+            object_memory: self.object_memory,
+            in_process: self.in_process,
+            merge: self.merge,
+            jobs: self.jobs,
+            shard: self.shard,
+        }
     }
 }

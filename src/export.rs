@@ -211,7 +211,7 @@ fn mjcf_hand(s: &mut String, case: &Case, start: &Start) {
         quat(&palm_rotation(&case.pose.axes))
     );
     box_geom(s, "      ", "palm", &hand.palm_box(), "");
-    let density = format!(" density=\"{}\"", case.params.finger_density_kg_m3);
+    let density = format!(" density=\"{}\"", case.params.fingers.finger_density_kg_m3);
     for f in &hand.finger_list {
         let sd = f.side.sign();
         let n = &f.name;
@@ -297,8 +297,8 @@ fn mjcf_actuators(s: &mut String, case: &Case) {
     let sim = case.params;
     let limits = bend_limits(case.hand);
     let (kp, kv) = (
-        sim.motor_stiffness_nm_per_rad,
-        sim.motor_damping_nms_per_rad,
+        sim.fingers.motor_stiffness_nm_per_rad,
+        sim.fingers.motor_damping_nms_per_rad,
     );
     let torques = crate::sim::scene::finger_torque_limits(case.hand, sim);
     let _ = writeln!(s, "  <actuator>");
@@ -341,9 +341,9 @@ impl Keyframes {
             k.planned.push(b1);
             k.planned.push(b2);
             k.ctrl
-                .push((b1 + sim.squeeze_deg.to_radians()).clamp(lo1, hi1));
+                .push((b1 + sim.fingers.squeeze_deg.to_radians()).clamp(lo1, hi1));
             k.ctrl
-                .push((b2 + sim.squeeze2_deg.to_radians()).clamp(lo2, hi2));
+                .push((b2 + sim.fingers.squeeze2_deg.to_radians()).clamp(lo2, hi2));
         }
         k
     }
@@ -383,21 +383,21 @@ fn protocol(input: &ExportInput, keys: &Keyframes) -> serde_json::Value {
         "planned_bend_rad": keys.planned,
         "open_bend_rad": keys.open,
         "target_bend_rad": keys.ctrl,
-        "close_duration_s": sim.close_duration_s,
-        "close_until_stalled": sim.close_until_stalled,
+        "close_duration_s": sim.closing.close_duration_s,
+        "close_until_stalled": sim.closing.close_until_stalled,
         "stall": {
             "joint_rad_s": crate::sim::STALL.joint_rad_s,
             "object_mm_s": crate::sim::STALL.object_mm_s,
             "object_rad_s": crate::sim::STALL.object_rad_s,
             "window_s": crate::sim::STALL.window_s,
         },
-        "duration_s": sim.duration_s,
-        "joint1_lock_torque_nm": sim.joint1_lock_torque_nm,
-        "motor_stiffness_nm_per_rad": sim.motor_stiffness_nm_per_rad,
-        "hold_translation_mm": sim.hold_translation_mm,
-        "hold_rotation_deg": sim.hold_rotation_deg,
-        "max_closing_shift_mm": sim.max_closing_shift_mm,
-        "approach": sim.approach,
+        "duration_s": sim.hold.duration_s,
+        "joint1_lock_torque_nm": sim.fingers.joint1_lock_torque_nm,
+        "motor_stiffness_nm_per_rad": sim.fingers.motor_stiffness_nm_per_rad,
+        "hold_translation_mm": sim.hold.hold_translation_mm,
+        "hold_rotation_deg": sim.hold.hold_rotation_deg,
+        "max_closing_shift_mm": sim.hold.max_closing_shift_mm,
+        "approach": sim.closing.approach,
         "gravity": match sim.gravity { GravityMode::Down => "down", GravityMode::Six => "six" },
         "is_revolution": case.object.is_revolution,
         "mass_kg": case.mass_kg,
@@ -414,7 +414,7 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
     std::fs::create_dir_all(dir).map_err(|e| io_error(dir, e))?;
     let o = hand.fingers.offset_mm * MM;
     let l2 = hand.phalanx_2.length_mm * MM;
-    let rho = sim.finger_density_kg_m3;
+    let rho = sim.fingers.finger_density_kg_m3;
     let mut s = String::new();
     let _ = writeln!(s, "<?xml version=\"1.0\"?>");
     let _ = writeln!(s, "<robot name=\"{}\">", hand.name);
@@ -491,7 +491,7 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
             let _ = writeln!(
                 s,
                 "    <limit lower=\"{:.9}\" upper=\"{:.9}\" effort=\"{}\" velocity=\"10\"/>",
-                range.0, range.1, sim.torque_limit_nm
+                range.0, range.1, sim.fingers.torque_limit_nm
             );
             let _ = writeln!(s, "  </joint>");
         }

@@ -170,50 +170,7 @@ pub fn select(
                 .get_or_insert_with(|| align_with_rule(mesh, props, *axis, p.frame))
                 .clone();
             let mut t = StageTimings::default();
-            // The pinch pass searches the extended rules' graded domain again (it changes only
-            // how a finger is placed): reuse it rather than slice and grade a second time.
-            let extended = sel
-                .axes
-                .iter()
-                .find(|a| a.rules == RuleSet::Extended && a.aligned.axis == *axis)
-                .filter(|_| rules == RuleSet::Pinch)
-                .map(|a| a.graded.clone());
-            let graded = match (extended, p.domains) {
-                (Some(graded), _) => graded,
-                (None, None) => plan::grade_domain_with(
-                    &aligned.mesh,
-                    p.hand,
-                    p.planner,
-                    p.friction,
-                    rules,
-                    &mut t,
-                ),
-                (None, Some(cache)) => {
-                    let key = (
-                        *axis,
-                        rules.domain_rules(),
-                        p.planner.angular_step_deg.to_bits(),
-                        p.planner.height_step_mm.to_bits(),
-                    );
-                    let domain = cache
-                        .borrow_mut()
-                        .entry(key)
-                        .or_insert_with(|| {
-                            plan::stage1_with(
-                                &aligned.mesh,
-                                p.hand,
-                                p.planner,
-                                rules.domain_rules(),
-                            )
-                        })
-                        .clone();
-                    plan::grade_built_with(domain, p.hand, p.planner, p.friction, rules, &mut t)
-                }
-            };
-            let slot = sel.axes.len();
-            let t0 = std::time::Instant::now();
-            let mut found = 0;
-            let mut stopped = false;
+            let graded = graded_for(&sel, p, rules, &aligned, &mut t);
             // An equal share of what is left of the rule set's budget (rounded up, so an axis
             // with few candidates leaves more to those after it).
             let budget = match p.planner.candidate_budget {
@@ -222,49 +179,113 @@ pub fn select(
                     .saturating_sub(spent)
                     .div_ceil(GraspAxis::SEARCH_ORDER.len() - k),
             };
-            let available = candidate_count(&graded, p.planner);
-            let (tried, rejections) = search_with(
-                &aligned.mesh,
-                p.hand,
-                &graded,
-                p.planner,
-                rules,
+            let plan = search_axis(
+                &mut sel,
+                p,
+                (aligned, rules, graded),
                 budget,
-                |g| {
-                    found += 1;
-                    let check = match p.max_checked {
-                        Some(max) if sel.checked() < max && !has_hold(&sel) => {
-                            Some((p.check)(&aligned, &g))
-                        }
-                        _ => None,
-                    };
-                    sel.candidates.push(Candidate {
-                        axis_plan: slot,
-                        grasp: g,
-                        check,
-                    });
-                    stopped = is_done(&sel, p, collect);
-                    !stopped
-                },
+                collect,
+                &mut t,
             );
-            t.search += ms(t0);
             timings.add(&t);
-            spent += tried;
-            sel.axes.push(AxisPlan {
-                aligned,
-                rules,
-                graded,
-                candidates_tried: tried,
-                rejections,
-                grasps_found: found,
-                exhausted: !stopped && tried == available,
-                candidates_available: available,
-                budget_stopped: !stopped && tried < available,
-            });
+            spent += plan.candidates_tried;
+            sel.axes.push(plan);
         }
     }
     sel.chosen = choose(&sel.candidates);
     sel
+}
+
+/// The graded domain of `rules` on `aligned`. The pinch pass searches the extended rules'
+/// graded domain again (it changes only how a finger is placed): it is reused rather than
+/// sliced and graded a second time. With a domain cache, stage 1 comes from it.
+fn graded_for(
+    sel: &Selection,
+    p: &SelectParams,
+    rules: RuleSet,
+    aligned: &AlignedObject,
+    t: &mut StageTimings,
+) -> plan::GradedDomain {
+    let axis = aligned.axis;
+    let extended = sel
+        .axes
+        .iter()
+        .find(|a| a.rules == RuleSet::Extended && a.aligned.axis == axis)
+        .filter(|_| rules == RuleSet::Pinch)
+        .map(|a| a.graded.clone());
+    match (extended, p.domains) {
+        (Some(graded), _) => graded,
+        (None, None) => {
+            plan::grade_domain_with(&aligned.mesh, p.hand, p.planner, p.friction, rules, t)
+        }
+        (None, Some(cache)) => {
+            let key = (
+                axis,
+                rules.domain_rules(),
+                p.planner.angular_step_deg.to_bits(),
+                p.planner.height_step_mm.to_bits(),
+            );
+            let domain = cache
+                .borrow_mut()
+                .entry(key)
+                .or_insert_with(|| {
+                    plan::stage1_with(&aligned.mesh, p.hand, p.planner, rules.domain_rules())
+                })
+                .clone();
+            plan::grade_built_with(domain, p.hand, p.planner, p.friction, rules, t)
+        }
+    }
+}
+
+/// Searches one axis under one rule set for at most `budget` candidates, adding each feasible
+/// grasp to `sel` (checked while checks remain and none has held) until enough is known.
+fn search_axis(
+    sel: &mut Selection,
+    p: &SelectParams,
+    (aligned, rules, graded): (AlignedObject, RuleSet, plan::GradedDomain),
+    budget: usize,
+    collect: usize,
+    t: &mut StageTimings,
+) -> AxisPlan {
+    let slot = sel.axes.len();
+    let t0 = std::time::Instant::now();
+    let mut found = 0;
+    let mut stopped = false;
+    let available = candidate_count(&graded, p.planner);
+    let (tried, rejections) = search_with(
+        &aligned.mesh,
+        p.hand,
+        &graded,
+        p.planner,
+        rules,
+        budget,
+        |g| {
+            found += 1;
+            let check = match p.max_checked {
+                Some(max) if sel.checked() < max && !has_hold(sel) => Some((p.check)(&aligned, &g)),
+                _ => None,
+            };
+            sel.candidates.push(Candidate {
+                axis_plan: slot,
+                grasp: g,
+                check,
+            });
+            stopped = is_done(sel, p, collect);
+            !stopped
+        },
+    );
+    t.search += ms(t0);
+    AxisPlan {
+        aligned,
+        rules,
+        graded,
+        candidates_tried: tried,
+        rejections,
+        grasps_found: found,
+        exhausted: !stopped && tried == available,
+        candidates_available: available,
+        budget_stopped: !stopped && tried < available,
+    }
 }
 
 /// Returns true if and only if enough is known: without the check, `collect` grasps; with it,
@@ -309,4 +330,44 @@ fn choose(candidates: &[Candidate]) -> Option<usize> {
 
 fn ms(t: std::time::Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1000.0
+}
+
+/// Why a scenario's `[sim] override_angles` cannot be checked.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum OverrideError {
+    /// The graded domain has no indexed elevation to put the palm on.
+    #[error("override_angles: the object has no indexed elevation")]
+    NoElevation,
+    /// The palm could not be placed at the chosen elevation.
+    #[error("override_angles: palm placement failed: {0:?}")]
+    PalmPlacement(plan::palm::PalmRejection),
+}
+
+/// The hand pose for a scenario whose joint angles are fixed by `[sim] override_angles`: the
+/// palm at approach 0 and pitch 0 on indexed elevation `override_index` (default: the middle
+/// one) of the graded domain. (Placed here, not in sim/, so that the physics check does not
+/// call the planner: issue 31.)
+///
+/// # Errors
+/// [`OverrideError`]: why the grasp cannot be checked.
+pub fn override_pose(
+    mesh: &Mesh,
+    hand: &Hand,
+    graded: &GradedDomain,
+    override_index: Option<usize>,
+    angles: &[[f64; 2]],
+) -> Result<crate::sim::SimHand, OverrideError> {
+    let n = graded.domain.elevations.len();
+    if n == 0 {
+        return Err(OverrideError::NoElevation);
+    }
+    let index = override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
+    let z1 = graded.domain.elevations[index - 1];
+    let palm =
+        plan::palm::place_palm(mesh, hand, z1, 0.0, 0.0).map_err(OverrideError::PalmPlacement)?;
+    Ok(crate::sim::SimHand {
+        origin_mm: palm.origin,
+        axes: palm.axes,
+        theta_deg: angles.to_vec(),
+    })
 }

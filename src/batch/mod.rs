@@ -13,6 +13,7 @@
 //! runs each object in its own process so a crash, a timeout or memory exhaustion costs one
 //! error line.
 
+pub mod command;
 pub mod isolate;
 pub mod journal;
 pub mod record;

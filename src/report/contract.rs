@@ -465,7 +465,7 @@ pub struct SimReport {
     pub start: Option<crate::sim::scene::Start>,
     /// The object's collider: `convex_hull` or `convex_decomposition`, and its part count.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub collider: Option<String>,
+    pub collider: Option<crate::sim::ColliderReport>,
     /// Object mass simulated `[kg]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mass_kg: Option<f64>,

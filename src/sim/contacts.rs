@@ -155,3 +155,16 @@ pub fn friction_use(scene: &Scene) -> FrictionUse {
     }
     out
 }
+
+/// True if and only if the object touches the hand.
+pub(super) fn touches_hand(scene: &Scene) -> bool {
+    scene
+        .world
+        .narrow_phase
+        .contact_pairs_with(scene.object_collider)
+        .any(|pair| {
+            pair.has_any_active_contact()
+                && (scene.hand_colliders.contains(&pair.collider1)
+                    || scene.hand_colliders.contains(&pair.collider2))
+        })
+}

@@ -5,6 +5,12 @@
 //! planner's millimetres and degrees and [`convert`] converts once. The scene is built in the
 //! aligned object frame, where the thesis's weight acts along −Z.
 //!
+//! Files: [`params`] (the `[sim]` table), [`scene`] (the rapier scene and where it starts),
+//! [`collider`] (the object's collision shape), [`protocol`] (the two protocols' drivers),
+//! [`closing`], [`hold`] with [`early`] (the rest rule) and [`flight`] (drop detection),
+//! [`payload`], [`outcome`] (what is reported), [`contacts`] (the grip's contacts) and
+//! [`convert`] (nalgebra to glam, millimetres to metres).
+//!
 //! Scene ([`scene`]): the palm is a fixed box at the planned pose; each phalanx is a
 //! dynamic box (finger width and thickness 2 × finger offset; phalanx 2's thinned tip as a thinner
 //! box); joints are revolute on the finger joint axes with the hand's limits, as multibody
@@ -27,18 +33,28 @@
 //! relative to the palm during the hold gives the verdict: `hold` within the thresholds, `slip`
 //! beyond them while still touching the hand, `drop` when it has left the hand.
 
+pub mod closing;
+pub mod collider;
 pub mod contacts;
 pub mod convert;
+pub mod early;
+pub mod flight;
+pub mod hold;
+pub mod outcome;
 pub mod params;
+pub mod payload;
 pub mod protocol;
 pub mod scene;
 
-pub use protocol::{
-    check, check_closed, check_with_payload, payload_bracket, payload_margin, Closed,
-    ClosingOutcome, DirectionOutcome, EarlyDecision, FingerClosing, FirstTouch, SimOutcome, Stall,
-    Verdict, STALL,
+pub use closing::{Stall, STALL};
+pub use collider::{collider_inertia, ColliderKind, ColliderReport, ObjectShape};
+pub use early::EarlyDecision;
+pub use outcome::{
+    ClosingOutcome, DecidedBy, DirectionOutcome, FingerClosing, FirstTouch, SimOutcome, Verdict,
 };
-pub use scene::{collider_inertia, Case, ColliderKind, ObjectShape, OverrideError, SimHand};
+pub use payload::{check_with_payload, payload_bracket, payload_margin};
+pub use protocol::{check, check_closed, Closed};
+pub use scene::{Case, SimHand};
 
 /// A body's pose: position `[m]` and orientation, aligned object frame.
 pub type BodyPose = (nalgebra::Vector3<f64>, nalgebra::UnitQuaternion<f64>);

@@ -1,5 +1,11 @@
 //! The physics check's parameters (DESIGN.md section 5), as a scenario's `[sim]` table gives
 //! them, and their validation. Units in the names: seconds, newton-metres, millimetres, degrees.
+//!
+//! [`SimParams`] groups them by concern (solver, fingers, closing, hold, early decision,
+//! selection, input); the `[sim]` table stays flat, its keys the fields' names: it is read into
+//! a flat view (the private `flat::SimParams`, the same name so that serde's messages and the
+//! `Debug` text are the flat table's) and converted. serde's `flatten` cannot be used here: it
+//! does not work with `deny_unknown_fields`, which names a mistyped key.
 
 use crate::messages::keyed;
 use serde::Deserialize;
@@ -30,14 +36,163 @@ pub enum Protocol {
 /// The default of `[sim] max_closing_shift_mm` `[mm]` (docs/SIM.md, "What the closing does").
 pub const DEFAULT_MAX_CLOSING_SHIFT_MM: f64 = 5.0;
 
-/// Physics check parameters (DESIGN.md section 5); used by the physics check.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+/// Physics check parameters (DESIGN.md section 5); used by the physics check. Each field of a
+/// group is the `[sim]` key of the same name.
+#[derive(Clone, PartialEq, Deserialize)]
+#[serde(from = "flat::SimParams")]
 pub struct SimParams {
     /// Gravity direction(s).
     pub gravity: GravityMode,
     /// `fast` (default) or `full`, the reference protocol the fast one is compared with.
     pub protocol: Protocol,
+    /// The rapier solver: timestep, iterations and contact stiffness.
+    pub solver: SolverParams,
+    /// How the fingers are driven (motor torques, gains, squeeze) and how heavy they are.
+    pub fingers: FingerParams,
+    /// How the fingers close before gravity comes on (docs/SIM.md, "What the closing does").
+    pub closing: ClosingParams,
+    /// The hold: how long each gravity direction is held, and the thresholds of a `hold`.
+    pub hold: HoldParams,
+    /// The `fast` protocol's rest rule (docs/SIM.md, "Deciding early").
+    pub early: EarlyParams,
+    /// The candidate search's policy: how many planned grasps a run checks.
+    pub selection: SelectionParams,
+    /// Where the grasp comes from: the planner, or joint angles fixed by the scenario.
+    pub input: InputParams,
+}
+
+/// The rapier solver: timestep, iterations and contact stiffness.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SolverParams {
+    /// Physics timestep `[s]`.
+    pub timestep_s: f64,
+    /// Constraint solver iterations (substeps) per step.
+    pub solver_iterations: usize,
+    /// PGS sweeps per solver iteration.
+    pub pgs_iterations: usize,
+    /// Stabilisation (position correction) sweeps per solver iteration.
+    pub stabilization_iterations: usize,
+    /// Natural frequency of contacts `[Hz]`: their stiffness relative to the bodies' masses.
+    pub contact_stiffness_hz: f64,
+}
+
+impl Default for SolverParams {
+    fn default() -> Self {
+        SolverParams {
+            timestep_s: 1.0 / 960.0,
+            solver_iterations: 8,
+            pgs_iterations: 8,
+            stabilization_iterations: 2,
+            contact_stiffness_hz: 10000.0,
+        }
+    }
+}
+
+/// How the fingers are driven (motor torques, gains, squeeze) and how heavy they are.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FingerParams {
+    /// Joint 1's motor target closes this far past its planned angle `[deg]`.
+    pub squeeze_deg: f64,
+    /// Joint 2's motor target closes this far past its planned angle `[deg]`.
+    pub squeeze2_deg: f64,
+    /// Joint motor torque limit `[N·m]`.
+    pub torque_limit_nm: f64,
+    /// Torque a stalled joint 1 holds once joint 2 closes (a worm drive's lock) `[N·m]`.
+    pub joint1_lock_torque_nm: f64,
+    /// Joint motor stiffness `[N·m/rad]`: torque per radian short of the target, up to the limit.
+    pub motor_stiffness_nm_per_rad: f64,
+    /// Joint motor damping `[N·m·s/rad]`.
+    pub motor_damping_nms_per_rad: f64,
+    /// Density of the phalanges `[kg/m³]` (the hand file gives no masses).
+    pub finger_density_kg_m3: f64,
+    /// Each finger's motors are capped at `torque_limit_nm` times the number of fingers on the
+    /// palm's less crowded side over the number on its own side, so that the two sides squeeze
+    /// the object equally (issue 33: with equal torques the thesis hand's two fingers push the
+    /// object across towards its one thumb until the contacts' angles balance them);
+    /// `false`: every finger at `torque_limit_nm`.
+    pub balanced_squeeze: bool,
+}
+
+impl Default for FingerParams {
+    fn default() -> Self {
+        FingerParams {
+            squeeze_deg: 10.0,
+            squeeze2_deg: 10.0,
+            torque_limit_nm: 1.0,
+            joint1_lock_torque_nm: 10.0,
+            motor_stiffness_nm_per_rad: 20.0,
+            motor_damping_nms_per_rad: 0.2,
+            finger_density_kg_m3: 1000.0,
+            balanced_squeeze: true,
+        }
+    }
+}
+
+/// How the fingers close before gravity comes on (docs/SIM.md, "What the closing does").
+#[derive(Debug, Clone, PartialEq)]
+pub struct ClosingParams {
+    /// Time the fingers get to close before gravity is turned on `[s]`: with
+    /// `close_until_stalled`, the longest they get.
+    pub close_duration_s: f64,
+    /// Each closing phase (joint 1, then joint 2) ends as soon as the hand and the object have
+    /// stopped (`sim::STALL`), at most at half `close_duration_s`; `false`: each phase takes
+    /// its half of `close_duration_s` (the check before issue 15).
+    pub close_until_stalled: bool,
+    /// The fingers start this much more open than planned at each joint `[deg]`.
+    pub open_margin_deg: f64,
+    /// How joint 1 closes: `squeeze` (each finger straight to its target, the check before
+    /// issue 33) or `together` (a finger that touches the object stops there until every
+    /// finger has touched, or the others have stopped, then all squeeze at once).
+    pub approach: Approach,
+}
+
+impl Default for ClosingParams {
+    fn default() -> Self {
+        ClosingParams {
+            close_duration_s: 0.5,
+            close_until_stalled: true,
+            open_margin_deg: 20.0,
+            approach: Approach::Squeeze,
+        }
+    }
+}
+
+/// The hold: how long each gravity direction is held, and the thresholds of a `hold`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HoldParams {
+    /// Hold time per gravity direction `[s]`.
+    pub duration_s: f64,
+    /// Largest translation relative to the palm that still counts as `hold` `[mm]`.
+    pub hold_translation_mm: f64,
+    /// Largest rotation relative to the palm that still counts as `hold` `[deg]`.
+    pub hold_rotation_deg: f64,
+    /// Deepest a finger or the palm may be inside the object at the end of closing for the
+    /// grasp to count as a hold `[mm]`: a grasp that holds only because a finger passed into
+    /// the object is not a hold (issue 14). Beyond it the verdict is `slip` (the object stays
+    /// in the hand, but not by a grasp a real hand could make).
+    pub max_penetration_mm: f64,
+    /// Farthest the closing may push the object relative to the palm for the grasp to count
+    /// as a hold of the planned grasp `[mm]` (issue 33): beyond it the object was pushed across
+    /// until the other fingers caught it, a different grasp from the one planned, and the
+    /// verdict is `slip` (`closing_pushed`), so the candidate search moves on as for a slip.
+    pub max_closing_shift_mm: f64,
+}
+
+impl Default for HoldParams {
+    fn default() -> Self {
+        HoldParams {
+            duration_s: 2.0,
+            hold_translation_mm: 5.0,
+            hold_rotation_deg: 5.0,
+            max_penetration_mm: 2.0,
+            max_closing_shift_mm: DEFAULT_MAX_CLOSING_SHIFT_MM,
+        }
+    }
+}
+
+/// The `fast` protocol's rest rule (docs/SIM.md, "Deciding early").
+#[derive(Debug, Clone, PartialEq)]
+pub struct EarlyParams {
     /// `fast` protocol: the window over which the object's motion relative to the palm is
     /// measured before a direction can be decided `hold` or `slip` at rest, and the least hold
     /// time `[s]`.
@@ -49,73 +204,42 @@ pub struct SimParams {
     /// fraction of `hold_translation_mm` and `hold_rotation_deg`, the projected motion included;
     /// a `slip` only if it stays beyond one of them divided by this.
     pub rest_margin: f64,
-    /// Hold time per gravity direction `[s]`.
-    pub duration_s: f64,
-    /// Physics timestep `[s]`.
-    pub timestep_s: f64,
-    /// Joint 1's motor target closes this far past its planned angle `[deg]`.
-    pub squeeze_deg: f64,
-    /// Joint 2's motor target closes this far past its planned angle `[deg]`.
-    pub squeeze2_deg: f64,
-    /// Joint motor torque limit `[N·m]`.
-    pub torque_limit_nm: f64,
-    /// Torque a stalled joint 1 holds once joint 2 closes (a worm drive's lock) `[N·m]`.
-    pub joint1_lock_torque_nm: f64,
-    /// Largest translation relative to the palm that still counts as `hold` `[mm]`.
-    pub hold_translation_mm: f64,
-    /// Largest rotation relative to the palm that still counts as `hold` `[deg]`.
-    pub hold_rotation_deg: f64,
-    /// Time the fingers get to close before gravity is turned on `[s]`: with
-    /// `close_until_stalled`, the longest they get.
-    pub close_duration_s: f64,
-    /// Each closing phase (joint 1, then joint 2) ends as soon as the hand and the object have
-    /// stopped (`sim::STALL`), at most at half `close_duration_s`; `false`: each phase takes
-    /// its half of `close_duration_s` (the check before issue 15).
-    pub close_until_stalled: bool,
-    /// Constraint solver iterations (substeps) per step.
-    pub solver_iterations: usize,
-    /// PGS sweeps per solver iteration.
-    pub pgs_iterations: usize,
-    /// Stabilisation (position correction) sweeps per solver iteration.
-    pub stabilization_iterations: usize,
-    /// Joint motor stiffness `[N·m/rad]`: torque per radian short of the target, up to the limit.
-    pub motor_stiffness_nm_per_rad: f64,
-    /// Joint motor damping `[N·m·s/rad]`.
-    pub motor_damping_nms_per_rad: f64,
-    /// Density of the phalanges `[kg/m³]` (the hand file gives no masses).
-    pub finger_density_kg_m3: f64,
-    /// Natural frequency of contacts `[Hz]`: their stiffness relative to the bodies' masses.
-    pub contact_stiffness_hz: f64,
-    /// The fingers start this much more open than planned at each joint `[deg]`.
-    pub open_margin_deg: f64,
+}
+
+impl Default for EarlyParams {
+    fn default() -> Self {
+        EarlyParams {
+            rest_window_s: 0.2,
+            rest_safety: 2.0,
+            rest_margin: 0.8,
+        }
+    }
+}
+
+/// The candidate search's policy: how many planned grasps a run checks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SelectionParams {
+    /// A run checks the planner's candidates in search order until one holds or this many have
+    /// been checked (1: only the first grasp, as the thesis would give it).
+    pub max_checked: usize,
+}
+
+impl Default for SelectionParams {
+    fn default() -> Self {
+        SelectionParams {
+            max_checked: crate::DEFAULT_MAX_CHECKED,
+        }
+    }
+}
+
+/// Where the grasp comes from: the planner, or joint angles fixed by the scenario.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct InputParams {
     /// Skip the planner and close the fingers to these `[θ1, θ2]` per finger `[deg]`, with the
     /// palm upright at Finger_1's `override_index` (a sim-only scenario).
     pub override_angles: Option<Vec<[f64; 2]>>,
     /// Finger_1's elevation index for `override_angles` (default: the middle of the domain).
     pub override_index: Option<usize>,
-    /// A run checks the planner's candidates in search order until one holds or this many have
-    /// been checked (1: only the first grasp, as the thesis would give it).
-    pub max_checked: usize,
-    /// Deepest a finger or the palm may be inside the object at the end of closing for the
-    /// grasp to count as a hold `[mm]`: a grasp that holds only because a finger passed into
-    /// the object is not a hold (issue 14). Beyond it the verdict is `slip` (the object stays
-    /// in the hand, but not by a grasp a real hand could make).
-    pub max_penetration_mm: f64,
-    /// Farthest the closing may push the object relative to the palm for the grasp to count
-    /// as a hold of the planned grasp `[mm]` (issue 33): beyond it the object was pushed across
-    /// until the other fingers caught it, a different grasp from the one planned, and the
-    /// verdict is `slip` (`closing_pushed`), so the candidate search moves on as for a slip.
-    pub max_closing_shift_mm: f64,
-    /// Each finger's motors are capped at `torque_limit_nm` times the number of fingers on the
-    /// palm's less crowded side over the number on its own side, so that the two sides squeeze
-    /// the object equally (issue 33: with equal torques the thesis hand's two fingers push the
-    /// object across towards its one thumb until the contacts' angles balance them);
-    /// `false`: every finger at `torque_limit_nm`.
-    pub balanced_squeeze: bool,
-    /// How joint 1 closes: `squeeze` (each finger straight to its target, the check before
-    /// issue 33) or `together` (a finger that touches the object stops there until every
-    /// finger has touched, or the others have stopped, then all squeeze at once).
-    pub approach: Approach,
 }
 
 /// How the fingers' joint 1 close (`[sim] approach`, docs/SIM.md "What the closing does").
@@ -134,37 +258,170 @@ impl Default for SimParams {
         SimParams {
             gravity: GravityMode::Down,
             protocol: Protocol::Fast,
-            rest_window_s: 0.2,
-            rest_safety: 2.0,
-            rest_margin: 0.8,
-            duration_s: 2.0,
-            timestep_s: 1.0 / 960.0,
-            squeeze_deg: 10.0,
-            squeeze2_deg: 10.0,
-            torque_limit_nm: 1.0,
-            joint1_lock_torque_nm: 10.0,
-            hold_translation_mm: 5.0,
-            hold_rotation_deg: 5.0,
-            close_duration_s: 0.5,
-            close_until_stalled: true,
-            solver_iterations: 8,
-            pgs_iterations: 8,
-            stabilization_iterations: 2,
-            motor_stiffness_nm_per_rad: 20.0,
-            motor_damping_nms_per_rad: 0.2,
-            finger_density_kg_m3: 1000.0,
-            contact_stiffness_hz: 10000.0,
-            open_margin_deg: 20.0,
-            override_angles: None,
-            override_index: None,
-            max_checked: crate::DEFAULT_MAX_CHECKED,
-            max_penetration_mm: 2.0,
-            max_closing_shift_mm: DEFAULT_MAX_CLOSING_SHIFT_MM,
-            balanced_squeeze: true,
-            approach: Approach::Squeeze,
+            solver: SolverParams::default(),
+            fingers: FingerParams::default(),
+            closing: ClosingParams::default(),
+            hold: HoldParams::default(),
+            early: EarlyParams::default(),
+            selection: SelectionParams::default(),
+            input: InputParams::default(),
         }
     }
 }
+
+/// The `Debug` text is the flat `[sim]` table's, as before the fields were grouped (the batch
+/// input hash reads it).
+impl std::fmt::Debug for SimParams {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        flat::SimParams::from(self.clone()).fmt(f)
+    }
+}
+
+/// The `[sim]` table as written: one field per key, in the order serde's messages list them.
+mod flat {
+    use super::{Approach, GravityMode, Protocol};
+    use serde::Deserialize;
+
+    /// The flat `[sim]` table (see the module docs of [`super`]).
+    #[derive(Debug, Clone, PartialEq, Deserialize)]
+    #[serde(deny_unknown_fields, default)]
+    pub(super) struct SimParams {
+        pub(super) gravity: GravityMode,
+        pub(super) protocol: Protocol,
+        pub(super) rest_window_s: f64,
+        pub(super) rest_safety: f64,
+        pub(super) rest_margin: f64,
+        pub(super) duration_s: f64,
+        pub(super) timestep_s: f64,
+        pub(super) squeeze_deg: f64,
+        pub(super) squeeze2_deg: f64,
+        pub(super) torque_limit_nm: f64,
+        pub(super) joint1_lock_torque_nm: f64,
+        pub(super) hold_translation_mm: f64,
+        pub(super) hold_rotation_deg: f64,
+        pub(super) close_duration_s: f64,
+        pub(super) close_until_stalled: bool,
+        pub(super) solver_iterations: usize,
+        pub(super) pgs_iterations: usize,
+        pub(super) stabilization_iterations: usize,
+        pub(super) motor_stiffness_nm_per_rad: f64,
+        pub(super) motor_damping_nms_per_rad: f64,
+        pub(super) finger_density_kg_m3: f64,
+        pub(super) contact_stiffness_hz: f64,
+        pub(super) open_margin_deg: f64,
+        pub(super) override_angles: Option<Vec<[f64; 2]>>,
+        pub(super) override_index: Option<usize>,
+        pub(super) max_checked: usize,
+        pub(super) max_penetration_mm: f64,
+        pub(super) max_closing_shift_mm: f64,
+        pub(super) balanced_squeeze: bool,
+        pub(super) approach: Approach,
+    }
+
+    impl Default for SimParams {
+        fn default() -> Self {
+            super::SimParams::default().into()
+        }
+    }
+
+    impl From<SimParams> for super::SimParams {
+        fn from(s: SimParams) -> Self {
+            super::SimParams {
+                gravity: s.gravity,
+                protocol: s.protocol,
+                solver: super::SolverParams {
+                    timestep_s: s.timestep_s,
+                    solver_iterations: s.solver_iterations,
+                    pgs_iterations: s.pgs_iterations,
+                    stabilization_iterations: s.stabilization_iterations,
+                    contact_stiffness_hz: s.contact_stiffness_hz,
+                },
+                fingers: super::FingerParams {
+                    squeeze_deg: s.squeeze_deg,
+                    squeeze2_deg: s.squeeze2_deg,
+                    torque_limit_nm: s.torque_limit_nm,
+                    joint1_lock_torque_nm: s.joint1_lock_torque_nm,
+                    motor_stiffness_nm_per_rad: s.motor_stiffness_nm_per_rad,
+                    motor_damping_nms_per_rad: s.motor_damping_nms_per_rad,
+                    finger_density_kg_m3: s.finger_density_kg_m3,
+                    balanced_squeeze: s.balanced_squeeze,
+                },
+                closing: super::ClosingParams {
+                    close_duration_s: s.close_duration_s,
+                    close_until_stalled: s.close_until_stalled,
+                    open_margin_deg: s.open_margin_deg,
+                    approach: s.approach,
+                },
+                hold: super::HoldParams {
+                    duration_s: s.duration_s,
+                    hold_translation_mm: s.hold_translation_mm,
+                    hold_rotation_deg: s.hold_rotation_deg,
+                    max_penetration_mm: s.max_penetration_mm,
+                    max_closing_shift_mm: s.max_closing_shift_mm,
+                },
+                early: super::EarlyParams {
+                    rest_window_s: s.rest_window_s,
+                    rest_safety: s.rest_safety,
+                    rest_margin: s.rest_margin,
+                },
+                selection: super::SelectionParams {
+                    max_checked: s.max_checked,
+                },
+                input: super::InputParams {
+                    override_angles: s.override_angles,
+                    override_index: s.override_index,
+                },
+            }
+        }
+    }
+
+    impl From<super::SimParams> for SimParams {
+        fn from(s: super::SimParams) -> Self {
+            SimParams {
+                gravity: s.gravity,
+                protocol: s.protocol,
+                rest_window_s: s.early.rest_window_s,
+                rest_safety: s.early.rest_safety,
+                rest_margin: s.early.rest_margin,
+                duration_s: s.hold.duration_s,
+                timestep_s: s.solver.timestep_s,
+                squeeze_deg: s.fingers.squeeze_deg,
+                squeeze2_deg: s.fingers.squeeze2_deg,
+                torque_limit_nm: s.fingers.torque_limit_nm,
+                joint1_lock_torque_nm: s.fingers.joint1_lock_torque_nm,
+                hold_translation_mm: s.hold.hold_translation_mm,
+                hold_rotation_deg: s.hold.hold_rotation_deg,
+                close_duration_s: s.closing.close_duration_s,
+                close_until_stalled: s.closing.close_until_stalled,
+                solver_iterations: s.solver.solver_iterations,
+                pgs_iterations: s.solver.pgs_iterations,
+                stabilization_iterations: s.solver.stabilization_iterations,
+                motor_stiffness_nm_per_rad: s.fingers.motor_stiffness_nm_per_rad,
+                motor_damping_nms_per_rad: s.fingers.motor_damping_nms_per_rad,
+                finger_density_kg_m3: s.fingers.finger_density_kg_m3,
+                contact_stiffness_hz: s.solver.contact_stiffness_hz,
+                open_margin_deg: s.closing.open_margin_deg,
+                override_angles: s.input.override_angles,
+                override_index: s.input.override_index,
+                max_checked: s.selection.max_checked,
+                max_penetration_mm: s.hold.max_penetration_mm,
+                max_closing_shift_mm: s.hold.max_closing_shift_mm,
+                balanced_squeeze: s.fingers.balanced_squeeze,
+                approach: s.closing.approach,
+            }
+        }
+    }
+}
+
+/// `[("sim.<field>", s.<group>.<field>), ...]`: each grouped value with its `[sim]` key.
+macro_rules! sim_keyed {
+    ($s:expr; $($group:ident . $field:ident),+ $(,)?) => {
+        [$((concat!("sim.", stringify!($field)), $s.$group.$field)),+]
+    };
+}
+
+/// A key and what is wrong with its value.
+type Invalid = (&'static str, String);
 
 impl SimParams {
     /// Checks every value's range, and `override_angles` against a hand of `fingers` fingers:
@@ -172,68 +429,93 @@ impl SimParams {
     ///
     /// # Errors
     /// `(key, problem)`.
-    pub fn validate(&self, fingers: usize) -> Result<(), (&'static str, String)> {
+    pub fn validate(&self, fingers: usize) -> Result<(), Invalid> {
+        self.validate_positive()?;
+        self.validate_counts()?;
+        self.validate_bounds()?;
+        self.input.validate(fingers)?;
+        self.fingers.validate_squeeze()
+    }
+
+    /// The values that must be finite and positive.
+    fn validate_positive(&self) -> Result<(), Invalid> {
         let s = self;
-        for (key, v) in keyed!("sim", s;
-            duration_s,
-            timestep_s,
-            torque_limit_nm,
-            joint1_lock_torque_nm,
-            hold_translation_mm,
-            hold_rotation_deg,
-            close_duration_s,
-            motor_stiffness_nm_per_rad,
-            finger_density_kg_m3,
-            contact_stiffness_hz,
-            open_margin_deg,
-            rest_window_s,
-            rest_safety,
-            rest_margin,
-            max_penetration_mm,
-            max_closing_shift_mm,
+        for (key, v) in sim_keyed!(s;
+            hold.duration_s,
+            solver.timestep_s,
+            fingers.torque_limit_nm,
+            fingers.joint1_lock_torque_nm,
+            hold.hold_translation_mm,
+            hold.hold_rotation_deg,
+            closing.close_duration_s,
+            fingers.motor_stiffness_nm_per_rad,
+            fingers.finger_density_kg_m3,
+            solver.contact_stiffness_hz,
+            closing.open_margin_deg,
+            early.rest_window_s,
+            early.rest_safety,
+            early.rest_margin,
+            hold.max_penetration_mm,
+            hold.max_closing_shift_mm,
         ) {
             if !(v.is_finite() && v > 0.0) {
                 return Err((key, format!("must be positive, got {v}")));
             }
         }
-        for (key, v) in keyed!("sim", s;
-            solver_iterations,
-            pgs_iterations,
-            stabilization_iterations,
-            max_checked,
+        Ok(())
+    }
+
+    /// The iteration counts and `max_checked`: 1 to 100.
+    fn validate_counts(&self) -> Result<(), Invalid> {
+        let s = self;
+        for (key, v) in sim_keyed!(s;
+            solver.solver_iterations,
+            solver.pgs_iterations,
+            solver.stabilization_iterations,
+            selection.max_checked,
         ) {
             if !(1..=100).contains(&v) {
                 return Err((key, format!("must be in 1..=100, got {v}")));
             }
         }
-        if !(s.motor_damping_nms_per_rad.is_finite() && s.motor_damping_nms_per_rad >= 0.0) {
+        Ok(())
+    }
+
+    /// The damping (zero allowed), the rest margin (a fraction) and the timestep against the
+    /// hold.
+    fn validate_bounds(&self) -> Result<(), Invalid> {
+        let damping = self.fingers.motor_damping_nms_per_rad;
+        if !(damping.is_finite() && damping >= 0.0) {
             return Err((
                 "sim.motor_damping_nms_per_rad",
-                format!(
-                    "must be zero or positive, got {}",
-                    s.motor_damping_nms_per_rad
-                ),
+                format!("must be zero or positive, got {damping}"),
             ));
         }
-        if s.rest_margin > 1.0 {
+        if self.early.rest_margin > 1.0 {
             return Err((
                 "sim.rest_margin",
                 format!(
                     "must be at most 1 (a fraction of the thresholds), got {}",
-                    s.rest_margin
+                    self.early.rest_margin
                 ),
             ));
         }
-        if s.timestep_s > 0.05 || s.timestep_s * 10.0 > s.duration_s {
+        let timestep_s = self.solver.timestep_s;
+        if timestep_s > 0.05 || timestep_s * 10.0 > self.hold.duration_s {
             return Err((
                 "sim.timestep_s",
-                format!(
-                    "must be at most 0.05 s and a tenth of duration_s, got {}",
-                    s.timestep_s
-                ),
+                format!("must be at most 0.05 s and a tenth of duration_s, got {timestep_s}"),
             ));
         }
-        if let Some(a) = &s.override_angles {
+        Ok(())
+    }
+}
+
+impl InputParams {
+    /// `override_angles` against a hand of `fingers` fingers, and `override_index` only with
+    /// them.
+    fn validate(&self, fingers: usize) -> Result<(), Invalid> {
+        if let Some(a) = &self.override_angles {
             if a.len() != fingers {
                 return Err((
                     "sim.override_angles",
@@ -250,18 +532,119 @@ impl SimParams {
                 ));
             }
         }
-        if s.override_index.is_some() && s.override_angles.is_none() {
+        if self.override_index.is_some() && self.override_angles.is_none() {
             return Err((
                 "sim.override_index",
                 "applies only with override_angles (the planner places the palm otherwise)"
                     .to_string(),
             ));
         }
-        for (key, v) in keyed!("sim", s; squeeze_deg, squeeze2_deg) {
+        Ok(())
+    }
+}
+
+impl FingerParams {
+    /// The squeeze overshoots: zero or positive.
+    fn validate_squeeze(&self) -> Result<(), Invalid> {
+        for (key, v) in keyed!("sim", self; squeeze_deg, squeeze2_deg) {
             if !v.is_finite() || v < 0.0 {
                 return Err((key, format!("must be zero or positive, got {v}")));
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_flat_sim_table_fills_the_groups() {
+        let p: SimParams = toml::from_str(
+            "torque_limit_nm = 0.5\nrest_margin = 0.5\nmax_checked = 3\napproach = \"together\"\n\
+             override_angles = [[90.0, 80.0]]",
+        )
+        .unwrap();
+        assert_eq!(p.fingers.torque_limit_nm, 0.5);
+        assert_eq!(p.early.rest_margin, 0.5);
+        assert_eq!(p.selection.max_checked, 3);
+        assert_eq!(p.closing.approach, Approach::Together);
+        assert_eq!(p.input.override_angles, Some(vec![[90.0, 80.0]]));
+        // Everything else at its default.
+        let mut expected = SimParams::default();
+        expected.fingers.torque_limit_nm = 0.5;
+        expected.early.rest_margin = 0.5;
+        expected.selection.max_checked = 3;
+        expected.closing.approach = Approach::Together;
+        expected.input.override_angles = Some(vec![[90.0, 80.0]]);
+        assert_eq!(p, expected);
+        assert_eq!(
+            toml::from_str::<SimParams>("").unwrap(),
+            SimParams::default()
+        );
+    }
+
+    #[test]
+    fn messages_and_debug_text_are_the_flat_tables() {
+        let err = toml::from_str::<SimParams>("torque_limt_nm = 1.0").unwrap_err();
+        let msg = err.to_string();
+        assert!(
+            msg.contains(
+                "unknown field `torque_limt_nm`, expected one of `gravity`, `protocol`, \
+                 `rest_window_s`"
+            ),
+            "{msg}"
+        );
+        let err = toml::from_str::<SimParams>("duration_s = \"long\"").unwrap_err();
+        assert!(err.to_string().contains("expected f64"), "{err}");
+        let debug = format!("{:?}", SimParams::default());
+        assert!(
+            debug.starts_with(
+                "SimParams { gravity: Down, protocol: Fast, rest_window_s: 0.2, rest_safety: 2.0,"
+            ),
+            "{debug}"
+        );
+        assert!(
+            debug.ends_with("balanced_squeeze: true, approach: Squeeze }"),
+            "{debug}"
+        );
+    }
+
+    #[test]
+    fn validation_reports_the_first_key_in_the_old_order() {
+        let check = |toml: &str| {
+            toml::from_str::<SimParams>(toml)
+                .unwrap()
+                .validate(3)
+                .map_err(|(key, _)| key)
+        };
+        assert_eq!(check(""), Ok(()));
+        // duration_s before timestep_s before the counts before the damping.
+        assert_eq!(
+            check("duration_s = 0.0\ntimestep_s = 0.0\nmax_checked = 0"),
+            Err("sim.duration_s")
+        );
+        assert_eq!(
+            check("max_checked = 0\nmotor_damping_nms_per_rad = -1.0"),
+            Err("sim.max_checked")
+        );
+        assert_eq!(check("timestep_s = 0.5"), Err("sim.timestep_s"));
+        assert_eq!(check("rest_margin = 1.5"), Err("sim.rest_margin"));
+        assert_eq!(check("override_index = 2"), Err("sim.override_index"));
+        assert_eq!(
+            check("override_angles = [[90.0, 90.0]]\nsqueeze2_deg = -1.0"),
+            Err("sim.override_angles")
+        );
+        assert_eq!(check("squeeze2_deg = -1.0"), Err("sim.squeeze2_deg"));
+        let mut p = SimParams::default();
+        p.solver.timestep_s = 0.5;
+        assert_eq!(
+            p.validate(3),
+            Err((
+                "sim.timestep_s",
+                "must be at most 0.05 s and a tenth of duration_s, got 0.5".to_string()
+            ))
+        );
     }
 }

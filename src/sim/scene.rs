@@ -1,11 +1,13 @@
-//! Building the rapier scene: palm, phalanges, joints with motors, and the object.
+//! Building the rapier scene: the hand's placement ([`SimHand`]), where the check starts clear of
+//! the object's collider ([`Start`]), the palm, phalanges and joints with motors, and the object
+//! (its collider from [`super::collider`]). Units: millimetres and degrees at the interface,
+//! metres inside rapier.
 
+use super::collider::ObjectShape;
 use super::convert;
 use super::params::SimParams;
 use crate::hand::{palm_rotation, BodyPose, Hand, HandBox};
-use crate::mesh::Mesh;
-use nalgebra::{Point3, Vector3};
-use rapier3d::parry::transformation::vhacd::VHACDParameters;
+use nalgebra::{Point3, UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
 
 /// The hand's placement for the physics check: the palm pose and the planned joint angles.
@@ -19,46 +21,7 @@ pub struct SimHand {
     pub theta_deg: Vec<[f64; 2]>,
 }
 
-/// Why a scenario's `[sim] override_angles` cannot be checked.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum OverrideError {
-    /// The graded domain has no indexed elevation to put the palm on.
-    #[error("override_angles: the object has no indexed elevation")]
-    NoElevation,
-    /// The palm could not be placed at the chosen elevation.
-    #[error("override_angles: palm placement failed: {0:?}")]
-    PalmPlacement(crate::plan::palm::PalmRejection),
-}
-
 impl SimHand {
-    /// The hand pose for a scenario whose joint angles are fixed by `[sim] override_angles`:
-    /// the palm at approach 0 and pitch 0 on indexed elevation `override_index` (default: the
-    /// middle one) of the graded domain.
-    ///
-    /// # Errors
-    /// [`OverrideError`]: why the grasp cannot be checked.
-    pub fn from_override(
-        mesh: &Mesh,
-        hand: &Hand,
-        graded: &crate::plan::GradedDomain,
-        p: &SimParams,
-        angles: &[[f64; 2]],
-    ) -> Result<SimHand, OverrideError> {
-        let n = graded.domain.elevations.len();
-        if n == 0 {
-            return Err(OverrideError::NoElevation);
-        }
-        let index = p.override_index.unwrap_or(n.div_ceil(2)).clamp(1, n);
-        let z1 = graded.domain.elevations[index - 1];
-        let palm = crate::plan::palm::place_palm(mesh, hand, z1, 0.0, 0.0)
-            .map_err(OverrideError::PalmPlacement)?;
-        Ok(SimHand {
-            origin_mm: palm.origin,
-            axes: palm.axes,
-            theta_deg: angles.to_vec(),
-        })
-    }
-
     /// The palm pose and the centre ALS's joint angles of a planned grasp.
     pub fn from_grasp(g: &crate::plan::search::Grasp) -> SimHand {
         SimHand {
@@ -71,296 +34,6 @@ impl SimHand {
                 .collect(),
         }
     }
-}
-
-/// How the object's collider was made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ColliderKind {
-    /// The convex hull of the mesh (the mesh is convex).
-    ConvexHull,
-    /// A convex decomposition (V-HACD) of the mesh.
-    ConvexDecomposition,
-}
-
-impl ColliderKind {
-    /// The name used in JSON.
-    pub fn as_str(self) -> &'static str {
-        match self {
-            ColliderKind::ConvexHull => "convex_hull",
-            ColliderKind::ConvexDecomposition => "convex_decomposition",
-        }
-    }
-}
-
-impl std::fmt::Display for ColliderKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.pad(self.as_str())
-    }
-}
-
-/// The object's collision shape, built once per object and shared by every run.
-#[derive(Clone)]
-pub struct ObjectShape {
-    /// The shape in metres, aligned frame.
-    pub shape: SharedShape,
-    /// How it was made.
-    pub kind: ColliderKind,
-    /// Number of convex parts.
-    pub parts: usize,
-    /// True if and only if the object is inertially a body of revolution about its principal
-    /// axis (aligned Z): its two transverse principal moments agree within 0.1 %.
-    pub is_revolution: bool,
-    /// For a convex hull that parry would merge into bent faces, rebuilt from its face planes
-    /// (see `coarsened_hull`): the full hull's vertex count.
-    pub coarsened_from: Option<usize>,
-}
-
-/// Convex decompositions made in this process, by the digest of their mesh: the same object
-/// in several scenarios of one run (the chapter 4 object and its weak-motor twin, a tuning
-/// set) is decomposed once. At most [`SHAPE_CACHE_LEN`], the oldest dropped first.
-static SHAPE_CACHE: std::sync::Mutex<Vec<([u8; 32], ObjectShape)>> =
-    std::sync::Mutex::new(Vec::new());
-
-/// Convex decompositions kept by [`ObjectShape::cached`].
-pub const SHAPE_CACHE_LEN: usize = 16;
-
-/// The digest of what [`ObjectShape::from_mesh`] reads: vertices, triangles and volume.
-fn shape_key(mesh: &Mesh, volume_mm3: f64) -> [u8; 32] {
-    use sha2::{Digest, Sha256};
-    let mut h = Sha256::new();
-    for p in &mesh.vertices {
-        for v in [p.x, p.y, p.z] {
-            h.update(v.to_bits().to_le_bytes());
-        }
-    }
-    h.update(b"t");
-    for t in &mesh.triangles {
-        for i in t {
-            h.update(i.to_le_bytes());
-        }
-    }
-    h.update(volume_mm3.to_bits().to_le_bytes());
-    h.finalize().into()
-}
-
-impl ObjectShape {
-    /// [`ObjectShape::from_mesh`], with convex decompositions (0.1–0.4 s each) and rebuilt hulls
-    /// (tens of milliseconds) kept for the rest of the process: the same mesh gives the same
-    /// shape, bit for bit, either way.
-    pub fn cached(mesh: &Mesh, volume_mm3: f64) -> ObjectShape {
-        let key = shape_key(mesh, volume_mm3);
-        let lock = || SHAPE_CACHE.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, s)) = lock().iter().find(|(k, _)| *k == key) {
-            return s.clone();
-        }
-        let shape = ObjectShape::from_mesh(mesh, volume_mm3);
-        if shape.kind == ColliderKind::ConvexDecomposition || shape.coarsened_from.is_some() {
-            let mut cache = lock();
-            if !cache.iter().any(|(k, _)| *k == key) {
-                if cache.len() >= SHAPE_CACHE_LEN {
-                    cache.remove(0);
-                }
-                cache.push((key, shape.clone()));
-            }
-        }
-        shape
-    }
-
-    /// The convex hull of `mesh` (aligned, millimetres) if the mesh is convex (hull volume within
-    /// 2 % of `volume_mm3`), a convex decomposition otherwise.
-    pub fn from_mesh(mesh: &Mesh, volume_mm3: f64) -> ObjectShape {
-        let props = crate::mesh::mass_properties(mesh);
-        let (ixx, iyy) = (props.inertia[(0, 0)], props.inertia[(1, 1)]);
-        let is_revolution = (ixx - iyy).abs() <= 1e-3 * ixx.abs().max(iyy.abs());
-        let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
-        if let Some(hull) = SharedShape::convex_hull(&points) {
-            let hull_mm3 = f64::from(hull.mass_properties(1.0).mass()) * 1e9;
-            if hull_mm3 <= volume_mm3 * 1.02 {
-                let rebuilt = (bent_shape_m(&hull) > MERGED_FACE_TOLERANCE_M)
-                    .then(|| coarsened_hull(&points))
-                    .flatten();
-                let (shape, coarsened_from) = match rebuilt {
-                    Some((coarse, from)) => (coarse, Some(from)),
-                    None => (hull, None),
-                };
-                return ObjectShape {
-                    shape,
-                    kind: ColliderKind::ConvexHull,
-                    parts: 1,
-                    is_revolution,
-                    coarsened_from,
-                };
-            }
-        }
-        let params = VHACDParameters {
-            resolution: 64,
-            ..VHACDParameters::default()
-        };
-        let shape =
-            SharedShape::convex_decomposition_with_params(&points, &mesh.triangles, &params);
-        let parts = shape.as_compound().map_or(1, |c| c.shapes().len());
-        ObjectShape {
-            shape,
-            kind: ColliderKind::ConvexDecomposition,
-            parts,
-            is_revolution,
-            coarsened_from: None,
-        }
-    }
-}
-
-/// How far a vertex of a merged hull face may lie off that face's plane `[m]`: rapier's allowed
-/// contact error at the check's 1 cm length unit (0.05 mm).
-const MERGED_FACE_TOLERANCE_M: f32 = 5e-5;
-
-/// How far the faces of `poly` leave their planes `[m]`. parry builds a hull's faces by merging
-/// neighbouring triangles whose unit normals differ by less than √ε of f32 in `1 − n₁·n₂`
-/// (about 1.5°; `ConvexPolyhedron::from_convex_mesh`), with the normal of one of them: right for a plane split into triangles, wrong for a finely tessellated curved
-/// surface (a cylinder of more than about 240 segments, whose faces meet at under 1.5°), which
-/// it chains into one non-planar face. The contacts against that face let a finger sink in:
-/// 8.4 mm into a 512-segment cylinder of 60 mm, against 0.01 mm at 144 segments.
-fn bent_face_m(poly: &rapier3d::parry::shape::ConvexPolyhedron) -> f32 {
-    let (points, ids) = (poly.points(), poly.vertices_adj_to_face());
-    poly.faces()
-        .iter()
-        .map(|f| {
-            let first = f.first_vertex_or_edge as usize;
-            let face = &ids[first..first + f.num_vertices_or_edges as usize];
-            let p = points[face[0] as usize];
-            face.iter()
-                .map(|&i| f.normal.dot(points[i as usize] - p).abs())
-                .fold(0.0f32, f32::max)
-        })
-        .fold(0.0f32, f32::max)
-}
-
-/// [`bent_face_m`] of a shape that is a convex polyhedron (0 for any other).
-fn bent_shape_m(shape: &SharedShape) -> f32 {
-    shape.as_convex_polyhedron().map_or(0.0, bent_face_m)
-}
-
-/// Neighbouring faces of the hull from [`coarsened_hull`] are at least this far apart in
-/// normal: 2°, beyond parry's merge of 1.5°.
-const MIN_FACE_ANGLE_RAD: f64 = 2.0 * std::f64::consts::PI / 180.0;
-
-/// A face plane of the hull is a supporting plane if no hull vertex lies further than this
-/// outside it `[m]` (0.1 µm; f32 coordinates of a 0.1 m object are good to about 0.01 µm).
-const SUPPORT_TOLERANCE_M: f64 = 1e-7;
-
-/// The rebuilt hull may stand off the true one by at most this `[m]` (0.05 mm) or it is not used.
-const MAX_OUTER_STANDOFF_M: f64 = 5e-5;
-
-/// The convex hull of `points` (metres), rebuilt where parry would merge curved faces into
-/// non-planar ones ([`bent_face_m`]): the hull's face planes are taken largest
-/// face first, each kept only if its normal is at least [`MIN_FACE_ANGLE_RAD`] from every plane
-/// kept (a plane split into triangles is one plane, kept once), and the hull is rebuilt as the
-/// intersection of the kept half-spaces (its vertices found through the polar dual: the convex
-/// hull of the planes' poles, each of whose triangles is a vertex where its three planes meet).
-/// Every kept plane is a plane of the true hull, so the rebuilt one contains it, and stands off
-/// it by about r·θ²/8 on a round part of radius r (0.01 mm on a 60 mm cylinder at 2°); any
-/// two of its faces meet at 2° or more, so parry keeps them apart. Returns it with the full
-/// hull's vertex count, or `None` where the full hull needs no rebuilding (every thesis object)
-/// or the rebuilt one would stand off by more than [`MAX_OUTER_STANDOFF_M`].
-fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
-    use rapier3d::parry::transformation::try_convex_hull;
-    let (vertices, triangles) = try_convex_hull(points).ok()?;
-    let v64: Vec<Vector3<f64>> = vertices
-        .iter()
-        .map(|v| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z)))
-        .collect();
-    let centre = v64.iter().sum::<Vector3<f64>>() / v64.len() as f64;
-    // Each triangle's plane n·(x − centre) = d, with its area.
-    let true_planes: Vec<(f64, Vector3<f64>, f64)> = triangles
-        .iter()
-        .filter_map(|t| {
-            let [a, b, c] = t.map(|i| v64[i as usize]);
-            let cross = (b - a).cross(&(c - a));
-            let area = cross.norm();
-            (area > 0.0).then(|| {
-                let n = cross / area;
-                (area, n, n.dot(&(a - centre)))
-            })
-        })
-        .collect();
-    let mut planes: Vec<(f64, Vector3<f64>, f64)> =
-        true_planes.iter().copied().filter(|p| p.2 > 0.0).collect();
-    planes.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.2.total_cmp(&b.2)));
-    let cos_min = MIN_FACE_ANGLE_RAD.cos();
-    let mut kept: Vec<(Vector3<f64>, f64)> = Vec::new();
-    // A sliver triangle of nearly collinear points (a side's rings, one above the other) has a
-    // normal of rounding noise: its plane is kept only if the whole hull is on its inner side.
-    let supporting = |n: &Vector3<f64>, d: f64| {
-        v64.iter()
-            .all(|v| n.dot(&(v - centre)) <= d + SUPPORT_TOLERANCE_M)
-    };
-    for (_, n, d) in planes {
-        if kept.iter().all(|(m, _)| m.dot(&n) < cos_min) && supporting(&n, d) {
-            kept.push((n, d));
-        }
-    }
-    // The poles n / d; each triangle of their hull is a vertex of the intersection.
-    let poles: Vec<Vector> = kept
-        .iter()
-        .map(|(n, d)| {
-            let p = n / *d;
-            Vector::new(p.x as f32, p.y as f32, p.z as f32)
-        })
-        .collect();
-    let (dual_points, dual_triangles) = try_convex_hull(&poles).ok()?;
-    let by_pole: std::collections::HashMap<[u32; 3], usize> = poles
-        .iter()
-        .enumerate()
-        .map(|(k, p)| (p.to_array().map(f32::to_bits), k))
-        .collect();
-    // How far a point (relative to the centre) stands outside the true hull `[m]`.
-    let standoff = |x: &Vector3<f64>| {
-        true_planes
-            .iter()
-            .map(|(_, n, d)| n.dot(x) - d)
-            .fold(0.0f64, f64::max)
-    };
-    let mut corners: Vec<Vector> = Vec::new();
-    for t in &dual_triangles {
-        let planes = t.map(|i| {
-            by_pole
-                .get(&dual_points[i as usize].to_array().map(f32::to_bits))
-                .map(|&k| kept[k])
-        });
-        let [Some(p1), Some(p2), Some(p3)] = planes else {
-            continue;
-        };
-        let m =
-            nalgebra::Matrix3::from_rows(&[p1.0.transpose(), p2.0.transpose(), p3.0.transpose()]);
-        // Three nearly parallel planes (a sliver of the dual hull) meet far off, or nowhere:
-        // their corner is another triangle's.
-        let Some(x) = m.lu().solve(&Vector3::new(p1.1, p2.1, p3.1)) else {
-            continue;
-        };
-        if x.iter().all(|c| c.is_finite()) && standoff(&x) <= MAX_OUTER_STANDOFF_M {
-            let p = x + centre;
-            corners.push(Vector::new(p.x as f32, p.y as f32, p.z as f32));
-        }
-    }
-    let rebuilt = SharedShape::convex_hull(&corners)?;
-    let poly = rebuilt.as_convex_polyhedron()?;
-    if poly.points().len() < 4 || bent_face_m(poly) > MERGED_FACE_TOLERANCE_M {
-        return None;
-    }
-    // It must hold the whole true hull (no corner lost to the skips above): every vertex inside
-    // every face plane parry made.
-    let ids = poly.vertices_adj_to_face();
-    let inside = poly.faces().iter().all(|f| {
-        let a = poly.points()[ids[f.first_vertex_or_edge as usize] as usize];
-        let a = Vector3::new(f64::from(a.x), f64::from(a.y), f64::from(a.z));
-        let n = Vector3::new(
-            f64::from(f.normal.x),
-            f64::from(f.normal.y),
-            f64::from(f.normal.z),
-        );
-        v64.iter().all(|x| n.dot(&(x - a)) <= SUPPORT_TOLERANCE_M)
-    });
-    inside.then_some((rebuilt, vertices.len()))
 }
 
 /// Handles of what the protocol measures.
@@ -541,10 +214,10 @@ pub fn finger_torque_limits(hand: &Hand, params: &SimParams) -> Vec<f64> {
         .iter()
         .map(|f| {
             let own = count(f.side);
-            if params.balanced_squeeze && fewest > 0 && own > 0 {
-                params.torque_limit_nm * fewest as f64 / own as f64
+            if params.fingers.balanced_squeeze && fewest > 0 && own > 0 {
+                params.fingers.torque_limit_nm * fewest as f64 / own as f64
             } else {
-                params.torque_limit_nm
+                params.fingers.torque_limit_nm
             }
         })
         .collect()
@@ -608,6 +281,41 @@ fn overlap_mm(object: &SharedShape, frame: &BodyPose, boxes: &[HandBox]) -> f64 
         .fold(0.0, f64::max)
 }
 
+/// The palm's origin `[mm]` backed off the object along palm x by the depth found, plus the
+/// tolerance, until clear (a few rounds: moving off one part can meet another only in a
+/// concave object), and how far it was backed off `[mm]`.
+fn backed_off(pose: &SimHand, object: &ObjectShape, palm: &[HandBox]) -> (Point3<f64>, f64) {
+    let r_palm = palm_rotation(&pose.axes);
+    let mut origin = pose.origin_mm;
+    let mut backoff = 0.0;
+    for _ in 0..10 {
+        let d = overlap_mm(&object.shape, &(origin, r_palm), palm);
+        if d <= START_TOLERANCE_MM {
+            break;
+        }
+        backoff += d + START_TOLERANCE_MM;
+        origin = pose.origin_mm + pose.axes[0] * backoff;
+    }
+    (origin, backoff)
+}
+
+/// The margins a finger may start open by `[deg]`, in the order they are tried: `margin0`, then
+/// wider in 5° steps up to 90°, then narrower down to 0.
+fn open_margins(margin0: f64) -> Vec<f64> {
+    let mut margins = vec![margin0];
+    margins.extend(
+        (1..)
+            .map(|k| margin0 + 5.0 * f64::from(k))
+            .take_while(|m| *m <= 90.0),
+    );
+    margins.extend(
+        (1..)
+            .map(|k| margin0 - 5.0 * f64::from(k))
+            .take_while(|m| *m >= 0.0),
+    );
+    margins
+}
+
 /// The start of the check for `case` (see [`Start`]).
 pub fn start(case: &Case) -> Start {
     let Case {
@@ -627,31 +335,10 @@ pub fn start(case: &Case) -> Start {
         bend(hand.joints.theta2_range_deg[1]),
         bend(hand.joints.theta2_range_deg[0]),
     ];
-    // The palm: backed off by the depth found, plus the tolerance, until clear (a few rounds:
-    // moving off one part can meet another only in a concave object).
-    let mut origin = pose.origin_mm;
-    let mut backoff = 0.0;
-    for _ in 0..10 {
-        let d = overlap_mm(&object.shape, &(origin, r_palm), &palm);
-        if d <= START_TOLERANCE_MM {
-            break;
-        }
-        backoff += d + START_TOLERANCE_MM;
-        origin = pose.origin_mm + pose.axes[0] * backoff;
-    }
+    let (origin, backoff) = backed_off(pose, object, &palm);
     let mut penetration = overlap_mm(&object.shape, &(origin, r_palm), &palm);
-    let margin0 = params.open_margin_deg;
-    let mut margins = vec![margin0];
-    margins.extend(
-        (1..)
-            .map(|k| margin0 + 5.0 * f64::from(k))
-            .take_while(|m| *m <= 90.0),
-    );
-    margins.extend(
-        (1..)
-            .map(|k| margin0 - 5.0 * f64::from(k))
-            .take_while(|m| *m >= 0.0),
-    );
+    let margin0 = params.closing.open_margin_deg;
+    let margins = open_margins(margin0);
     let mut open_bend = Vec::new();
     let mut open_margin = Vec::new();
     for (f, [t1, t2]) in hand.finger_list.iter().zip(&pose.theta_deg) {
@@ -761,10 +448,10 @@ pub fn build(case: &Case) -> Scene {
         object_collider,
         hand_colliders,
         fingers,
-        lock_torque: params.joint1_lock_torque_nm as f32,
+        lock_torque: params.fingers.joint1_lock_torque_nm as f32,
         motor_gains: (
-            params.motor_stiffness_nm_per_rad as f32,
-            params.motor_damping_nms_per_rad as f32,
+            params.fingers.motor_stiffness_nm_per_rad as f32,
+            params.fingers.motor_damping_nms_per_rad as f32,
         ),
         reach_m: reach_mm(hand) * convert::M_PER_MM,
         object_radius_m: object_radius_m(object),
@@ -776,7 +463,7 @@ fn new_world(params: &SimParams) -> PhysicsWorld {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::ZERO;
     let ip = &mut world.integration_parameters;
-    ip.dt = params.timestep_s as f32;
+    ip.dt = params.solver.timestep_s as f32;
     // rapier's tolerances scale with length_unit (allowed linear error 5e-3 × unit, prediction
     // distance 2e-2 × unit); at the default of 1 m they would be 5 mm and 20 mm, a sizeable part
     // of a 40 mm object. 1 cm makes them 0.05 mm and 0.2 mm (pinned by a test).
@@ -784,9 +471,9 @@ fn new_world(params: &SimParams) -> PhysicsWorld {
     // A grasp is a closed loop of stiff contacts and joints (palm, phalanges, object): rapier's
     // default of one PGS sweep per substep leaves the object creeping under the squeeze (the
     // convergence study in docs/SIM.md); more sweeps per substep settle it.
-    ip.num_solver_iterations = params.solver_iterations;
-    ip.num_internal_pgs_iterations = params.pgs_iterations;
-    ip.num_internal_stabilization_iterations = params.stabilization_iterations;
+    ip.num_solver_iterations = params.solver.solver_iterations;
+    ip.num_internal_pgs_iterations = params.solver.pgs_iterations;
+    ip.num_internal_stabilization_iterations = params.solver.stabilization_iterations;
     // Contact softness is a natural frequency relative to the bodies' effective mass. rapier's
     // default (30 Hz; 60 Hz against fixed bodies) is a spring of about 430 N/m against a 12 g
     // phalanx: a 1 N·m finger squeezing at 30 mm (33 N) would sink centimetres into the object.
@@ -802,7 +489,7 @@ fn new_world(params: &SimParams) -> PhysicsWorld {
     // of stale contacts between steps.
     ip.friction_model = FrictionModel::Coulomb;
     ip.contact_recycling = false;
-    let hz = params.contact_stiffness_hz as f32;
+    let hz = params.solver.contact_stiffness_hz as f32;
     ip.contact_softness = SpringCoefficients::new(hz, 10.0);
     ip.static_contact_softness = SpringCoefficients::new(hz, 10.0);
     world
@@ -845,24 +532,14 @@ fn insert_finger(
     let f = at.finger;
     let [t1, t2] = at.theta_deg;
     let [open1, open2] = at.open_bend_rad;
-    let density = params.finger_density_kg_m3 as f32;
+    let density = params.fingers.finger_density_kg_m3 as f32;
     let limits = |range: [f64; 2]| [bend(range[1]) as f32, bend(range[0]) as f32];
     let limits1 = limits(hand.joints.theta1_range_deg);
     let limits2 = limits(hand.joints.theta2_range_deg);
     let motor = |target: f64, limits: [f32; 2]| (target as f32).clamp(limits[0], limits[1]);
     let revolute = |anchor: &Vector3<f64>, limits: [f32; 2], target: f32| {
-        RevoluteJointBuilder::new(Vector::new(0.0, 0.0, f.side.sign() as f32))
-            .local_anchor1(convert::vector_m(anchor))
-            .local_anchor2(Vector::ZERO)
-            .limits(limits)
-            .motor_model(MotorModel::ForceBased)
-            .motor_position(
-                target,
-                params.motor_stiffness_nm_per_rad as f32,
-                params.motor_damping_nms_per_rad as f32,
-            )
-            .motor_max_force(at.torque_nm as f32)
-            .contacts_enabled(false)
+        let axis = Vector::new(0.0, 0.0, f.side.sign() as f32);
+        revolute_joint(axis, anchor, limits, target, params, at.torque_nm)
     };
     let (p1, p2) = hand.phalanx_boxes(f.side);
     let [(j1, r1), (j2, r2)] = hand.finger_poses(f, &at.palm_pose, [open1, open2]);
@@ -879,8 +556,8 @@ fn insert_finger(
         }
         body
     };
-    let squeeze = params.squeeze_deg.to_radians();
-    let squeeze2 = params.squeeze2_deg.to_radians();
+    let squeeze = params.fingers.squeeze_deg.to_radians();
+    let squeeze2 = params.fingers.squeeze2_deg.to_radians();
     // Body, colliders, joint, in this order for each phalanx: rapier's state (and so the run)
     // depends on the order of insertion.
     let b1 = phalanx(world, convert::pose(&j1, &r1), &[p1]);
@@ -909,6 +586,32 @@ fn insert_finger(
         joint2_target: motor(bend(t2) + squeeze2, limits2),
         joint1_target: motor(bend(t1) + squeeze, limits1),
     }
+}
+
+/// A finger joint: revolute about `axis` (the parent's frame) at `anchor` `[mm]` on the parent,
+/// within `limits` `[rad]`, with a force-based position motor towards `target` `[rad]` at the
+/// scenario's stiffness and damping, capped at `torque_nm`; the two phalanges it joins do not
+/// collide.
+fn revolute_joint(
+    axis: Vector,
+    anchor: &Vector3<f64>,
+    limits: [f32; 2],
+    target: f32,
+    params: &SimParams,
+    torque_nm: f64,
+) -> RevoluteJointBuilder {
+    RevoluteJointBuilder::new(axis)
+        .local_anchor1(convert::vector_m(anchor))
+        .local_anchor2(Vector::ZERO)
+        .limits(limits)
+        .motor_model(MotorModel::ForceBased)
+        .motor_position(
+            target,
+            params.fingers.motor_stiffness_nm_per_rad as f32,
+            params.fingers.motor_damping_nms_per_rad as f32,
+        )
+        .motor_max_force(torque_nm as f32)
+        .contacts_enabled(false)
 }
 
 /// A multibody places its links from its joint coordinates, which start at zero (every
@@ -963,21 +666,34 @@ fn object_radius_m(object: &ObjectShape) -> f64 {
     f64::from(sphere.radius() + (sphere.center() - com).length())
 }
 
-/// The object's centre of mass `[m]` and inertia tensor about it `[kg·m²]`, aligned frame, as the
-/// rapier check has them: its collider's mass distribution scaled to `mass_kg`.
-pub fn collider_inertia(
-    object: &ObjectShape,
-    mass_kg: f64,
-) -> (nalgebra::Vector3<f64>, nalgebra::Matrix3<f64>) {
-    let unit = object.shape.mass_properties(1.0);
-    let density = mass_kg / f64::from(unit.mass()).max(f64::MIN_POSITIVE);
-    let props = object.shape.mass_properties(density as f32);
-    let m = props.reconstruct_inertia_matrix();
-    let c = props.local_com;
-    let cols = m.to_cols_array();
+/// The palm, phalanx 1 and 2 of each finger, then the object (aligned frame, metres).
+pub(super) fn poses(scene: &Scene) -> Vec<super::BodyPose> {
+    let mut handles = vec![scene.palm];
+    for f in &scene.fingers {
+        handles.push(f.phalanx1);
+        handles.push(f.phalanx2);
+    }
+    handles.push(scene.object);
+    handles
+        .iter()
+        .map(|h| {
+            let p = scene.world.bodies[*h].position();
+            (
+                convert::vector_mm(p.translation) * convert::M_PER_MM,
+                convert::unit_quaternion(p.rotation),
+            )
+        })
+        .collect()
+}
+
+/// The object's pose relative to the palm: (translation in mm, rotation).
+pub(super) fn relative(scene: &Scene) -> (Vector3<f64>, UnitQuaternion<f64>) {
+    let palm = scene.world.bodies[scene.palm].position();
+    let obj = scene.world.bodies[scene.object].position();
+    let rel = palm.inverse() * *obj;
     (
-        nalgebra::Vector3::new(f64::from(c.x), f64::from(c.y), f64::from(c.z)),
-        nalgebra::Matrix3::from_column_slice(&cols.map(f64::from)),
+        convert::vector_mm(rel.translation),
+        convert::unit_quaternion(rel.rotation),
     )
 }
 
@@ -989,94 +705,6 @@ mod tests {
     fn thesis_hand() -> Hand {
         let (_, text) = crate::hand::bundled("thesis").unwrap();
         Hand::parse(text, Path::new("thesis.toml"), &[]).unwrap()
-    }
-
-    #[test]
-    fn a_convex_decomposition_is_made_once_per_mesh() {
-        let objects = crate::objects::thesis_objects();
-        let mesh = &objects.iter().find(|(n, _)| *n == "chapter4").unwrap().1;
-        let mesh = crate::mesh::align(mesh).mesh;
-        let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
-        let first = ObjectShape::cached(&mesh, volume);
-        assert_eq!(first.kind, ColliderKind::ConvexDecomposition);
-        // The same mesh again: the same shape, not a new decomposition.
-        let again = ObjectShape::cached(&mesh, volume);
-        assert!(std::sync::Arc::ptr_eq(&first.shape.0, &again.shape.0));
-        // Equal to one made afresh, part for part.
-        let fresh = ObjectShape::from_mesh(&mesh, volume);
-        assert_eq!(fresh.parts, first.parts);
-        let aabb = |s: &ObjectShape| s.shape.compute_local_aabb();
-        assert_eq!(aabb(&fresh), aabb(&first));
-        // Another mesh (one vertex moved) is another key.
-        let mut moved = mesh.clone();
-        moved.vertices[0].x += 1e-3;
-        assert_ne!(shape_key(&moved, volume), shape_key(&mesh, volume));
-        // A convex mesh is not kept (its hull is cheap).
-        let prism = crate::objects::prism(40.0, 100.0, 80.0);
-        let v = crate::mesh::mass_properties(&prism).volume_mm3;
-        let a = ObjectShape::cached(&prism, v);
-        let b = ObjectShape::cached(&prism, v);
-        assert_eq!(a.kind, ColliderKind::ConvexHull);
-        assert!(!std::sync::Arc::ptr_eq(&a.shape.0, &b.shape.0));
-    }
-
-    /// A cylinder of 60 mm and 120 mm on `segments` facets, with a ring every 10 mm.
-    fn fine_cylinder(segments: usize) -> Mesh {
-        use crate::objects::{radial_solid, uniform_angles, Ring};
-        let rings: Vec<Ring> = (0..=12)
-            .map(|k| Ring {
-                z: 10.0 * k as f64,
-                radii: vec![30.0; segments],
-            })
-            .collect();
-        radial_solid(&uniform_angles(segments), &rings)
-    }
-
-    #[test]
-    fn a_hull_parry_would_merge_into_curved_faces_is_rebuilt_from_its_planes() {
-        let shape = |segments| {
-            let mesh = fine_cylinder(segments);
-            let v = crate::mesh::mass_properties(&mesh).volume_mm3;
-            (ObjectShape::from_mesh(&mesh, v), mesh)
-        };
-        let hull_of = |s: &ObjectShape| {
-            let c = s.shape.as_convex_polyhedron().unwrap();
-            rapier3d::parry::transformation::try_convex_hull(c.points()).unwrap()
-        };
-        // 144 facets meet at 2.5°: parry keeps them apart, and the hull is the plain one, as for
-        // every thesis object.
-        let (plain, _) = shape(144);
-        assert_eq!(plain.coarsened_from, None);
-        assert_eq!(plain.kind, ColliderKind::ConvexHull);
-        // 512 facets meet at 0.7°, within parry's 1.5° merge: the side would become one face
-        // bent round the cylinder, some 30 mm off its own plane.
-        let mesh = fine_cylinder(512);
-        let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
-        let bent = bent_shape_m(&SharedShape::convex_hull(&points).unwrap());
-        assert!(bent > 0.02, "{bent} m");
-        assert!(bent_shape_m(&plain.shape) <= MERGED_FACE_TOLERANCE_M);
-        let (rebuilt, mesh) = shape(512);
-        assert_eq!(rebuilt.coarsened_from, Some(1024));
-        let (v, t) = hull_of(&rebuilt);
-        assert!(bent_shape_m(&rebuilt.shape) <= MERGED_FACE_TOLERANCE_M);
-        // Fewer facets, no two within 2° of each other: 512 / (2° of 0.703°) rounds to 148 or so.
-        assert!((200..=400).contains(&v.len()), "{} vertices", v.len());
-        // It holds the whole mesh (every vertex inside every face plane, to 0.1 µm) and stands
-        // off it by under 0.05 mm: every corner within 30 mm + 0.05 mm of the axis and within
-        // the caps.
-        for tri in &t {
-            let [a, b, c] = tri.map(|i| v[i as usize]);
-            let n = (b - a).cross(c - a).normalize();
-            for p in &mesh.vertices {
-                let out = n.dot(convert::point_m(p) - a);
-                assert!(out <= 1e-7, "{p:?}: {out} m outside");
-            }
-        }
-        for c in &v {
-            let r = (c.x * c.x + c.y * c.y).sqrt();
-            assert!((0.0299..=0.030_05).contains(&r), "{r} m");
-            assert!(c.z >= -1e-6 && c.z <= 0.120 + 1e-6, "{} m", c.z);
-        }
     }
 
     /// A 40 x 100 x 80 mm box about the z axis, its faces at x = ±20 and y = ±50.

@@ -61,7 +61,7 @@ fn the_d40_holds_where_it_was_planned() {
     // The palm is planned on the object, so it touches first, at the first step.
     let first = c.first_touch.as_ref().unwrap();
     assert_eq!((first.body.as_str(), first.phalanx), ("palm", 0));
-    assert!(first.at_s <= SimParams::default().timestep_s * 1.5);
+    assert!(first.at_s <= SimParams::default().solver.timestep_s * 1.5);
     // Where the closing left the bodies: the palm, six phalanges, the object.
     assert_eq!(out.closed_poses.len(), 8);
 }
@@ -71,10 +71,8 @@ fn equal_torques_push_the_d40_towards_the_thumb() {
     // With every finger at the full torque limit, finger_1 and finger_3 squeeze twice as hard
     // as the thumb opposite them: the object goes across by about 4 mm and the thumb's
     // phalanx 2 closes through its whole squeeze without meeting it.
-    let params = SimParams {
-        balanced_squeeze: false,
-        ..SimParams::default()
-    };
+    let mut params = SimParams::default();
+    params.fingers.balanced_squeeze = false;
     let out = d40_backed_off(0.0, &params);
     let c = &out.closing;
     assert!(
@@ -86,7 +84,7 @@ fn equal_torques_push_the_d40_towards_the_thumb() {
     assert_eq!(thumb.name, "finger_2");
     assert!(!thumb.touching[1], "{thumb:?}");
     assert!(
-        (thumb.error_deg[1] - params.squeeze2_deg).abs() < 0.5,
+        (thumb.error_deg[1] - params.fingers.squeeze2_deg).abs() < 0.5,
         "{thumb:?}"
     );
     assert!(c.phalanges_on_plan < 2, "{c:?}");
@@ -112,10 +110,8 @@ fn a_palm_backed_off_10_mm_is_reported_and_bounded() {
         assert_eq!(d.closing_translation_mm, c.shift_mm);
     }
     // ... while with the bound above the push, the same closing is judged by the hold alone.
-    let loose = SimParams {
-        max_closing_shift_mm: 20.0,
-        ..SimParams::default()
-    };
+    let mut loose = SimParams::default();
+    loose.hold.max_closing_shift_mm = 20.0;
     let out = d40_backed_off(10.0, &loose);
     assert!(!out.closing.pushed);
     assert_eq!(out.closing.shift_mm, c.shift_mm);

@@ -8,6 +8,7 @@ mod export;
 mod formats;
 mod frames;
 mod geometry;
+mod hostile;
 mod isolation;
 mod issue16;
 mod planner;

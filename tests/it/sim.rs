@@ -110,7 +110,8 @@ fn the_same_scenario_gives_the_same_sim_numbers() {
 fn rapier_tolerances_are_pinned_at_hand_scale() {
     // At rapier's default length unit (1 m) the allowed penetration would be 5 mm and the
     // prediction distance 20 mm: most of a 40 mm object. grasp-sim sets a 1 cm unit.
-    use grasp_sim::sim::scene::{build, Case, ObjectShape, SimHand};
+    use grasp_sim::sim::scene::{build, Case, SimHand};
+    use grasp_sim::sim::ObjectShape;
     let (_d, s) = scenario_with("cylinder_d40.stl", "");
     let mesh = grasp_sim::objects::cylinder(40.0, 124.0);
     let shape = ObjectShape::from_mesh(&mesh, grasp_sim::mesh::mass_properties(&mesh).volume_mm3);
@@ -186,7 +187,7 @@ fn hold_slip_and_drop_are_told_apart() {
     // It has come to rest on the hand by 0.5 s: the fast protocol decides the slip then rather
     // than holding to the end (`fast_and_full_protocols_agree_on_the_bundled_scenarios`
     // compares its numbers with the full hold's).
-    assert_eq!(d.decided_by, "rest");
+    assert_eq!(d.decided_by, grasp_sim::sim::DecidedBy::Rest);
     assert!(d.decided_at_s < 1.0, "decided at {} s", d.decided_at_s);
     let mut drops = Vec::new();
     for name in ["sim_cup_weak_motors", "sim_d40_slippery_heavy"] {
@@ -311,10 +312,8 @@ fn the_closing_ends_when_the_hand_and_the_object_stop() {
     // object have stopped; the fixed schedule closes for the whole 0.5 s. On D40 both end in
     // the same grip: joint angles within a tenth of a degree, and both hold.
     use grasp_sim::scenario::SimParams;
-    let fixed = SimParams {
-        close_until_stalled: false,
-        ..Default::default()
-    };
+    let mut fixed = SimParams::default();
+    fixed.closing.close_until_stalled = false;
     let (stalled, fixed) = (
         d40_case(SimParams::default(), grasp_sim::sim::check),
         d40_case(fixed, grasp_sim::sim::check),
@@ -336,7 +335,7 @@ fn the_closing_ends_when_the_hand_and_the_object_stop() {
     assert_eq!(a.verdict, Verdict::Hold);
     assert_eq!(b.verdict, Verdict::Hold);
     // The steps reported are the closing's and the hold's: the closing saved is saved.
-    let dt = SimParams::default().timestep_s;
+    let dt = SimParams::default().solver.timestep_s;
     let steps = |d: &grasp_sim::sim::DirectionOutcome| {
         ((d.closed_at_s + d.decided_at_s) / dt).round() as usize
     };
@@ -401,7 +400,7 @@ fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
             })
             .collect()
     };
-    let remaining = |n: usize| params.duration_s - n as f64 * SAMPLE_S;
+    let remaining = |n: usize| params.hold.duration_s - n as f64 * SAMPLE_S;
     // The verdict by motion after `n` samples, for a grasp the closing left clear (`deep`:
     // deeper than `max_penetration_mm`).
     let by = |samples: &[(Vector3<f64>, UnitQuaternion<f64>)], n: usize, deep: bool| {
@@ -588,7 +587,7 @@ fn a_drop_clear_of_the_hand_is_the_full_protocols_drop() {
     let mut clear = 0;
     for (a, b) in full.directions.iter().zip(&fast.directions) {
         assert_eq!(a.verdict, b.verdict, "gravity {:?}", a.gravity);
-        if b.decided_by == "clear_of_hand" {
+        if b.decided_by == grasp_sim::sim::DecidedBy::ClearOfHand {
             clear += 1;
             let d = (a.translation_mm - b.translation_mm).abs();
             assert!(

@@ -10,6 +10,8 @@
 //! and the HeightStep) is built once per distinct pair of those; a grasp that two settings both
 //! produce is simulated once (its physics does not depend on how it was found).
 
+pub mod command;
+
 use crate::batch::{scenario_for, Item};
 use crate::mesh::AlignedObject;
 use crate::plan::{self, Domain};
@@ -192,6 +194,17 @@ impl std::str::FromStr for Sweep {
     }
 }
 
+/// The most settings a tuning grid may have: each is a plan and a physics check per object, and
+/// the grid is held in memory (three sweeps of 1000 values each would be 10⁹ settings).
+pub const MAX_SETTINGS: usize = 10_000;
+
+/// How many settings the sweeps make (their values' product, saturating).
+pub fn grid_size(sweeps: &[Sweep]) -> usize {
+    sweeps
+        .iter()
+        .fold(1usize, |n, s| n.saturating_mul(s.values.len()))
+}
+
 /// Every combination of the sweeps' values, the first sweep varying slowest.
 pub fn grid(sweeps: &[Sweep]) -> Vec<Vec<f64>> {
     let mut out = vec![Vec::new()];
@@ -306,7 +319,13 @@ struct Prepared {
 }
 
 /// A simulated grasp: verdict, translation, payload margin of a hold, and the outcome.
-type Simulated = (Verdict, f64, Option<f64>, sim::SimOutcome);
+#[derive(Clone)]
+struct Simulated {
+    /// The check's outcome.
+    outcome: sim::SimOutcome,
+    /// The payload margin, for a grasp that held.
+    payload_margin: Option<f64>,
+}
 
 /// Simulated grasps by (axis, fingerprint).
 type SimCache = HashMap<(crate::mesh::GraspAxis, Vec<u64>), Simulated>;
@@ -328,7 +347,10 @@ fn simulate(
     let out = sim::check(&case);
     counters.sim_runs += 1;
     let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
-    let o = (out.verdict, out.translation_mm, margin, out);
+    let o = Simulated {
+        outcome: out,
+        payload_margin: margin,
+    };
     sims.insert(key, o.clone());
     o
 }
@@ -502,7 +524,7 @@ fn run_object(
             s.name.apply(&mut params, *v);
         }
         let valid = validate_planner(&params, &p.scenario.hand, p.scenario.object.friction);
-        results.push(match (valid, &p.scenario.sim.override_angles) {
+        results.push(match (valid, &p.scenario.sim.input.override_angles) {
             (Err((key, why)), _) => {
                 object_result(p, ObjectStatus::Invalid, None, Some(format!("{key} {why}")))
             }
@@ -541,9 +563,9 @@ fn object_result(
     ObjectResult {
         scenario: p.scenario.name.clone(),
         status,
-        verdict: outcome.map(|o| o.0),
-        translation_mm: outcome.map(|o| o.1),
-        payload_margin: outcome.and_then(|o| o.2),
+        verdict: outcome.map(|o| o.outcome.verdict),
+        translation_mm: outcome.map(|o| o.outcome.translation_mm),
+        payload_margin: outcome.and_then(|o| o.payload_margin),
         reason,
     }
 }
@@ -572,7 +594,13 @@ fn run_override(
         .clone();
     let mut t = StageTimings::default();
     let graded = plan::grade_built(domain, hand, params, p.scenario.object.friction, &mut t);
-    let pose = SimHand::from_override(&aligned.mesh, hand, &graded, &p.scenario.sim, angles);
+    let pose = crate::select::override_pose(
+        &aligned.mesh,
+        hand,
+        &graded,
+        p.scenario.sim.input.override_index,
+        angles,
+    );
     let outcome = pose.ok().map(|pose| {
         let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
         let shape = p.object.shape(aligned);
@@ -607,11 +635,7 @@ fn run_planned(
         let key = (a.axis, fingerprint(&pose));
         let (sims, counters) = &mut *cache.borrow_mut();
         let o = simulate(p, &pose, &shape, key, sims, counters);
-        sim::SimOutcome {
-            verdict: o.0,
-            translation_mm: o.1,
-            ..o.3
-        }
+        o.outcome
     };
     let mut t = StageTimings::default();
     let selection = crate::select::select(
@@ -622,7 +646,7 @@ fn run_planned(
             planner: params,
             friction: p.scenario.object.friction,
             collect: candidates,
-            max_checked: Some(p.scenario.sim.max_checked.max(1)),
+            max_checked: Some(p.scenario.sim.selection.max_checked.max(1)),
             check: &check,
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,

@@ -1,0 +1,457 @@
+//! Running one input, end to end: the one place that turns a scenario into its report, used by
+//! the command line ([`inputs`]), `batch` and the Python-free library API alike.
+//!
+//! [`compute`] prepares the object, plans (choosing among candidates with the physics check when
+//! it runs), checks the chosen grasp and judges `[expect]`; it writes nothing. [`write_outputs`]
+//! writes what the options ask for (`--export-urdf`, `--export-mjcf`, `--report`) from what was
+//! computed. [`run`] is the two in turn.
+
+mod build;
+pub mod inputs;
+
+use crate::prepared::PreparedObject;
+use crate::report::{ExpectReport, GraspSource, PlanStatus, RunReport, SimReport, StageTimings};
+use crate::scenario::Scenario;
+use crate::{export, mesh, plan, quality, scenario, select, sim, visual};
+
+/// Any error that stops a scenario from running: bad input, never a grasp outcome.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A bad scenario or hand file.
+    #[error(transparent)]
+    Scenario(#[from] scenario::ScenarioError),
+    /// A bad mesh file.
+    #[error(transparent)]
+    Mesh(#[from] mesh::MeshError),
+    /// An export could not be written.
+    #[error(transparent)]
+    Export(#[from] export::ExportError),
+}
+
+/// The flags that decide what is computed for each input, as the command line, `batch` and its
+/// workers give them.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct RunFlags {
+    /// Skip the physics check.
+    pub no_sim: bool,
+    /// Find the payload margin by bisection.
+    pub payload: bool,
+    /// Compute the analytic grasp quality of every grasp reported.
+    pub quality: bool,
+}
+
+/// How to run a scenario.
+#[derive(Clone)]
+pub struct RunOptions {
+    /// Skip the physics check.
+    pub no_sim: bool,
+    /// Find the payload margin by bisection (several more physics runs).
+    pub payload: bool,
+    /// Compute the analytic grasp quality of every grasp reported (`quality`, docs/QUALITY.md):
+    /// a 6-D convex hull per grasp, so off by default.
+    pub quality: bool,
+    /// How many feasible grasps to collect, in search order (the thesis stops at 1).
+    pub candidates: usize,
+    /// With the physics check: check candidates in search order until one holds or this many
+    /// have been checked (`None`: the scenario's `[sim] max_checked`).
+    pub max_checked: Option<usize>,
+    /// Write the planned grasp as an MJCF scene into this folder (a subfolder per scenario).
+    pub export_mjcf: Option<std::path::PathBuf>,
+    /// Write the hand as URDF into this folder (a subfolder per scenario).
+    pub export_urdf: Option<std::path::PathBuf>,
+    /// Write figures, 3D scenes and report.html into this folder (a subfolder per scenario).
+    pub report: Option<std::path::PathBuf>,
+    /// The name of the subfolder of `report`, `export_mjcf` and `export_urdf` (`None`: the
+    /// scenario's name).
+    pub folder: Option<String>,
+}
+
+/// Candidates the physics check runs on at most before a run settles for the best it saw.
+pub const DEFAULT_MAX_CHECKED: usize = 8;
+
+impl Default for RunOptions {
+    fn default() -> Self {
+        RunFlags::default().into()
+    }
+}
+
+impl From<RunFlags> for RunOptions {
+    fn from(f: RunFlags) -> RunOptions {
+        RunOptions {
+            no_sim: f.no_sim,
+            payload: f.payload,
+            quality: f.quality,
+            candidates: 1,
+            max_checked: None,
+            export_mjcf: None,
+            export_urdf: None,
+            report: None,
+            folder: None,
+        }
+    }
+}
+
+/// Everything but `folder`, as a derived `Debug` would write it: a batch's input hash is this
+/// text (`batch::input_hash`), and where the outputs go does not change what is computed, so
+/// results files written before `folder` existed still resume.
+impl std::fmt::Debug for RunOptions {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RunOptions")
+            .field("no_sim", &self.no_sim)
+            .field("payload", &self.payload)
+            .field("quality", &self.quality)
+            .field("candidates", &self.candidates)
+            .field("max_checked", &self.max_checked)
+            .field("export_mjcf", &self.export_mjcf)
+            .field("export_urdf", &self.export_urdf)
+            .field("report", &self.report)
+            .finish()
+    }
+}
+
+impl RunOptions {
+    /// The subfolder of the output folders for `scenario`.
+    pub fn folder_for<'a>(&'a self, scenario: &'a Scenario) -> &'a str {
+        self.folder.as_deref().unwrap_or(&scenario.name)
+    }
+
+    /// Whether any output folder is asked for.
+    pub fn writes_folders(&self) -> bool {
+        self.report.is_some() || self.export_mjcf.is_some() || self.export_urdf.is_some()
+    }
+}
+
+/// What [`compute`] found for a scenario: the report, and what the outputs are written from.
+pub struct Computed {
+    /// The report (its `mjcf_scene` is set by [`write_outputs`]).
+    pub report: RunReport,
+    object: PreparedObject,
+    selection: select::Selection,
+    /// The pose the physics check ran (or would run) on, and where the grasp came from.
+    posed: Option<sim::SimHand>,
+    /// The bodies' poses at the end of the first hold and at the end of the closing.
+    sim_poses: Option<(Vec<sim::BodyPose>, Vec<sim::BodyPose>)>,
+}
+
+impl Computed {
+    /// The aligned object the chosen grasp (or `override_angles`) is on.
+    fn checked_on(&self) -> &mesh::AlignedObject {
+        self.selection.chosen().map_or(&self.object.aligned, |c| {
+            &self.selection.axes[c.axis_plan].aligned
+        })
+    }
+}
+
+/// Runs a scenario: [`compute`], then [`write_outputs`].
+///
+/// # Errors
+/// [`Error`] for a bad mesh file or an output that cannot be written.
+pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error> {
+    let mut computed = compute(scenario, options)?;
+    write_outputs(&mut computed, scenario, options)?;
+    Ok(computed.report)
+}
+
+/// Prepares the object, plans, checks the chosen grasp and judges `[expect]`. Writes nothing.
+///
+/// # Errors
+/// [`Error`] for a bad mesh file.
+pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Error> {
+    let mut timings = StageTimings::default();
+    let object = PreparedObject::load(&scenario.object, &mut timings)?;
+    let selection = select_grasps(scenario, options, &object, &mut timings);
+    let qualities = qualities(scenario, options, &selection);
+    let plan = build::plan_report(scenario, &selection, &qualities, timings);
+    let chosen = selection.chosen();
+    let checked_on = chosen.map_or(&object.aligned, |c| &selection.axes[c.axis_plan].aligned);
+    let posed = sim_pose(
+        scenario,
+        checked_on,
+        &selection.axes[0].graded,
+        chosen.map(|c| (&c.grasp, c.check.clone())),
+    );
+    let (sim, sim_poses, ran) = run_sim(scenario, options, &object, checked_on, &posed);
+    // A check that ran here (not in the candidate search: `override_angles`) closed its own
+    // grip: the quality is that grip's, not the planned contacts'.
+    let quality = match (&ran, options.quality) {
+        (Some(out), true) => Some(quality::of_check(
+            checked_on,
+            out,
+            &scenario.hand,
+            scenario.object.friction,
+        )),
+        _ => selection.chosen.and_then(|i| qualities[i].clone()),
+    };
+    let expect = match &scenario.expect {
+        Some(e) => ExpectReport::judge(e, &plan, &sim),
+        None => ExpectReport::none(),
+    };
+    let shown = selection.reported_axis();
+    let report = RunReport {
+        scenario: scenario.name.clone(),
+        object: build::object_report(scenario, &object),
+        warnings: build::warnings(
+            scenario,
+            &object,
+            &shown.graded,
+            plan.open_slices,
+            plan.status == PlanStatus::Ungraspable,
+        ),
+        plan,
+        sim,
+        expect,
+        quality,
+        mjcf_scene: None,
+    };
+    Ok(Computed {
+        report,
+        posed: posed.ok().map(|p| p.0),
+        object,
+        selection,
+        sim_poses,
+    })
+}
+
+/// Writes the URDF and MJCF exports and the `--report` folder that `options` ask for, from
+/// what [`compute`] found; sets the report's `mjcf_scene`.
+///
+/// # Errors
+/// [`Error::Export`] for an output that cannot be written.
+pub fn write_outputs(
+    computed: &mut Computed,
+    scenario: &Scenario,
+    options: &RunOptions,
+) -> Result<(), Error> {
+    if let Some(dir) = &options.export_urdf {
+        export::write_urdf(
+            &dir.join(options.folder_for(scenario)),
+            &scenario.hand,
+            &scenario.sim,
+        )?;
+    }
+    if let (Some(dir), Some(pose)) = (&options.export_mjcf, &computed.posed) {
+        let aligned = computed.checked_on();
+        let shape = computed.object.shape(aligned);
+        let input = export::ExportInput {
+            name: &scenario.name,
+            object: aligned,
+            case: computed.object.case(scenario, pose, &shape),
+        };
+        let folder = dir.join(options.folder_for(scenario));
+        export::write_mjcf(&folder, &input)?;
+        computed.report.mjcf_scene = Some(folder.join("scene.xml"));
+    }
+    if let Some(dir) = &options.report {
+        let shown = computed.selection.reported_axis();
+        visual::write_report(
+            &dir.join(options.folder_for(scenario)),
+            &computed.report,
+            &shown.graded,
+            computed.selection.chosen().map(|c| &c.grasp),
+            &shown.aligned.mesh,
+            &scenario.hand,
+            computed
+                .sim_poses
+                .as_ref()
+                .map(|(end, closed)| visual::SimulatedPoses { end, closed }),
+        )?;
+    }
+    Ok(())
+}
+
+/// The physics check of one planned grasp on `aligned`, as a run does it: the one place that
+/// turns a grasp into a check (the candidate search and `tune` call it).
+pub fn check_grasp(
+    scenario: &Scenario,
+    object: &PreparedObject,
+    aligned: &mesh::AlignedObject,
+    grasp: &plan::search::Grasp,
+) -> sim::SimOutcome {
+    let shape = object.shape(aligned);
+    let pose = sim::SimHand::from_grasp(grasp);
+    sim::check(&object.case(scenario, &pose, &shape))
+}
+
+/// Plans across axes and rule sets; with the physics check on the planner's grasps, checks
+/// candidates until one holds (at most `max_checked`).
+fn select_grasps(
+    scenario: &Scenario,
+    options: &RunOptions,
+    object: &PreparedObject,
+    timings: &mut StageTimings,
+) -> select::Selection {
+    let check = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
+        check_grasp(scenario, object, a, g)
+    };
+    // The physics check chooses among candidates only when it runs on the planner's grasps.
+    let checks_candidates = !options.no_sim && scenario.sim.input.override_angles.is_none();
+    let max_checked = options
+        .max_checked
+        .unwrap_or(scenario.sim.selection.max_checked);
+    select::select(
+        object.mesh(),
+        &object.props,
+        &select::SelectParams {
+            hand: &scenario.hand,
+            planner: &scenario.planner,
+            friction: scenario.object.friction,
+            collect: options.candidates,
+            max_checked: checks_candidates.then_some(max_checked.max(1)),
+            check: &check,
+            domains: None,
+            frame: scenario.object.frame,
+        },
+        timings,
+    )
+}
+
+/// The analytic quality of every candidate when `--quality` asks for it.
+fn qualities(
+    scenario: &Scenario,
+    options: &RunOptions,
+    selection: &select::Selection,
+) -> Vec<Option<quality::Quality>> {
+    selection
+        .candidates
+        .iter()
+        .map(|c| {
+            options.quality.then(|| {
+                let aligned = &selection.axes[c.axis_plan].aligned;
+                let (h, mu) = (&scenario.hand, scenario.object.friction);
+                quality::of_grasp(&c.grasp, aligned, c.check.as_ref(), h, mu)
+            })
+        })
+        .collect()
+}
+
+/// The pose to check: `override_angles` (placed on the thesis axis's `graded` domain) or the
+/// chosen grasp, where the grasp came from, and the candidate search's outcome for it; or why
+/// there is nothing to check.
+type Posed = Result<(sim::SimHand, GraspSource, Option<sim::SimOutcome>), String>;
+
+fn sim_pose(
+    scenario: &Scenario,
+    aligned: &mesh::AlignedObject,
+    graded: &plan::GradedDomain,
+    grasp: Option<(&plan::search::Grasp, Option<sim::SimOutcome>)>,
+) -> Posed {
+    let p = &scenario.sim;
+    match (&p.input.override_angles, grasp) {
+        (Some(angles), _) => select::override_pose(
+            &aligned.mesh,
+            &scenario.hand,
+            graded,
+            p.input.override_index,
+            angles,
+        )
+        .map(|pose| (pose, GraspSource::OverrideAngles, None))
+        .map_err(|e| e.to_string()),
+        (None, Some((g, done))) => Ok((sim::SimHand::from_grasp(g), GraspSource::Planner, done)),
+        (None, None) => Err("no feasible grasp to check".to_string()),
+    }
+}
+
+/// The physics check's report, the bodies' poses for the report's scenes, and the outcome when
+/// the check ran here rather than in the candidate search.
+type Simulated = (
+    SimReport,
+    Option<(Vec<sim::BodyPose>, Vec<sim::BodyPose>)>,
+    Option<sim::SimOutcome>,
+);
+
+/// Runs the physics check on the posed grasp (or says why it did not run).
+fn run_sim(
+    scenario: &Scenario,
+    options: &RunOptions,
+    object: &PreparedObject,
+    aligned: &mesh::AlignedObject,
+    posed: &Posed,
+) -> Simulated {
+    // With --no-sim the check's reason is `--no-sim`, unless an MJCF export asked for the pose
+    // and there is none: then the reason is why not.
+    let (pose, source, done) = match posed {
+        Err(_) if options.no_sim && options.export_mjcf.is_none() => {
+            return (SimReport::not_run("--no-sim"), None, None)
+        }
+        Err(why) => return (SimReport::not_run(why), None, None),
+        Ok(_) if options.no_sim => return (SimReport::not_run("--no-sim"), None, None),
+        Ok((pose, source, done)) => (pose, *source, done),
+    };
+    let shape = object.shape(aligned);
+    let case = object.case(scenario, pose, &shape);
+    // The candidate search already checked the chosen grasp: the same case, the same outcome.
+    let (out, payload, ran) = match done {
+        Some(out) => {
+            let payload = (options.payload && out.verdict == sim::Verdict::Hold)
+                .then(|| sim::payload_bracket(&case));
+            (out.clone(), payload, false)
+        }
+        None => {
+            let (out, payload) = sim::check_with_payload(&case, options.payload);
+            (out, payload, true)
+        }
+    };
+    let poses = (out.final_poses.clone(), out.closed_poses.clone());
+    let ran = ran.then(|| out.clone());
+    let report = build::checked_report(out, payload, &case, &shape, source, options);
+    (report, Some(poses), ran)
+}
+
+/// Progress of a long command (`batch`, `tune`), shown by the caller: a bar on a terminal, lines
+/// in a log, or nothing.
+pub trait Progress: Sync {
+    /// `total` steps begin.
+    fn begin(&self, total: usize);
+    /// Step `done` of `total` has finished; `message` says which and how.
+    fn step(&self, done: usize, total: usize, message: &str);
+    /// The steps are over.
+    fn end(&self);
+}
+
+/// Creates `dir` if needed and checks a file can be written in it: output folders are checked
+/// before any work, so an unwritable one costs nothing.
+///
+/// # Errors
+/// A file in the way, or a folder that cannot be created or written in.
+pub fn check_output_dir(dir: &std::path::Path) -> anyhow::Result<()> {
+    use anyhow::Context;
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!("{}: is a file, not a folder", dir.display());
+    }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("{}: cannot create folder", dir.display()))?;
+    let probe = dir.join(".grasp-sim-write-test");
+    std::fs::write(&probe, b"")
+        .and_then(|()| std::fs::remove_file(&probe))
+        .with_context(|| format!("{}: cannot write in this folder", dir.display()))
+}
+
+/// Checks that `file` can be written later: its folder exists and takes a file.
+///
+/// # Errors
+/// No such folder, a folder where the file should be, or a folder that cannot be written in.
+pub fn check_output_file(file: &std::path::Path) -> anyhow::Result<()> {
+    use anyhow::Context;
+    let dir = file
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(std::path::Path::new("."));
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "{}: cannot write: no folder {}",
+            file.display(),
+            dir.display()
+        );
+    }
+    if file.is_dir() {
+        anyhow::bail!(
+            "{}: is a folder; give a file to write the results to (for example {})",
+            file.display(),
+            file.join("results.jsonl").display()
+        );
+    }
+    let probe = dir.join(".grasp-sim-write-test");
+    std::fs::write(&probe, b"")
+        .and_then(|()| std::fs::remove_file(&probe))
+        .with_context(|| format!("{}: cannot write in {}", file.display(), dir.display()))
+}

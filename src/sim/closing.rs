@@ -1,0 +1,472 @@
+//! Closing the hand on the object, gravity off (docs/SIM.md, "What the closing does"): joint 1
+//! first, then joint 2, each until the hand and the object stop ([`STALL`]) or for its share of
+//! `close_duration_s`; and what the closing did: the object's shift, the joints' errors against
+//! the plan, which phalanx touched first, the penetration left. Units: millimetres and degrees in
+//! what it reports, SI inside rapier.
+
+use super::convert;
+use super::outcome::{ClosingOutcome, FingerClosing, FirstTouch, WITHIN_PLAN_DEG};
+use super::scene::{poses, relative, Case, Scene};
+use nalgebra::{UnitQuaternion, Vector3};
+use rapier3d::prelude::*;
+
+/// The end of a closing phase with `close_until_stalled` (docs/SIM.md, "Closing until the hand
+/// stops"): every joint, and the object relative to the palm, slower than these for
+/// `window_s`.
+#[derive(Debug, Clone, Copy)]
+pub struct Stall {
+    /// Fastest joint `[rad/s]`.
+    pub joint_rad_s: f64,
+    /// Fastest object translation `[mm/s]`.
+    pub object_mm_s: f64,
+    /// Fastest object rotation `[rad/s]`.
+    pub object_rad_s: f64,
+    /// How long all of them must stay below `[s]`.
+    pub window_s: f64,
+}
+
+/// The rule, for rapier and the MuJoCo replay (`protocol.json`).
+pub const STALL: Stall = Stall {
+    joint_rad_s: 0.02,
+    object_mm_s: 0.5,
+    object_rad_s: 0.01,
+    window_s: 0.02,
+};
+
+impl Stall {
+    /// True if `(joint, object translation, object rotation)` speeds are all below the rule's.
+    fn quiet(&self, (joint, object_mm_s, object_rad_s): (f64, f64, f64)) -> bool {
+        joint < self.joint_rad_s
+            && object_mm_s < self.object_mm_s
+            && object_rad_s < self.object_rad_s
+    }
+}
+
+/// Where the closing left the object, and how it got there.
+#[derive(Debug, Clone)]
+pub(super) struct Closing {
+    /// Object translation relative to the palm at the start `[mm]`.
+    pub(super) p0: Vector3<f64>,
+    /// Object rotation relative to the palm at the start.
+    pub(super) q0: UnitQuaternion<f64>,
+    /// What the closing did, as reported.
+    pub(super) outcome: ClosingOutcome,
+    /// Where it left the bodies.
+    pub(super) poses: Vec<super::BodyPose>,
+    /// ... and after closing `[mm]`.
+    pub(super) pc: Vector3<f64>,
+    /// Object rotation relative to the palm after closing.
+    pub(super) qc: UnitQuaternion<f64>,
+    /// Per finger, joint bend after closing minus the plan `[deg]`.
+    pub(super) joint_errors_deg: Vec<[f64; 2]>,
+    /// Deepest penetration of a hand collider into the object after closing `[mm]`.
+    pub(super) penetration_mm: f64,
+    /// Steps taken.
+    pub(super) steps: usize,
+    /// The contacts carrying the grip when closing ended.
+    pub(super) contacts: Vec<super::contacts::GripContact>,
+}
+
+/// Closes the hand, gravity off: joint 1 first, then joint 2, each for half `close_duration_s`
+/// or, with `close_until_stalled`, until the hand and the object have stopped ([`STALL`]).
+pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
+    let params = case.params;
+    let stall = params.closing.close_until_stalled.then_some(&STALL);
+    let dt = params.solver.timestep_s;
+    let close_steps = (params.closing.close_duration_s / dt).round() as usize;
+    let (p0, q0) = relative(scene);
+    let mut first_contact = FirstContacts::new(scene.fingers.len());
+    // Joint 1 closes for at most half the closing time, joint 2 for the rest.
+    let phases = [close_steps / 2, close_steps - close_steps / 2];
+    let mut steps = 0;
+    let mut together = Together {
+        waiting: params.closing.approach == super::params::Approach::Together,
+        held: vec![false; scene.fingers.len()],
+    };
+    for (phase, max_steps) in phases.into_iter().enumerate() {
+        if phase == 1 {
+            if together.waiting {
+                together.release(scene);
+            }
+            scene.release_joint2();
+        }
+        let mut quiet_steps = 0;
+        for _ in 0..max_steps {
+            scene.world.step();
+            steps += 1;
+            let now = touching(scene);
+            first_contact.update(&now, steps as f64 * dt);
+            if together.hold_touching(scene, &now) {
+                quiet_steps = 0;
+            }
+            let Some(rule) = stall else { continue };
+            if rule.quiet(motion(scene)) {
+                quiet_steps += 1;
+                if quiet_steps as f64 * dt >= rule.window_s {
+                    if together.waiting {
+                        // A finger that stopped without touching: the others squeeze now.
+                        together.release(scene);
+                        quiet_steps = 0;
+                        continue;
+                    }
+                    break;
+                }
+            } else {
+                quiet_steps = 0;
+            }
+        }
+    }
+    closed(scene, case, (p0, q0), &first_contact, steps)
+}
+
+/// Where the closing left the hand and the object after `steps`, from the object's pose
+/// relative to the palm at the start, `(p0, q0)`, and the first contacts.
+fn closed(
+    scene: &Scene,
+    case: &Case,
+    (p0, q0): (Vector3<f64>, UnitQuaternion<f64>),
+    first_contact: &FirstContacts,
+    steps: usize,
+) -> Closing {
+    let dt = case.params.solver.timestep_s;
+    let (pc, qc) = relative(scene);
+    let joint_errors_deg = joint_errors(scene);
+    let outcome = closing_outcome(
+        case,
+        first_contact,
+        &touching(scene),
+        &gaps_mm(scene),
+        &joint_errors_deg,
+        ((pc - p0).norm(), q0.angle_to(&qc).to_degrees()),
+        steps as f64 * dt,
+    );
+    Closing {
+        p0,
+        q0,
+        pc,
+        qc,
+        penetration_mm: penetration_mm(scene),
+        joint_errors_deg,
+        steps,
+        contacts: super::contacts::grip_contacts(scene),
+        outcome,
+        poses: poses(scene),
+    }
+}
+
+/// Per finger, the gap between phalanx 1, phalanx 2 (its nearest collider) and the object's
+/// collider now `[mm]`, 0 when they touch or overlap.
+fn gaps_mm(scene: &Scene) -> Vec<[f64; 2]> {
+    let w = &scene.world;
+    let object = &w.colliders[scene.object_collider];
+    let gap = |body: RigidBodyHandle| -> f64 {
+        w.bodies[body]
+            .colliders()
+            .iter()
+            .filter_map(|&h| {
+                let c = &w.colliders[h];
+                rapier3d::parry::query::distance(
+                    c.position(),
+                    c.shape(),
+                    object.position(),
+                    object.shape(),
+                )
+                .ok()
+            })
+            .map(|d| f64::from(d.distance) * 1000.0)
+            .fold(f64::INFINITY, f64::min)
+            .max(0.0)
+    };
+    scene
+        .fingers
+        .iter()
+        .map(|f| [gap(f.phalanx1), gap(f.phalanx2)])
+        .collect()
+}
+
+/// The `together` approach (`[sim] approach`): fingers held where they touched, until all have
+/// or the hand has stopped.
+struct Together {
+    /// True while fingers wait for the others (always false under `squeeze`).
+    waiting: bool,
+    /// Per finger, true if and only if it is held.
+    held: Vec<bool>,
+}
+
+impl Together {
+    /// While waiting, holds every finger that touches the object `now` and is not held yet;
+    /// once all are held, sends them on together. Returns true if and only if it did now.
+    fn hold_touching(&mut self, scene: &mut Scene, now: &Touching) -> bool {
+        if !self.waiting {
+            return false;
+        }
+        for (k, t) in now.fingers.iter().enumerate() {
+            if (t[0] || t[1]) && !self.held[k] {
+                scene.hold_joint1(k, true);
+                self.held[k] = true;
+            }
+        }
+        if self.held.iter().all(|h| *h) {
+            self.release(scene);
+            return true;
+        }
+        false
+    }
+
+    /// Sends every held finger on to its squeeze target, and stops waiting.
+    fn release(&mut self, scene: &mut Scene) {
+        release_held(scene, &mut self.held);
+        self.waiting = false;
+    }
+}
+
+/// Sends every held finger's joint 1 on to its squeeze target.
+fn release_held(scene: &mut Scene, held: &mut [bool]) {
+    for (k, h) in held.iter_mut().enumerate() {
+        if *h {
+            scene.hold_joint1(k, false);
+        }
+        *h = false;
+    }
+}
+
+/// Which hand bodies touch the object now: the palm, and phalanx 1 and 2 of each finger.
+struct Touching {
+    palm: bool,
+    fingers: Vec<[bool; 2]>,
+}
+
+/// When each hand body first touched the object during the closing `[s]`.
+struct FirstContacts {
+    palm: Option<f64>,
+    fingers: Vec<[Option<f64>; 2]>,
+}
+
+impl FirstContacts {
+    fn new(fingers: usize) -> FirstContacts {
+        FirstContacts {
+            palm: None,
+            fingers: vec![[None; 2]; fingers],
+        }
+    }
+
+    /// Records the bodies of `now` that touch for the first time at `t`.
+    fn update(&mut self, now: &Touching, t: f64) {
+        if now.palm && self.palm.is_none() {
+            self.palm = Some(t);
+        }
+        for (first, touch) in self.fingers.iter_mut().zip(&now.fingers) {
+            for j in 0..2 {
+                if touch[j] && first[j].is_none() {
+                    first[j] = Some(t);
+                }
+            }
+        }
+    }
+
+    /// The earliest first touch: (`palm` or the finger's name, phalanx, time); the palm, then
+    /// the fingers in order, on a tie.
+    fn first(&self, names: &[String]) -> Option<FirstTouch> {
+        let mut best: Option<FirstTouch> = self.palm.map(|t| FirstTouch {
+            body: "palm".to_string(),
+            phalanx: 0,
+            at_s: t,
+        });
+        for (name, first) in names.iter().zip(&self.fingers) {
+            for (j, t) in first.iter().enumerate() {
+                if let Some(t) = *t {
+                    if best.as_ref().is_none_or(|b| t < b.at_s) {
+                        best = Some(FirstTouch {
+                            body: name.clone(),
+                            phalanx: j + 1,
+                            at_s: t,
+                        });
+                    }
+                }
+            }
+        }
+        best
+    }
+}
+
+/// The hand bodies in contact with the object now (a solver contact: within rapier's
+/// prediction distance, 0.2 mm at the scene's length unit).
+fn touching(scene: &Scene) -> Touching {
+    let w = &scene.world;
+    let mut now = Touching {
+        palm: false,
+        fingers: vec![[false; 2]; scene.fingers.len()],
+    };
+    for pair in w.narrow_phase.contact_pairs_with(scene.object_collider) {
+        if !pair.has_any_active_contact() {
+            continue;
+        }
+        let other = if pair.collider1 == scene.object_collider {
+            pair.collider2
+        } else {
+            pair.collider1
+        };
+        let Some(body) = w.colliders.get(other).and_then(|c| c.parent()) else {
+            continue;
+        };
+        if body == scene.palm {
+            now.palm = true;
+        }
+        for (k, f) in scene.fingers.iter().enumerate() {
+            if body == f.phalanx1 {
+                now.fingers[k][0] = true;
+            }
+            if body == f.phalanx2 {
+                now.fingers[k][1] = true;
+            }
+        }
+    }
+    now
+}
+
+/// The report of a closing: `shift` is the object's (translation `[mm]`, rotation `[deg]`)
+/// relative to the palm over the closing, `duration_s` its length.
+fn closing_outcome(
+    case: &Case,
+    first: &FirstContacts,
+    end: &Touching,
+    gaps: &[[f64; 2]],
+    errors: &[[f64; 2]],
+    (shift_mm, turn_deg): (f64, f64),
+    duration_s: f64,
+) -> ClosingOutcome {
+    let names: Vec<String> = case
+        .hand
+        .finger_list
+        .iter()
+        .map(|f| f.name.clone())
+        .collect();
+    let fingers: Vec<FingerClosing> = names
+        .iter()
+        .zip(&case.pose.theta_deg)
+        .zip(errors)
+        .zip(end.fingers.iter().zip(&first.fingers).zip(gaps))
+        .map(
+            |(((name, planned), error), ((touching, first), gap))| FingerClosing {
+                name: name.clone(),
+                planned_deg: *planned,
+                final_deg: [planned[0] - error[0], planned[1] - error[1]],
+                error_deg: *error,
+                touching: *touching,
+                gap_mm: *gap,
+                first_contact_s: *first,
+            },
+        )
+        .collect();
+    let phalanges_on_plan = fingers
+        .iter()
+        .flat_map(|f| (0..2).map(move |j| f.touching[j] && f.error_deg[j].abs() <= WITHIN_PLAN_DEG))
+        .filter(|on| *on)
+        .count();
+    let max_shift_mm = case.params.hold.max_closing_shift_mm;
+    ClosingOutcome {
+        shift_mm,
+        turn_deg,
+        duration_s,
+        max_shift_mm,
+        pushed: shift_mm > max_shift_mm,
+        first_touch: first.first(&names),
+        palm_touching: end.palm,
+        fingers,
+        phalanges_on_plan,
+    }
+}
+
+/// The hand's and the object's motion relative to the palm: (fastest joint `[rad/s]`, object
+/// speed `[mm/s]`, object angular speed `[rad/s]`).
+fn motion(scene: &Scene) -> (f64, f64, f64) {
+    let b = &scene.world.bodies;
+    let n = |v: Vector| f64::from(v.length());
+    let mut joint = 0.0f64;
+    for f in &scene.fingers {
+        let w1 = b[f.phalanx1].angvel();
+        let w2 = b[f.phalanx2].angvel();
+        joint = joint.max(n(w1)).max(n(w2 - w1));
+    }
+    let o = &b[scene.object];
+    (joint, n(o.linvel()) * 1000.0, n(o.angvel()))
+}
+
+/// The deepest penetration of a hand collider into the object now `[mm]` (0 when none).
+fn penetration_mm(scene: &Scene) -> f64 {
+    let mut depth = 0.0f64;
+    for pair in scene
+        .world
+        .narrow_phase
+        .contact_pairs_with(scene.object_collider)
+    {
+        if !(scene.hand_colliders.contains(&pair.collider1)
+            || scene.hand_colliders.contains(&pair.collider2))
+        {
+            continue;
+        }
+        if let rapier3d::geometry::PairContacts::Rigid(r) = &pair.contacts {
+            for m in &r.manifolds {
+                for p in &m.points {
+                    depth = depth.max(-f64::from(p.dist));
+                }
+            }
+        }
+    }
+    depth * 1000.0
+}
+
+/// Per finger, each joint's bend minus its planned bend `[deg]`.
+fn joint_errors(scene: &Scene) -> Vec<[f64; 2]> {
+    let bodies = &scene.world.bodies;
+    let rp = *bodies[scene.palm].rotation();
+    scene
+        .fingers
+        .iter()
+        .map(|f| {
+            let [t1, t2] = f.planned_bend_rad;
+            let r1 = *bodies[f.phalanx1].rotation();
+            let r2 = *bodies[f.phalanx2].rotation();
+            let bend = |parent: Rotation, child: Rotation| {
+                convert::unit_quaternion(parent.inverse() * child).angle()
+            };
+            [
+                (bend(rp, r1) - t1).to_degrees(),
+                (bend(r1, r2) - t2).to_degrees(),
+            ]
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_stall_rule_needs_every_speed_below_its_bound() {
+        // 0.02 rad/s for the joints, 0.5 mm/s and 0.01 rad/s for the object.
+        assert!(STALL.quiet((0.019, 0.49, 0.009)));
+        assert!(!STALL.quiet((0.02, 0.0, 0.0)));
+        assert!(!STALL.quiet((0.0, 0.5, 0.0)));
+        assert!(!STALL.quiet((0.0, 0.0, 0.01)));
+    }
+
+    #[test]
+    fn the_first_touch_is_the_earliest_the_palm_first_on_a_tie() {
+        let names = ["finger_1".to_string(), "thumb".to_string()];
+        let touch = |palm, fingers: Vec<[bool; 2]>| Touching { palm, fingers };
+        let mut first = FirstContacts::new(2);
+        assert_eq!(first.first(&names), None);
+        first.update(&touch(false, vec![[false, false], [false, true]]), 0.10);
+        // A later touch of the same phalanx keeps its first time.
+        first.update(&touch(false, vec![[true, false], [false, true]]), 0.15);
+        assert_eq!(first.fingers, vec![[Some(0.15), None], [None, Some(0.10)]]);
+        let t = first.first(&names).unwrap();
+        assert_eq!((t.body.as_str(), t.phalanx, t.at_s), ("thumb", 2, 0.10));
+        // The palm at the same time as a finger comes first.
+        let mut tie = FirstContacts::new(2);
+        tie.update(&touch(true, vec![[true, false], [false, false]]), 0.2);
+        let t = tie.first(&names).unwrap();
+        assert_eq!((t.body.as_str(), t.phalanx), ("palm", 0));
+    }
+}

@@ -1,0 +1,295 @@
+//! What the physics check reports: the verdict, the outcome per gravity direction and over all of
+//! them, and what the closing did to the planned grasp. Units as in the JSON: millimetres,
+//! degrees, seconds.
+
+use nalgebra::Vector3;
+
+/// The verdict of the hold test.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Verdict {
+    /// The object stayed within the thresholds, no hand collider ended the closing deeper
+    /// inside it than `max_penetration_mm`, and the closing pushed it no farther than
+    /// `max_closing_shift_mm`.
+    Hold,
+    /// It moved beyond them but still touches the hand, or it stayed but a finger ended the
+    /// closing deeper inside it than `max_penetration_mm` (not a grasp a real hand makes), or
+    /// the closing pushed it farther than `max_closing_shift_mm` (not the grasp planned).
+    Slip,
+    /// It left the hand.
+    Drop,
+}
+
+impl Verdict {
+    /// The name used in JSON and TOML.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Hold => "hold",
+            Verdict::Slip => "slip",
+            Verdict::Drop => "drop",
+        }
+    }
+}
+
+impl std::fmt::Display for Verdict {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
+/// The result for one gravity direction (reported as is in the JSON's `sim.directions`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct DirectionOutcome {
+    /// Gravity direction (unit, aligned frame).
+    pub gravity: [f64; 3],
+    /// The verdict.
+    pub verdict: Verdict,
+    /// Object translation relative to the palm during the hold `[mm]`.
+    pub translation_mm: f64,
+    /// Object rotation relative to the palm during the hold, as judged: the tilt of the
+    /// principal axis for a body of revolution, the full rotation otherwise `[deg]`.
+    pub rotation_deg: f64,
+    /// The full rotation relative to the palm `[deg]`.
+    pub full_rotation_deg: f64,
+    /// The tilt of the object's principal axis (aligned Z) relative to the palm `[deg]`.
+    pub tilt_deg: f64,
+    /// Object translation relative to the palm while the fingers closed `[mm]`.
+    pub closing_translation_mm: f64,
+    /// Object rotation relative to the palm while the fingers closed `[deg]` (the full
+    /// rotation).
+    pub closing_rotation_deg: f64,
+    /// True if and only if the closing pushed the object farther than `max_closing_shift_mm`:
+    /// then the verdict is not `hold` (issue 33), whatever the hold did.
+    pub closing_pushed: bool,
+    /// Deepest penetration of a finger or the palm into the object at the end of closing `[mm]`
+    /// (rapier's contact depth): a grasp that holds only because a finger passed into the object
+    /// shows here (issue 14).
+    pub closing_penetration_mm: f64,
+    /// How long the fingers closed before gravity came on `[s]`: `close_duration_s`, or less
+    /// under the `fast` protocol when the hand and the object stopped sooner.
+    pub closed_at_s: f64,
+    /// Largest difference between a joint's bend after closing and its planned bend `[deg]`
+    /// (negative: stopped short of the plan, i.e. contact earlier than planned).
+    pub joint_error_deg: f64,
+    /// Per finger, the two joints' bend after closing minus the planned bend `[deg]`.
+    pub joint_errors_deg: Vec<[f64; 2]>,
+    /// True if and only if the object touches the hand at the end (at the decision, for a
+    /// direction decided early).
+    pub in_contact: bool,
+    /// Time into the hold at which the verdict was decided `[s]`: `duration_s` when the
+    /// direction ran to the end.
+    pub decided_at_s: f64,
+    /// What decided it: `end` (ran the whole hold), `rest` (at rest relative to the palm, the
+    /// remaining motion cannot bring it across a threshold: within them, `hold`; slid beyond
+    /// one and resting on the hand, `slip`), `out_of_reach` (left the hand's reach for good) or
+    /// `clear_of_hand` (flies clear of the resting hand for good): both `drop`.
+    pub decided_by: DecidedBy,
+    /// Object translation relative to the palm at the decision `[mm]`. For `out_of_reach`,
+    /// `translation_mm` is this continued in free flight to the end of the hold.
+    pub translation_at_decision_mm: f64,
+}
+
+/// What decided a direction's verdict (`decided_by` in the JSON's `sim.directions`; docs/SIM.md,
+/// "Deciding early").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum DecidedBy {
+    /// The direction ran the whole hold.
+    End,
+    /// At rest relative to the palm: the remaining motion cannot bring the object across a
+    /// threshold (within them, `hold`; slid beyond one and resting on the hand, `slip`).
+    Rest,
+    /// The object left the hand's reach for good: `drop`.
+    OutOfReach,
+    /// The object flies clear of the resting hand for good: `drop`.
+    ClearOfHand,
+}
+
+impl DecidedBy {
+    /// The name used in JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            DecidedBy::End => "end",
+            DecidedBy::Rest => "rest",
+            DecidedBy::OutOfReach => "out_of_reach",
+            DecidedBy::ClearOfHand => "clear_of_hand",
+        }
+    }
+
+    /// Returns true if and only if the object was decided to have left the hand: a `drop`
+    /// whatever else the hold measured.
+    pub fn is_drop(self) -> bool {
+        matches!(self, DecidedBy::OutOfReach | DecidedBy::ClearOfHand)
+    }
+}
+
+impl std::fmt::Display for DecidedBy {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
+/// The physics check's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SimOutcome {
+    /// The worst verdict over the gravity directions.
+    pub verdict: Verdict,
+    /// The worst direction's translation `[mm]`.
+    pub translation_mm: f64,
+    /// The worst direction's rotation `[deg]`.
+    pub rotation_deg: f64,
+    /// Per gravity direction.
+    pub directions: Vec<DirectionOutcome>,
+    /// Simulated time, all directions `[s]`.
+    pub simulated_s: f64,
+    /// Steps taken, all directions.
+    pub steps: usize,
+    /// Wall time `[ms]`.
+    pub wall_ms: f64,
+    /// Where the first gravity direction's run left the bodies (aligned frame, metres): the
+    /// palm, phalanx 1 and 2 of each finger, then the object.
+    pub final_poses: Vec<(Vector3<f64>, nalgebra::UnitQuaternion<f64>)>,
+    /// The contacts that carried the grip at the end of closing (gravity still off; the first
+    /// direction's closing under the `full` protocol): [`super::contacts::grip_contacts`].
+    pub grip_contacts: Vec<super::contacts::GripContact>,
+    /// What the closing did (the first direction's closing under the `full` protocol).
+    pub closing: ClosingOutcome,
+    /// Where the closing left the bodies, gravity still off (aligned frame, metres): the
+    /// palm, phalanx 1 and 2 of each finger, then the object.
+    pub closed_poses: Vec<super::BodyPose>,
+}
+
+/// What the closing did to the planned grasp (issue 33, docs/SIM.md "What the closing does"):
+/// how far it pushed the object, where each joint stopped against its plan, and which phalanx
+/// touched the object first. Reported as `sim.closing`.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct ClosingOutcome {
+    /// Object translation relative to the palm from the start of the closing to its end `[mm]`.
+    pub shift_mm: f64,
+    /// Object rotation relative to the palm over the closing `[deg]` (the full rotation).
+    pub turn_deg: f64,
+    /// How long the closing took `[s]`.
+    pub duration_s: f64,
+    /// The bound on `shift_mm` (`[sim] max_closing_shift_mm`) `[mm]`.
+    pub max_shift_mm: f64,
+    /// True if and only if `shift_mm` exceeds `max_shift_mm`: the grasp that held (if it did)
+    /// is not the one planned, and the verdict is not `hold`.
+    pub pushed: bool,
+    /// The first hand body to touch the object, and when; `None` if nothing touched it.
+    pub first_touch: Option<FirstTouch>,
+    /// True if and only if the palm touches the object at the end of the closing.
+    pub palm_touching: bool,
+    /// Per finger, in the hand's order.
+    pub fingers: Vec<FingerClosing>,
+    /// Phalanges that end the closing touching the object within [`WITHIN_PLAN_DEG`] of their
+    /// planned bend.
+    pub phalanges_on_plan: usize,
+}
+
+/// A phalanx ends the closing "on its plan" when it touches the object and its joint is within
+/// this of the planned bend `[deg]` (the thesis's Joint Angular Deviation, 5°).
+pub const WITHIN_PLAN_DEG: f64 = 5.0;
+
+/// The first touch of the closing.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FirstTouch {
+    /// `palm`, or the finger's name.
+    pub body: String,
+    /// 1 or 2 for a finger's phalanx, 0 for the palm.
+    pub phalanx: usize,
+    /// Time into the closing `[s]`.
+    pub at_s: f64,
+}
+
+/// One finger's closing: planned and final joint angles, in the thesis's interior angles.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct FingerClosing {
+    /// The finger's name.
+    pub name: String,
+    /// Planned `[θ1, θ2]` `[deg]` (the Grasp Parameter Set).
+    pub planned_deg: [f64; 2],
+    /// `[θ1, θ2]` where the closing left the joints `[deg]`: the set a hand would be commanded
+    /// to reach this grasp.
+    pub final_deg: [f64; 2],
+    /// Bend after closing minus the planned bend `[deg]` (negative: stopped short of the plan,
+    /// more open than planned; `final_deg = planned_deg − error_deg`).
+    pub error_deg: [f64; 2],
+    /// True if and only if phalanx 1, phalanx 2 touches the object at the end of the closing
+    /// (a contact rapier's solver holds: within its prediction distance, 0.2 mm).
+    pub touching: [bool; 2],
+    /// The gap between phalanx 1, phalanx 2 and the object's collider at the end of the closing
+    /// `[mm]` (0 when touching or inside).
+    pub gap_mm: [f64; 2],
+    /// When phalanx 1, phalanx 2 first touched the object `[s]` (`None`: never).
+    pub first_contact_s: [Option<f64>; 2],
+}
+
+impl ClosingOutcome {
+    /// The finger joint furthest from its plan: (finger name, joint 1 or 2, error `[deg]`).
+    pub fn worst_joint(&self) -> Option<(&str, usize, f64)> {
+        let mut worst: Option<(&str, usize, f64)> = None;
+        for f in &self.fingers {
+            for (j, e) in f.error_deg.iter().enumerate() {
+                if worst.is_none_or(|w| e.abs() > w.2.abs()) {
+                    worst = Some((&f.name, j + 1, *e));
+                }
+            }
+        }
+        worst
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decided_by_serialises_as_its_name() {
+        for d in [
+            DecidedBy::End,
+            DecidedBy::Rest,
+            DecidedBy::OutOfReach,
+            DecidedBy::ClearOfHand,
+        ] {
+            let json = serde_json::to_string(&d).unwrap();
+            assert_eq!(json, format!("\"{}\"", d.as_str()));
+        }
+        assert_eq!(DecidedBy::OutOfReach.as_str(), "out_of_reach");
+        assert_eq!(DecidedBy::ClearOfHand.to_string(), "clear_of_hand");
+        assert!(DecidedBy::OutOfReach.is_drop() && DecidedBy::ClearOfHand.is_drop());
+        assert!(!DecidedBy::Rest.is_drop() && !DecidedBy::End.is_drop());
+    }
+
+    #[test]
+    fn the_worst_joint_is_the_largest_error_either_way() {
+        let finger = |name: &str, error_deg| FingerClosing {
+            name: name.to_string(),
+            planned_deg: [90.0, 90.0],
+            final_deg: [90.0, 90.0],
+            error_deg,
+            touching: [true, true],
+            gap_mm: [0.0, 0.0],
+            first_contact_s: [None, None],
+        };
+        let c = ClosingOutcome {
+            shift_mm: 0.0,
+            turn_deg: 0.0,
+            duration_s: 0.1,
+            max_shift_mm: 5.0,
+            pushed: false,
+            first_touch: None,
+            palm_touching: false,
+            fingers: vec![finger("finger_1", [1.0, -3.5]), finger("thumb", [3.0, 2.0])],
+            phalanges_on_plan: 4,
+        };
+        assert_eq!(c.worst_joint(), Some(("finger_1", 2, -3.5)));
+        assert_eq!(
+            ClosingOutcome {
+                fingers: vec![],
+                ..c
+            }
+            .worst_joint(),
+            None
+        );
+    }
+}
