@@ -238,8 +238,8 @@ fn outcome_word(r: &ItemResult) -> String {
             Some(_) => "error".to_string(),
             None => format!(
                 "{} {}",
-                rec.value["plan"]["status"].as_str().unwrap_or("?"),
-                rec.value["sim"]["verdict"].as_str().unwrap_or("?")
+                rec.view.plan.status.as_deref().unwrap_or("?"),
+                rec.view.sim.verdict.as_deref().unwrap_or("?")
             ),
         },
         Err(_) => "interrupted".to_string(),
@@ -287,7 +287,7 @@ impl Batch {
             if let Some(rec) = self.kept.get(key) {
                 text.push_str(&rec.line);
                 text.push('\n');
-                lines.push(&rec.value);
+                lines.push(rec);
             }
         }
         let current: HashSet<&Key> = keys.iter().collect();
@@ -306,7 +306,7 @@ impl Batch {
             (Some(path), None) => journal::write_atomically(path, text.as_bytes())?,
             _ => std::io::stdout().lock().write_all(text.as_bytes())?,
         }
-        Ok(Counts::of(lines))
+        Ok(Counts::of_records(lines))
     }
 }
 
@@ -365,7 +365,7 @@ fn merge(request: &Request, keys: &[Key]) -> anyhow::Result<u8> {
         Some(path) => journal::write_atomically(path, text.as_bytes())?,
         None => std::io::stdout().lock().write_all(text.as_bytes())?,
     }
-    let counts = Counts::of(merged.iter().map(|r| &r.value));
+    let counts = Counts::of_records(&merged);
     eprintln!(
         "merge: {} from {}, every input exactly once: {} planned, {} ungraspable; physics: {} hold, {} slip, {} drop; expectations: {} met, {} not met, {} not judged; {}",
         super::plural(merged.len(), "object"),

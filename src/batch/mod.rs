@@ -487,14 +487,6 @@ pub struct Counts {
 }
 
 impl Counts {
-    /// Counts the outcomes of `lines`, parsed untyped.
-    ///
-    /// Kept for the binary until it calls [`Counts::of_views`] (`Record::view`).
-    pub fn of<'a>(lines: impl IntoIterator<Item = &'a serde_json::Value>) -> Counts {
-        let views: Vec<RecordView> = lines.into_iter().map(RecordView::of).collect();
-        Counts::of_views(&views)
-    }
-
     /// Counts the outcomes of `lines`.
     pub fn of_views<'a>(lines: impl IntoIterator<Item = &'a RecordView>) -> Counts {
         let mut c = Counts::default();

@@ -57,9 +57,6 @@ pub struct Record {
     pub line: String,
     /// The same, read back: what the readers use.
     pub view: RecordView,
-    /// The same, parsed untyped: kept only for the binary's batch bookkeeping until it reads
-    /// [`Record::view`] (then this goes).
-    pub value: serde_json::Value,
 }
 
 #[derive(Serialize)]
@@ -117,7 +114,6 @@ impl Record {
             },
             line,
             view: RecordView::of(&value),
-            value,
         }
     }
 
@@ -139,7 +135,6 @@ impl Record {
             key,
             line: line.to_string(),
             view,
-            value,
         })
     }
 
