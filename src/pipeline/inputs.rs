@@ -4,8 +4,8 @@
 //! A bad input is reported and the others still run and print; the exit status is the worst
 //! (2 bad input, 1 an expectation not met, 0).
 
+use super::input::{self, Item};
 use super::{run, RunOptions};
-use crate::batch::{self, Item};
 use crate::mesh::LengthUnit;
 use crate::scenario::{GravityMode, Scenario};
 use std::collections::HashMap;
@@ -61,7 +61,7 @@ pub fn run_inputs(
             "grasp-sim: warning: --payload is ignored with --no-sim (the payload search is part of the physics check)"
         );
     }
-    let mut template = batch::default_template();
+    let mut template = input::default_template();
     template.object.units = cl.units;
     let mut status = 0u8;
     let mut names = Names::default();
@@ -77,7 +77,7 @@ pub fn run_inputs(
                 cl.units.name()
             );
         }
-        let ran = batch::scenario_for(&item, &template).map(|mut s| {
+        let ran = input::scenario_for(&item, &template).map(|mut s| {
             if let Some(g) = cl.gravity {
                 s.sim.gravity = g;
             }

@@ -7,6 +7,7 @@
 //! computed. [`run`] is the two in turn.
 
 mod build;
+pub mod input;
 pub mod inputs;
 
 use crate::prepared::PreparedObject;
