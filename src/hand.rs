@@ -12,6 +12,7 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 mod geometry;
+pub mod kinematics;
 pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
 
 /// The largest length a hand file may give `[mm]`: a hand is hand-sized (issue 32).
@@ -355,7 +356,7 @@ impl Hand {
         }
         // The planner's graspable diameter range must exist: a finger whose phalanx 2 cannot
         // reach back to any object resting on the palm wraps nothing (issue 16, item 1).
-        let range = crate::plan::kinematics::graspable_range(self);
+        let range = kinematics::graspable_range(self);
         if range.max_kinematic_mm.partial_cmp(&range.min_mm) != Some(std::cmp::Ordering::Greater) {
             let what = if range.max_kinematic_mm == 0.0 {
                 "no object resting on the palm (up to 2 m across) is touched by both phalanges \

@@ -15,6 +15,8 @@
 mod align;
 mod load;
 mod mass;
+pub mod primitives;
+pub mod slice;
 pub mod urdf;
 
 pub use align::{

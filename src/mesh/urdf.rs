@@ -378,7 +378,7 @@ pub fn referenced_files(path: &Path) -> Vec<PathBuf> {
 
 /// Triangles of a primitive in metres, centred on its frame.
 fn primitive(shape: &Shape) -> Vec<[[f64; 3]; 3]> {
-    use crate::objects;
+    use super::primitives as objects;
     let mm = |m: f64| m * 1000.0;
     let mut mesh = match *shape {
         Shape::Box(s) => {

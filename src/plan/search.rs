@@ -369,7 +369,7 @@ fn palm_backoff_in_finger_planes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::StageTimings;
+    use crate::plan::StageTimings;
 
     #[test]
     fn every_schedule_gives_the_one_at_a_time_search() {
