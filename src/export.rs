@@ -23,13 +23,17 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// Problems writing an export.
+///
+/// Its message names the file; the reason is its `source()`, the I/O error, which `{:#}` (as the
+/// binary prints errors) appends: `{path}: cannot write: {reason}`.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: cannot write: {message}")]
+#[error("{path}: cannot write")]
 pub struct ExportError {
     /// The file or folder.
     pub path: PathBuf,
-    /// Why.
-    pub message: String,
+    /// What the operating system said.
+    #[source]
+    pub source: std::io::Error,
 }
 
 /// Everything an export needs about the grasp.
@@ -120,7 +124,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
 fn io_error(path: &Path, e: std::io::Error) -> ExportError {
     ExportError {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        source: e,
     }
 }
 

@@ -40,12 +40,13 @@ pub(crate) fn thesis_for_tests() -> Hand {
 #[derive(Debug, thiserror::Error)]
 pub enum HandError {
     /// The file could not be read.
-    #[error("{path}: cannot read hand file: {message}")]
+    #[error("{path}: cannot read hand file: {}", crate::messages::io_message(.error))]
     Io {
         /// The file.
         path: PathBuf,
-        /// Why.
-        message: String,
+        /// What the operating system said: not the error's `source()`, since the message
+        /// already says it in a few stable words, and `{:#}` would print it twice.
+        error: std::io::Error,
     },
     /// The TOML does not parse or does not fit the schema.
     #[error("{path}: {message}")]
@@ -200,7 +201,7 @@ impl Hand {
     pub fn load(path: &Path, overrides: &[(String, f64)]) -> Result<Hand, HandError> {
         let text = std::fs::read_to_string(path).map_err(|e| HandError::Io {
             path: path.to_path_buf(),
-            message: crate::messages::io_message(&e),
+            error: e,
         })?;
         Hand::parse(&text, path, overrides)
     }

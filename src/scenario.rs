@@ -20,13 +20,23 @@ use std::path::{Path, PathBuf};
 /// Problems with a scenario file.
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
-    /// The file could not be read.
+    /// The input is not a scenario file that can be read (a folder, a missing path, a file
+    /// of another kind).
     #[error("{path}: cannot read scenario: {message}")]
     Io {
         /// The file.
         path: PathBuf,
         /// Why.
         message: String,
+    },
+    /// Reading the scenario file failed.
+    #[error("{path}: cannot read scenario: {}", crate::messages::io_message(.error))]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said: not the error's `source()`, since the message
+        /// already says it in a few stable words, and `{:#}` would print it twice.
+        error: std::io::Error,
     },
     /// Bad TOML, an unknown key or a wrong type.
     #[error("{path}: {message}")]
@@ -257,9 +267,9 @@ impl Scenario {
                 message: "is a folder, not a scenario file (`grasp-sim batch FOLDER` runs every scenario, URDF or mesh in a folder)".to_string(),
             });
         }
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read {
             path: path.to_path_buf(),
-            message: crate::messages::io_message(&e),
+            error: e,
         })?;
         Scenario::parse(&text, path)
     }

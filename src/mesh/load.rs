@@ -182,7 +182,7 @@ fn file_format(path: &Path) -> Result<MeshFormat, MeshError> {
 fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
     std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
-        message: crate::messages::io_message(&e),
+        error: e,
     })
 }
 
@@ -687,7 +687,7 @@ pub fn load_stl(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> 
     }
     let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
-        message: crate::messages::io_message(&e),
+        error: e,
     })?;
     parse_stl(&bytes, path, unit)
 }

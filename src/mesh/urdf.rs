@@ -209,7 +209,7 @@ struct Read {
 fn read(path: &Path) -> Result<Read, MeshError> {
     let text = std::fs::read_to_string(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
-        message: crate::messages::io_message(&e),
+        error: e,
     })?;
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| urdf_err(path, format!("not well-formed XML: {e}")))?;

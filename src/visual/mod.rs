@@ -41,7 +41,7 @@ pub fn write_report(
     let simulated = simulated.map(|s| s.end);
     let err = |path: &Path, e: std::io::Error| crate::export::ExportError {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        source: e,
     };
     std::fs::create_dir_all(dir).map_err(|e| err(dir, e))?;
     let mut figs: Vec<(String, String)> = vec![
