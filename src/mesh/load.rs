@@ -420,13 +420,11 @@ fn obj_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     Ok((raw, false))
 }
 
+/// Reads a PLY file (ASCII or binary) as triangles, its polygons fanned; whether it is binary.
 fn ply_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     use ply_rs_bw::parser::Parser;
-    use ply_rs_bw::ply::{DefaultElement, Encoding, Property};
-    let err = |detail: String| MeshError::Ply {
-        path: path.to_path_buf(),
-        detail: detail.split_whitespace().collect::<Vec<_>>().join(" "),
-    };
+    use ply_rs_bw::ply::{DefaultElement, Encoding};
+    let err = |detail: String| ply_err(path, detail);
     let parser = Parser::<DefaultElement>::new();
     let mut reader = std::io::BufReader::new(std::io::Cursor::new(bytes));
     let header = parser
@@ -442,61 +440,100 @@ fn ply_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
             )));
         }
     }
-    let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
-        // ply-rs-bw's messages carry the offending line and a nested parser dump; keep the line.
-        let m = e
-            .to_string()
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join(" ");
-        let eof = e.kind() == std::io::ErrorKind::UnexpectedEof || m.contains("UnexpectedEof");
-        if eof {
-            return err(format!(
-                "unexpected end of file (truncated?): {}",
-                m.split(" Error: ").next().unwrap_or(&m)
-            ));
-        }
-        match m
-            .split_once("String: '")
-            .and_then(|(_, r)| r.split_once('\''))
-        {
-            Some((line, _)) => err(format!(
-                "cannot read the element line `{}`: not numbers of the types the header declares",
-                line.trim()
-            )),
-            None => err(m.split(" Error: ").next().unwrap_or(&m).to_string()),
-        }
-    })?;
+    let payload = parser
+        .read_payload(&mut reader, &header)
+        .map_err(|e| ply_payload_err(path, &e))?;
     let is_binary = header.encoding != Encoding::Ascii;
-    let scalar = |p: Option<&Property>| -> Option<f64> {
-        Some(match p? {
-            Property::Float(v) => f64::from(*v),
-            Property::Double(v) => *v,
-            Property::Char(v) => f64::from(*v),
-            Property::UChar(v) => f64::from(*v),
-            Property::Short(v) => f64::from(*v),
-            Property::UShort(v) => f64::from(*v),
-            Property::Int(v) => f64::from(*v),
-            Property::UInt(v) => f64::from(*v),
-            _ => return None,
-        })
-    };
     let vertices = payload
         .get("vertex")
         .ok_or_else(|| err("no `vertex` element".to_string()))?;
+    let points = ply_points(vertices, path)?;
+    let faces = payload
+        .get("face")
+        .ok_or_else(|| err("no `face` element: a point cloud is not a surface".to_string()))?;
+    let raw = ply_triangles(faces, &points, path)?;
+    Ok((raw, is_binary))
+}
+
+/// [`MeshError::Ply`] for `path` with `detail` on one line.
+fn ply_err(path: &Path, detail: String) -> MeshError {
+    MeshError::Ply {
+        path: path.to_path_buf(),
+        detail: detail.split_whitespace().collect::<Vec<_>>().join(" "),
+    }
+}
+
+/// The error for a PLY payload that does not read: a truncated file, or the element line that
+/// does not fit the header's types.
+fn ply_payload_err(path: &Path, e: &std::io::Error) -> MeshError {
+    let err = |detail: String| ply_err(path, detail);
+    // ply-rs-bw's messages carry the offending line and a nested parser dump; keep the line.
+    let m = e
+        .to_string()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let eof = e.kind() == std::io::ErrorKind::UnexpectedEof || m.contains("UnexpectedEof");
+    if eof {
+        return err(format!(
+            "unexpected end of file (truncated?): {}",
+            m.split(" Error: ").next().unwrap_or(&m)
+        ));
+    }
+    match m
+        .split_once("String: '")
+        .and_then(|(_, r)| r.split_once('\''))
+    {
+        Some((line, _)) => err(format!(
+            "cannot read the element line `{}`: not numbers of the types the header declares",
+            line.trim()
+        )),
+        None => err(m.split(" Error: ").next().unwrap_or(&m).to_string()),
+    }
+}
+
+/// A PLY scalar property as a number (`None` for a list or a missing property).
+fn ply_scalar(p: Option<&ply_rs_bw::ply::Property>) -> Option<f64> {
+    use ply_rs_bw::ply::Property;
+    Some(match p? {
+        Property::Float(v) => f64::from(*v),
+        Property::Double(v) => *v,
+        Property::Char(v) => f64::from(*v),
+        Property::UChar(v) => f64::from(*v),
+        Property::Short(v) => f64::from(*v),
+        Property::UShort(v) => f64::from(*v),
+        Property::Int(v) => f64::from(*v),
+        Property::UInt(v) => f64::from(*v),
+        _ => return None,
+    })
+}
+
+/// The PLY `vertex` elements' `x, y, z`.
+fn ply_points(
+    vertices: &[ply_rs_bw::ply::DefaultElement],
+    path: &Path,
+) -> Result<Vec<[f32; 3]>, MeshError> {
     let mut points = Vec::with_capacity(vertices.len());
     for (i, v) in vertices.iter().enumerate() {
         let mut p = [0f32; 3];
         for (k, key) in ["x", "y", "z"].iter().enumerate() {
-            let c = scalar(v.get(*key))
-                .ok_or_else(|| err(format!("vertex {i} has no numeric `{key}`")))?;
+            let c = ply_scalar(v.get(*key))
+                .ok_or_else(|| ply_err(path, format!("vertex {i} has no numeric `{key}`")))?;
             p[k] = c as f32;
         }
         points.push(p);
     }
-    let faces = payload
-        .get("face")
-        .ok_or_else(|| err("no `face` element: a point cloud is not a surface".to_string()))?;
+    Ok(points)
+}
+
+/// The PLY `face` elements as triangles of `points`, each polygon fanned.
+fn ply_triangles(
+    faces: &[ply_rs_bw::ply::DefaultElement],
+    points: &[[f32; 3]],
+    path: &Path,
+) -> Result<Vec<[[f32; 3]; 3]>, MeshError> {
+    use ply_rs_bw::ply::Property;
+    let err = |detail: String| ply_err(path, detail);
     let mut raw = Vec::new();
     for (f, face) in faces.iter().enumerate() {
         let list = face
@@ -543,7 +580,7 @@ fn ply_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
             ]);
         }
     }
-    Ok((raw, is_binary))
+    Ok(raw)
 }
 
 impl LoadedMesh {
