@@ -756,63 +756,9 @@ fn stl_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
 
     let is_binary = binary_size == Some(len) || (!starts_solid && declared.is_some());
     let triangles = if is_binary {
-        let declared = declared.unwrap_or(0);
-        let expected = binary_size.unwrap_or(84);
-        if len < expected {
-            return Err(MeshError::Truncated {
-                path: p(),
-                declared,
-                expected,
-                actual: len,
-            });
-        }
-        if len > expected {
-            return Err(MeshError::TrailingBytes {
-                path: p(),
-                declared,
-                extra: len - expected,
-            });
-        }
-        // The header is free text; blank it so stl_io's ASCII probe cannot misread a binary file
-        // whose header begins with "solid ".
-        let mut patched = bytes.to_vec();
-        patched[..80].fill(0);
-        read_triangles(&patched, path, true)?
+        stl_binary(bytes, path, declared.unwrap_or(0), binary_size.unwrap_or(84))?
     } else if starts_solid {
-        let text = std::str::from_utf8(bytes).map_err(|e| MeshError::NotStl {
-            path: p(),
-            detail: format!(
-                "starts with \"solid\" but is not UTF-8 text (byte {}), and its size {} is not \
-                 that of a binary STL",
-                e.valid_up_to(),
-                len
-            ),
-        })?;
-        let original_text = text;
-        // stl_io wants "solid <name>"; a bare "solid" first line is valid STL too.
-        let trimmed = text.trim_start();
-        let first_line = trimmed.lines().next().unwrap_or("");
-        let text = if first_line.trim() == "solid" {
-            format!("solid unnamed{}", &trimmed[first_line.len()..])
-        } else {
-            trimmed.to_string()
-        };
-        read_triangles(text.as_bytes(), path, false).map_err(|e| match e {
-            // stl_io names no line: find the first line that breaks the grammar and name it.
-            MeshError::Ascii { path, detail } => MeshError::Ascii {
-                detail: match first_bad_ascii_line(original_text) {
-                    // stl_io's own words add nothing to a non-finite number but its Rust
-                    // names ("expected finite f32, got NaN which is Nan").
-                    Some((n, line, want)) if detail.contains("expected finite f32") => {
-                        format!("line {n} ({line}): {want}, with finite numbers")
-                    }
-                    Some((n, line, want)) => format!("line {n} ({line}): {want} ({detail})"),
-                    None => detail,
-                },
-                path,
-            },
-            e => e,
-        })?
+        stl_ascii(bytes, path)?
     } else {
         return Err(MeshError::NotStl {
             path: p(),
@@ -821,6 +767,77 @@ fn stl_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     };
 
     Ok((triangles, is_binary))
+}
+
+/// The triangles of a binary STL whose header declares `declared` triangles, `expected` bytes.
+fn stl_binary(
+    bytes: &[u8],
+    path: &Path,
+    declared: u32,
+    expected: u64,
+) -> Result<Vec<[[f32; 3]; 3]>, MeshError> {
+    let p = || path.to_path_buf();
+    let len = bytes.len() as u64;
+    if len < expected {
+        return Err(MeshError::Truncated {
+            path: p(),
+            declared,
+            expected,
+            actual: len,
+        });
+    }
+    if len > expected {
+        return Err(MeshError::TrailingBytes {
+            path: p(),
+            declared,
+            extra: len - expected,
+        });
+    }
+    // The header is free text; blank it so stl_io's ASCII probe cannot misread a binary file
+    // whose header begins with "solid ".
+    let mut patched = bytes.to_vec();
+    patched[..80].fill(0);
+    read_triangles(&patched, path, true)
+}
+
+/// The triangles of an ASCII STL; a grammar error names the first line that breaks it.
+fn stl_ascii(bytes: &[u8], path: &Path) -> Result<Vec<[[f32; 3]; 3]>, MeshError> {
+    let p = || path.to_path_buf();
+    let len = bytes.len() as u64;
+    let text = std::str::from_utf8(bytes).map_err(|e| MeshError::NotStl {
+        path: p(),
+        detail: format!(
+            "starts with \"solid\" but is not UTF-8 text (byte {}), and its size {} is not \
+             that of a binary STL",
+            e.valid_up_to(),
+            len
+        ),
+    })?;
+    let original_text = text;
+    // stl_io wants "solid <name>"; a bare "solid" first line is valid STL too.
+    let trimmed = text.trim_start();
+    let first_line = trimmed.lines().next().unwrap_or("");
+    let text = if first_line.trim() == "solid" {
+        format!("solid unnamed{}", &trimmed[first_line.len()..])
+    } else {
+        trimmed.to_string()
+    };
+    read_triangles(text.as_bytes(), path, false).map_err(|e| match e {
+        // stl_io names no line: find the first line that breaks the grammar and name it.
+        MeshError::Ascii { path, detail } => MeshError::Ascii {
+            detail: match first_bad_ascii_line(original_text) {
+                // stl_io's own words add nothing to a non-finite number but its Rust
+                // names ("expected finite f32, got NaN which is Nan").
+                Some((n, line, want)) if detail.contains("expected finite f32") => {
+                    format!("line {n} ({line}): {want}, with finite numbers")
+                }
+                Some((n, line, want)) => format!("line {n} ({line}): {want} ({detail})"),
+                None => detail,
+            },
+            path,
+        },
+        e => e,
+    })
 }
 
 /// The first line of an ASCII STL that breaks its grammar (`solid`, then per facet `facet
