@@ -756,7 +756,12 @@ fn stl_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
 
     let is_binary = binary_size == Some(len) || (!starts_solid && declared.is_some());
     let triangles = if is_binary {
-        stl_binary(bytes, path, declared.unwrap_or(0), binary_size.unwrap_or(84))?
+        stl_binary(
+            bytes,
+            path,
+            declared.unwrap_or(0),
+            binary_size.unwrap_or(84),
+        )?
     } else if starts_solid {
         stl_ascii(bytes, path)?
     } else {
@@ -929,18 +934,14 @@ fn read_triangles(
     Ok(out)
 }
 
-pub(super) fn build(
-    raw: Vec<[[f32; 3]; 3]>,
+/// The file's triangles in millimetres (`scale` per file unit), each coordinate checked to be
+/// finite and within [`COORDINATE_LIMIT_MM`].
+fn scaled_soup(
+    raw: &[[[f32; 3]; 3]],
     path: &Path,
-    unit: LengthUnit,
-    is_binary: bool,
-    format: MeshFormat,
-) -> Result<LoadedMesh, MeshError> {
+    scale: f64,
+) -> Result<Vec<[Point3<f64>; 3]>, MeshError> {
     let p = || path.to_path_buf();
-    if raw.is_empty() {
-        return Err(MeshError::NoTriangles { path: p() });
-    }
-    let scale = unit.to_mm();
     let mut soup = Vec::with_capacity(raw.len());
     for (i, tri) in raw.iter().enumerate() {
         let mut corners = [Point3::origin(); 3];
@@ -968,6 +969,32 @@ pub(super) fn build(
         }
         soup.push(corners);
     }
+    Ok(soup)
+}
+
+/// Drops the triangles without area relative to the mesh's squared diagonal `diag2`; how many.
+fn drop_collinear(mesh: &mut Mesh, diag2: f64) -> usize {
+    let before = mesh.triangles.len();
+    let keep: Vec<bool> = (0..before)
+        .map(|t| mesh.area_normal(t).norm() > 1e-14 * diag2)
+        .collect();
+    let mut it = keep.iter();
+    mesh.triangles.retain(|_| *it.next().unwrap_or(&false));
+    before - mesh.triangles.len()
+}
+
+pub(super) fn build(
+    raw: Vec<[[f32; 3]; 3]>,
+    path: &Path,
+    unit: LengthUnit,
+    is_binary: bool,
+    format: MeshFormat,
+) -> Result<LoadedMesh, MeshError> {
+    let p = || path.to_path_buf();
+    if raw.is_empty() {
+        return Err(MeshError::NoTriangles { path: p() });
+    }
+    let soup = scaled_soup(&raw, path, unit.to_mm())?;
     let (mut mesh, mut degenerate) = Mesh::from_triangles_welded(&soup);
     if mesh.triangles.is_empty() {
         return Err(MeshError::AllDegenerate {
@@ -979,13 +1006,7 @@ pub(super) fn build(
     // mesh size so that the rule does not depend on the unit.
     let (lo, hi) = mesh.bounds();
     let diag2 = (hi - lo).norm_squared();
-    let before = mesh.triangles.len();
-    let keep: Vec<bool> = (0..before)
-        .map(|t| mesh.area_normal(t).norm() > 1e-14 * diag2)
-        .collect();
-    let mut it = keep.iter();
-    mesh.triangles.retain(|_| *it.next().unwrap_or(&false));
-    degenerate += before - mesh.triangles.len();
+    degenerate += drop_collinear(&mut mesh, diag2);
     if mesh.triangles.is_empty() {
         return Err(MeshError::AllDegenerate {
             path: p(),
