@@ -413,6 +413,53 @@ fn cut_within(
     let n = plane.normal();
     let above = |i: u32| dist(i) >= 0.0;
 
+    let segments = crossing_segments(mesh, tris, above);
+
+    let point = |e: Edge| -> Point3<f64> {
+        let (i, j) = e;
+        let (di, dj) = (dist(i), dist(j));
+        let (pi, pj) = (mesh.vertices[i as usize], mesh.vertices[j as usize]);
+        if di == 0.0 {
+            pi
+        } else if dj == 0.0 {
+            pj
+        } else {
+            let t = di / (di - dj);
+            pi + (pj - pi) * t
+        }
+    };
+
+    // Open chains first (from segments nothing leads into), then the closed loops that remain.
+    let mut contours: Vec<Contour> = chains(&segments)
+        .into_iter()
+        .map(|(chain, is_closed)| {
+            build_contour(&chain, &segments, &point, mesh, plane, &n, is_closed)
+        })
+        .collect();
+    contours.retain(|c| c.points.len() >= 2 && !c.normals.is_empty());
+    if tol_mm > 0.0 && (contours.iter().any(|c| !c.is_closed) || has_overlapping_outers(&contours))
+    {
+        contours = contours.iter().map(|c| c.simplified(tol_mm)).collect();
+    }
+    // A closed single-shell mesh never takes this path, so its slices are exactly the cut.
+    let mut repaired = false;
+    if contours.iter().any(|c| !c.is_closed) {
+        let tol = join_tolerance(&contours);
+        repaired = join_open(&mut contours, tol);
+    }
+    if repaired || has_overlapping_outers(&contours) {
+        contours = union_closed(contours);
+    }
+    finish(*plane, contours)
+}
+
+/// The segments the plane cuts from the triangles `tris`, each oriented by its triangle's
+/// winding (`above` says which side of the plane a vertex is on, a vertex on it counting above).
+fn crossing_segments(
+    mesh: &Mesh,
+    tris: impl Iterator<Item = usize>,
+    above: impl Fn(u32) -> bool,
+) -> Vec<Segment> {
     let mut segments: Vec<Segment> = Vec::new();
     for t in tris {
         let tri = &mesh.triangles[t];
@@ -444,21 +491,12 @@ fn cut_within(
             triangle: t,
         });
     }
+    segments
+}
 
-    let point = |e: Edge| -> Point3<f64> {
-        let (i, j) = e;
-        let (di, dj) = (dist(i), dist(j));
-        let (pi, pj) = (mesh.vertices[i as usize], mesh.vertices[j as usize]);
-        if di == 0.0 {
-            pi
-        } else if dj == 0.0 {
-            pj
-        } else {
-            let t = di / (di - dj);
-            pi + (pj - pi) * t
-        }
-    };
-
+/// The segments chained end to start: open chains first (from segments nothing leads into),
+/// then the closed loops that remain; each as its segment indices and whether it closes.
+fn chains(segments: &[Segment]) -> Vec<(Vec<usize>, bool)> {
     let mut by_from: HashMap<Edge, usize, EdgeBuild> =
         HashMap::with_capacity_and_hasher(segments.len(), EdgeBuild::default());
     let mut ends: HashSet<Edge, EdgeBuild> =
@@ -468,9 +506,8 @@ fn cut_within(
         ends.insert(s.to);
     }
 
-    // Open chains first (from segments nothing leads into), then the closed loops that remain.
     let mut used = vec![false; segments.len()];
-    let mut contours = Vec::new();
+    let mut out = Vec::new();
     let has_predecessor = |i: usize| ends.contains(&segments[i].from);
     let starts = (0..segments.len())
         .filter(|&i| !has_predecessor(i))
@@ -494,25 +531,9 @@ fn cut_within(
                 _ => break,
             }
         }
-        contours.push(build_contour(
-            &chain, &segments, &point, mesh, plane, &n, is_closed,
-        ));
+        out.push((chain, is_closed));
     }
-    contours.retain(|c| c.points.len() >= 2 && !c.normals.is_empty());
-    if tol_mm > 0.0 && (contours.iter().any(|c| !c.is_closed) || has_overlapping_outers(&contours))
-    {
-        contours = contours.iter().map(|c| c.simplified(tol_mm)).collect();
-    }
-    // A closed single-shell mesh never takes this path, so its slices are exactly the cut.
-    let mut repaired = false;
-    if contours.iter().any(|c| !c.is_closed) {
-        let tol = join_tolerance(&contours);
-        repaired = join_open(&mut contours, tol);
-    }
-    if repaired || has_overlapping_outers(&contours) {
-        contours = union_closed(contours);
-    }
-    finish(*plane, contours)
+    out
 }
 
 /// Sorts contours (decreasing absolute area, ties by first point) and finds the outermost.
