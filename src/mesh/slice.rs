@@ -688,32 +688,9 @@ pub fn join_open(contours: &mut Vec<Contour>, tol: f64) -> bool {
     if open.is_empty() || tol.is_nan() || tol <= 0.0 {
         return false;
     }
-    let first = |i: usize| contours[i].points[0];
-    let last = |i: usize| *contours[i].points.last().expect("a contour has points");
-    // Candidate links (end of a → start of b), nearest first; ties broken by index so the
-    // result is deterministic.
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-    for &a in &open {
-        for &b in &open {
-            let d = (first(b) - last(a)).norm();
-            if d <= tol {
-                pairs.push((d, a, b));
-            }
-        }
-    }
-    if pairs.is_empty() {
+    let Some((next, has_prev)) = links(contours, &open, tol) else {
         return false;
-    }
-    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
-    let mut next: HashMap<usize, usize> = HashMap::new();
-    let mut has_prev: HashSet<usize> = HashSet::new();
-    for &(_, a, b) in &pairs {
-        if next.contains_key(&a) || has_prev.contains(&b) {
-            continue;
-        }
-        next.insert(a, b);
-        has_prev.insert(b);
-    }
+    };
     // Follow the links: paths from chains with no predecessor, then the cycles left.
     let mut done: HashSet<usize> = HashSet::new();
     let mut joined: Vec<Contour> = Vec::new();
@@ -762,6 +739,43 @@ pub fn join_open(contours: &mut Vec<Contour>, tol: f64) -> bool {
     contours.retain(|c| c.is_closed);
     contours.extend(joined);
     true
+}
+
+/// The links that join the `open` contours end to start within `tol`, nearest first (each end
+/// and each start used once): each contour's successor, and the contours with a predecessor.
+/// `None` when no ends are that close.
+fn links(
+    contours: &[Contour],
+    open: &[usize],
+    tol: f64,
+) -> Option<(HashMap<usize, usize>, HashSet<usize>)> {
+    let first = |i: usize| contours[i].points[0];
+    let last = |i: usize| *contours[i].points.last().expect("a contour has points");
+    // Candidate links (end of a → start of b), nearest first; ties broken by index so the
+    // result is deterministic.
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for &a in open {
+        for &b in open {
+            let d = (first(b) - last(a)).norm();
+            if d <= tol {
+                pairs.push((d, a, b));
+            }
+        }
+    }
+    if pairs.is_empty() {
+        return None;
+    }
+    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut next: HashMap<usize, usize> = HashMap::new();
+    let mut has_prev: HashSet<usize> = HashSet::new();
+    for &(_, a, b) in &pairs {
+        if next.contains_key(&a) || has_prev.contains(&b) {
+            continue;
+        }
+        next.insert(a, b);
+        has_prev.insert(b);
+    }
+    Some((next, has_prev))
 }
 
 /// Returns true if and only if two closed outer (counter-clockwise) contours have overlapping
