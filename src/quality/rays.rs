@@ -135,24 +135,7 @@ impl RayCaster {
         if tab[obj + cols] < -1e-9 * scale {
             return Err(QualityError::CentreOutside);
         }
-        // Artificials still basic (at 0, up to round-off) leave the basis on their row's
-        // largest entry.
-        for r in 0..DIM {
-            if basis[r] >= col_art {
-                let row = &tab[r * width..r * width + col_art];
-                let (j, a) = row.iter().enumerate().fold((0, 0.0f64), |b, (j, v)| {
-                    if v.abs() > b.1 {
-                        (j, v.abs())
-                    } else {
-                        b
-                    }
-                });
-                if a > 1e-9 * scale {
-                    tab[r * width + cols] = 0.0;
-                    pivot(&mut tab, &mut basis, width, rows, r, j);
-                }
-            }
-        }
+        drive_out_artificials(&mut tab, &mut basis, width, rows, col_art, scale);
         if basis[..DIM].iter().any(|&b| b >= col_art) {
             // A wrench row that no edge reaches: W is not full-dimensional.
             return Err(QualityError::FewerDimensions);
@@ -198,6 +181,36 @@ impl RayCaster {
             Ok(t)
         } else {
             Err(QualityError::RayEnd { t })
+        }
+    }
+}
+
+/// Moves the artificials still basic after the first phase (at 0, up to round-off) out of the
+/// basis, each on its row's largest entry; one whose row has none stays (its wrench row is
+/// reached by no edge). Columns `col_art..` are the artificials, the last the right-hand side.
+fn drive_out_artificials(
+    tab: &mut [f64],
+    basis: &mut [usize],
+    width: usize,
+    rows: usize,
+    col_art: usize,
+    scale: f64,
+) {
+    let cols = col_art + DIM;
+    for r in 0..DIM {
+        if basis[r] >= col_art {
+            let row = &tab[r * width..r * width + col_art];
+            let (j, a) = row.iter().enumerate().fold((0, 0.0f64), |b, (j, v)| {
+                if v.abs() > b.1 {
+                    (j, v.abs())
+                } else {
+                    b
+                }
+            });
+            if a > 1e-9 * scale {
+                tab[r * width + cols] = 0.0;
+                pivot(tab, basis, width, rows, r, j);
+            }
         }
     }
 }
