@@ -23,13 +23,17 @@ use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
 /// Problems writing an export.
+///
+/// Its message names the file; the reason is its `source()`, the I/O error, which `{:#}` (as the
+/// binary prints errors) appends: `{path}: cannot write: {reason}`.
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: cannot write: {message}")]
+#[error("{path}: cannot write")]
 pub struct ExportError {
     /// The file or folder.
     pub path: PathBuf,
-    /// Why.
-    pub message: String,
+    /// What the operating system said.
+    #[source]
+    pub source: std::io::Error,
 }
 
 /// Everything an export needs about the grasp.
@@ -120,7 +124,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
 fn io_error(path: &Path, e: std::io::Error) -> ExportError {
     ExportError {
         path: path.to_path_buf(),
-        message: e.to_string(),
+        source: e,
     }
 }
 
@@ -405,6 +409,57 @@ fn protocol(input: &ExportInput, keys: &Keyframes) -> serde_json::Value {
     })
 }
 
+/// Writes a URDF link of one box `size` at `at` in its frame `[m]`, of density `rho`
+/// `[kg/m³]`: its inertial (a solid box's), visual and collision.
+fn urdf_box_link(s: &mut String, name: &str, size: Vector3<f64>, at: Vector3<f64>, rho: f64) {
+    let mass = rho * size.x * size.y * size.z;
+    let (ixx, iyy, izz) = (
+        mass * (size.y * size.y + size.z * size.z) / 12.0,
+        mass * (size.x * size.x + size.z * size.z) / 12.0,
+        mass * (size.x * size.x + size.y * size.y) / 12.0,
+    );
+    let geometry = format!(
+        "<origin xyz=\"{}\"/><geometry><box size=\"{}\"/></geometry>",
+        v3(&at),
+        v3(&size)
+    );
+    let _ = writeln!(s, "  <link name=\"{name}\">");
+    let _ = writeln!(
+        s,
+        "    <inertial><origin xyz=\"{}\"/><mass value=\"{mass:.9}\"/><inertia ixx=\"{ixx:.6e}\" ixy=\"0\" ixz=\"0\" iyy=\"{iyy:.6e}\" iyz=\"0\" izz=\"{izz:.6e}\"/></inertial>",
+        v3(&at)
+    );
+    let _ = writeln!(s, "    <visual>{geometry}</visual>");
+    let _ = writeln!(s, "    <collision>{geometry}</collision>");
+    let _ = writeln!(s, "  </link>");
+}
+
+/// Writes a revolute URDF joint `name` from `links.0` to `links.1` at `origin` `[m]`, about
+/// `(0, 0, side)`, within the bends `range` `[rad]`, with the motors' torque limit `[N·m]`.
+fn urdf_joint(
+    s: &mut String,
+    name: &str,
+    (parent, child): (&str, &str),
+    origin: Vector3<f64>,
+    sd: f64,
+    range: (f64, f64),
+    torque_limit_nm: f64,
+) {
+    let _ = writeln!(s, "  <joint name=\"{name}\" type=\"revolute\">");
+    let _ = writeln!(
+        s,
+        "    <parent link=\"{parent}\"/><child link=\"{child}\"/>"
+    );
+    let _ = writeln!(s, "    <origin xyz=\"{}\" rpy=\"0 0 0\"/>", v3(&origin));
+    let _ = writeln!(s, "    <axis xyz=\"0 0 {sd}\"/>");
+    let _ = writeln!(
+        s,
+        "    <limit lower=\"{:.9}\" upper=\"{:.9}\" effort=\"{}\" velocity=\"10\"/>",
+        range.0, range.1, torque_limit_nm
+    );
+    let _ = writeln!(s, "  </joint>");
+}
+
 /// Writes the hand (palm and six phalanges, revolute joints with limits and effort) as
 /// `hand.urdf` into `dir`, in the palm frame, joints at their zero (straight) bend.
 ///
@@ -419,26 +474,7 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
     let _ = writeln!(s, "<?xml version=\"1.0\"?>");
     let _ = writeln!(s, "<robot name=\"{}\">", hand.name);
     let boxed = |s: &mut String, name: &str, size: Vector3<f64>, at: Vector3<f64>| {
-        let mass = rho * size.x * size.y * size.z;
-        let (ixx, iyy, izz) = (
-            mass * (size.y * size.y + size.z * size.z) / 12.0,
-            mass * (size.x * size.x + size.z * size.z) / 12.0,
-            mass * (size.x * size.x + size.y * size.y) / 12.0,
-        );
-        let geometry = format!(
-            "<origin xyz=\"{}\"/><geometry><box size=\"{}\"/></geometry>",
-            v3(&at),
-            v3(&size)
-        );
-        let _ = writeln!(s, "  <link name=\"{name}\">");
-        let _ = writeln!(
-            s,
-            "    <inertial><origin xyz=\"{}\"/><mass value=\"{mass:.9}\"/><inertia ixx=\"{ixx:.6e}\" ixy=\"0\" ixz=\"0\" iyy=\"{iyy:.6e}\" iyz=\"0\" izz=\"{izz:.6e}\"/></inertial>",
-            v3(&at)
-        );
-        let _ = writeln!(s, "    <visual>{geometry}</visual>");
-        let _ = writeln!(s, "    <collision>{geometry}</collision>");
-        let _ = writeln!(s, "  </link>");
+        urdf_box_link(s, name, size, at, rho);
     };
     let palm = hand.palm_box();
     boxed(
@@ -481,19 +517,15 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
                 lim(hand.joints.theta2_range_deg),
             ),
         ] {
-            let _ = writeln!(s, "  <joint name=\"{n}_joint_{j}\" type=\"revolute\">");
-            let _ = writeln!(
-                s,
-                "    <parent link=\"{parent}\"/><child link=\"{child}\"/>"
+            urdf_joint(
+                &mut s,
+                &format!("{n}_joint_{j}"),
+                (&parent, &child),
+                origin,
+                sd,
+                range,
+                sim.fingers.torque_limit_nm,
             );
-            let _ = writeln!(s, "    <origin xyz=\"{}\" rpy=\"0 0 0\"/>", v3(&origin));
-            let _ = writeln!(s, "    <axis xyz=\"0 0 {sd}\"/>");
-            let _ = writeln!(
-                s,
-                "    <limit lower=\"{:.9}\" upper=\"{:.9}\" effort=\"{}\" velocity=\"10\"/>",
-                range.0, range.1, sim.fingers.torque_limit_nm
-            );
-            let _ = writeln!(s, "  </joint>");
         }
     }
     let _ = writeln!(s, "</robot>");

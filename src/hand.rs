@@ -12,6 +12,7 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 mod geometry;
+pub mod kinematics;
 pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
 
 /// The largest length a hand file may give `[mm]`: a hand is hand-sized (issue 32).
@@ -39,12 +40,13 @@ pub(crate) fn thesis_for_tests() -> Hand {
 #[derive(Debug, thiserror::Error)]
 pub enum HandError {
     /// The file could not be read.
-    #[error("{path}: cannot read hand file: {message}")]
+    #[error("{path}: cannot read hand file: {}", crate::messages::io_message(.error))]
     Io {
         /// The file.
         path: PathBuf,
-        /// Why.
-        message: String,
+        /// What the operating system said: not the error's `source()`, since the message
+        /// already says it in a few stable words, and `{:#}` would print it twice.
+        error: std::io::Error,
     },
     /// The TOML does not parse or does not fit the schema.
     #[error("{path}: {message}")]
@@ -199,7 +201,7 @@ impl Hand {
     pub fn load(path: &Path, overrides: &[(String, f64)]) -> Result<Hand, HandError> {
         let text = std::fs::read_to_string(path).map_err(|e| HandError::Io {
             path: path.to_path_buf(),
-            message: crate::messages::io_message(&e),
+            error: e,
         })?;
         Hand::parse(&text, path, overrides)
     }
@@ -249,14 +251,20 @@ impl Hand {
         Ok(hand)
     }
 
+    /// Checks the hand's values; every problem names its key.
     fn validate(&self, path: &Path) -> Result<(), HandError> {
-        let bad = |key: &str, problem: String| {
-            Err(HandError::Invalid {
+        self.check_lengths()
+            .and_then(|()| self.check_links())
+            .and_then(|()| self.check_wraps())
+            .map_err(|(key, problem)| HandError::Invalid {
                 path: path.to_path_buf(),
                 key: key.to_string(),
                 problem,
             })
-        };
+    }
+
+    /// The lengths: positive or non-negative as each must be, finite, and hand-sized.
+    fn check_lengths(&self) -> Result<(), (&'static str, String)> {
         let positive = [
             ("palm.offset_mm", self.palm.offset_mm),
             ("palm.half_width_mm", self.palm.half_width_mm),
@@ -269,7 +277,7 @@ impl Hand {
         ];
         for (key, v) in positive {
             if !(v.is_finite() && v > 0.0) {
-                return bad(key, format!("must be a positive length, got {v}"));
+                return Err((key, format!("must be a positive length, got {v}")));
             }
         }
         let non_negative = [
@@ -294,15 +302,15 @@ impl Hand {
         ];
         if let Some(v) = self.fingers.relief_mm {
             if !(v.is_finite() && (0.0..self.fingers.offset_mm).contains(&v)) {
-                return bad(
+                return Err((
                     "fingers.relief_mm",
                     format!("must be zero or positive and below fingers.offset_mm, got {v}"),
-                );
+                ));
             }
         }
         for (key, v) in non_negative {
             if !(v.is_finite() && v >= 0.0) {
-                return bad(key, format!("must be zero or positive, got {v}"));
+                return Err((key, format!("must be zero or positive, got {v}")));
             }
         }
         // A hand is hand-sized: the same 2 m the object size warning takes as the largest
@@ -310,52 +318,63 @@ impl Hand {
         // arithmetic turns the motors' limits into NaN and panics.
         for (key, v) in positive.iter().chain(&non_negative) {
             if *v > MAX_LENGTH_MM {
-                return bad(
+                return Err((
                     key,
                     format!("must be at most {MAX_LENGTH_MM} mm (a hand's size), got {v}"),
-                );
+                ));
             }
         }
+        Ok(())
+    }
+
+    /// The links, the joint ranges and the fingers: contact length left on each phalanx, a tip
+    /// no thicker than the finger offset, joint ranges within (0, 180], fingers named once.
+    fn check_links(&self) -> Result<(), (&'static str, String)> {
         for (key, p) in [
             ("phalanx_1", &self.phalanx_1),
             ("phalanx_2", &self.phalanx_2),
         ] {
             if p.unusable_proximal_mm + p.unusable_distal_mm >= p.length_mm {
-                return bad(key, "unusable lengths leave no contact length".to_string());
+                return Err((key, "unusable lengths leave no contact length".to_string()));
             }
         }
         if self.fingers.tip_thickness_mm > self.fingers.offset_mm {
-            return bad(
+            return Err((
                 "fingers.tip_thickness_mm",
                 "must not exceed fingers.offset_mm (the tip is thinned, thesis Fig. 3.8)"
                     .to_string(),
-            );
+            ));
         }
         for (key, [lo, hi]) in [
             ("joints.theta1_range_deg", self.joints.theta1_range_deg),
             ("joints.theta2_range_deg", self.joints.theta2_range_deg),
         ] {
             if !(lo.is_finite() && hi.is_finite() && 0.0 < lo && lo < hi && hi <= 180.0) {
-                return bad(
+                return Err((
                     key,
                     format!("must be [low, high] with 0 < low < high <= 180, got [{lo}, {hi}]"),
-                );
+                ));
             }
         }
         if self.finger_list.is_empty() {
-            return bad("finger", "the hand has no fingers".to_string());
+            return Err(("finger", "the hand has no fingers".to_string()));
         }
         for (i, f) in self.finger_list.iter().enumerate() {
             if self.finger_list[..i].iter().any(|g| g.name == f.name) {
-                return bad("finger.name", format!("`{}` appears twice", f.name));
+                return Err(("finger.name", format!("`{}` appears twice", f.name)));
             }
             if !f.height_mm.is_finite() {
-                return bad("finger.height_mm", format!("must be finite for {}", f.name));
+                return Err(("finger.height_mm", format!("must be finite for {}", f.name)));
             }
         }
+        Ok(())
+    }
+
+    /// The planner's graspable diameter range exists.
+    fn check_wraps(&self) -> Result<(), (&'static str, String)> {
         // The planner's graspable diameter range must exist: a finger whose phalanx 2 cannot
         // reach back to any object resting on the palm wraps nothing (issue 16, item 1).
-        let range = crate::plan::kinematics::graspable_range(self);
+        let range = kinematics::graspable_range(self);
         if range.max_kinematic_mm.partial_cmp(&range.min_mm) != Some(std::cmp::Ordering::Greater) {
             let what = if range.max_kinematic_mm == 0.0 {
                 "no object resting on the palm (up to 2 m across) is touched by both phalanges \
@@ -369,14 +388,14 @@ impl Hand {
                     range.max_kinematic_mm, range.min_mm
                 )
             };
-            return bad(
+            return Err((
                 "phalanx_1.length_mm",
                 format!(
                     "{} mm with phalanx_2.length_mm {} mm and these joint ranges: {what}; shorten \
                      phalanx 1, lengthen phalanx 2 or widen the joint ranges",
                     self.phalanx_1.length_mm, self.phalanx_2.length_mm
                 ),
-            );
+            ));
         }
         Ok(())
     }

@@ -5,7 +5,8 @@
 //! [`PreparedObject`], so loading, aligning, the mass formula and the collider are written once.
 
 use crate::mesh::{self, AlignedObject, GraspAxis, LoadedMesh, MassProperties, Mesh, MeshError};
-use crate::report::StageTimings;
+use crate::plan::timings::ms;
+use crate::plan::StageTimings;
 use crate::scenario::{ObjectSpec, Scenario};
 use crate::sim::{Case, ObjectShape, SimHand};
 use std::collections::BTreeMap;
@@ -87,8 +88,4 @@ impl PreparedObject {
             params: &scenario.sim,
         }
     }
-}
-
-fn ms(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1000.0
 }

@@ -41,9 +41,12 @@ use serde::Serialize;
 /// Number of friction-cone edges by default.
 pub const DEFAULT_CONE_EDGES: usize = 8;
 
+mod error;
 pub mod hull;
 pub mod linf;
 pub mod rays;
+
+pub use error::QualityError;
 
 /// A point contact between the hand and the object.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -989,7 +992,7 @@ mod tests {
         assert_eq!(q.linf.unwrap().epsilon, 0.0);
         // Too few support points allowed: no answer, and the reason, not a hang.
         let per_contact = edge_wrenches(&scattered(8, 9), &sphere_params(0.5));
-        let err = linf::epsilon(&per_contact, 2).unwrap_err();
+        let err = linf::epsilon(&per_contact, 2).unwrap_err().to_string();
         assert!(err.contains("not settled after 2 support points"), "{err}");
     }
 

@@ -20,13 +20,23 @@ use std::path::{Path, PathBuf};
 /// Problems with a scenario file.
 #[derive(Debug, thiserror::Error)]
 pub enum ScenarioError {
-    /// The file could not be read.
+    /// The input is not a scenario file that can be read (a folder, a missing path, a file
+    /// of another kind).
     #[error("{path}: cannot read scenario: {message}")]
     Io {
         /// The file.
         path: PathBuf,
         /// Why.
         message: String,
+    },
+    /// Reading the scenario file failed.
+    #[error("{path}: cannot read scenario: {}", crate::messages::io_message(.error))]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// What the operating system said: not the error's `source()`, since the message
+        /// already says it in a few stable words, and `{:#}` would print it twice.
+        error: std::io::Error,
     },
     /// Bad TOML, an unknown key or a wrong type.
     #[error("{path}: {message}")]
@@ -257,9 +267,9 @@ impl Scenario {
                 message: "is a folder, not a scenario file (`grasp-sim batch FOLDER` runs every scenario, URDF or mesh in a folder)".to_string(),
             });
         }
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Io {
+        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read {
             path: path.to_path_buf(),
-            message: crate::messages::io_message(&e),
+            error: e,
         })?;
         Scenario::parse(&text, path)
     }
@@ -281,94 +291,8 @@ impl Scenario {
         };
         let dir = path.parent().unwrap_or(Path::new("."));
         let o = raw.object;
-        let mass = match (o.density_kg_m3, o.mass_kg) {
-            (Some(_), Some(_)) => {
-                return Err(invalid(
-                    "object.mass_kg",
-                    "and `object.density_kg_m3` are both given; give one".to_string(),
-                ))
-            }
-            (Some(d), None) => MassSpec::Density(d),
-            (None, Some(m)) => MassSpec::Mass(m),
-            (None, None) => MassSpec::Default,
-        };
-        match mass {
-            MassSpec::Density(d) if !(d.is_finite() && d > 0.0) => {
-                return Err(invalid(
-                    "object.density_kg_m3",
-                    format!("must be positive, got {d}"),
-                ))
-            }
-            MassSpec::Mass(m) if !(m.is_finite() && m > 0.0) => {
-                return Err(invalid(
-                    "object.mass_kg",
-                    format!("must be positive, got {m}"),
-                ))
-            }
-            _ => {}
-        }
-        // A URDF's lengths are metres by its format: another unit would be silently ignored.
-        let is_urdf =
-            crate::mesh::MeshFormat::from_path(&o.mesh) == Some(crate::mesh::MeshFormat::Urdf);
-        if let (true, Some(u)) = (is_urdf, o.units.filter(|&u| u != LengthUnit::M)) {
-            return Err(invalid(
-                "object.units",
-                format!(
-                    "is \"{}\", but a URDF's lengths are metres (its meshes' `scale` gives their \
-                     unit); remove `units` or set it to \"m\"",
-                    u.name()
-                ),
-            ));
-        }
-        // Coulomb friction between a hand and an object: 0 is frictionless; rubber on rubber
-        // rarely exceeds ~1.5, so 2 bounds any plausible value.
-        if !(o.friction.is_finite() && o.friction > 0.0 && o.friction <= 2.0) {
-            return Err(invalid(
-                "object.friction",
-                format!("must be in (0, 2], got {}", o.friction),
-            ));
-        }
-        let overrides: Vec<(String, f64)> = raw.hand.overrides.into_iter().collect();
-        let file = raw.hand.file.unwrap_or_else(|| PathBuf::from("thesis"));
-        let bundled = file
-            .to_str()
-            .and_then(crate::hand::bundled)
-            .filter(|_| !dir.join(&file).is_file());
-        let (hand_file, loaded) = match bundled {
-            Some((name, text)) => {
-                let label = PathBuf::from(format!("<bundled hand {name}>"));
-                let hand = Hand::parse(text, &label, &overrides);
-                (label, hand)
-            }
-            None => {
-                let f = dir.join(&file);
-                let hand = Hand::load(&f, &overrides);
-                (f, hand)
-            }
-        };
-        let hand = loaded.map_err(|e| match e {
-            // The override was written in the scenario: name the scenario.
-            HandError::BadOverride {
-                path: hand,
-                key,
-                problem,
-            } => ScenarioError::Invalid {
-                path: path.to_path_buf(),
-                key: format!("hand.overrides.\"{key}\""),
-                problem: format!("{problem} ({})", hand.display()),
-            },
-            // A value out of range that the scenario's override set: name the scenario.
-            HandError::Invalid {
-                path: hand,
-                key,
-                problem,
-            } if overrides.iter().any(|(k, _)| *k == key) => ScenarioError::Invalid {
-                path: path.to_path_buf(),
-                key: format!("hand.overrides.\"{key}\""),
-                problem: format!("{problem} ({} with this override)", hand.display()),
-            },
-            other => other.into(),
-        })?;
+        let mass = validate_object(&o).map_err(|(key, problem)| invalid(key, problem))?;
+        let (hand_file, hand) = load_hand(raw.hand, dir, path)?;
 
         validate_planner(&raw.planner, &hand, o.friction)
             .map_err(|(key, problem)| invalid(key, problem))?;
@@ -409,6 +333,106 @@ impl Scenario {
             expect: raw.expect,
         })
     }
+}
+
+/// Checks a scenario's `[object]` (one of density and mass, positive; a URDF in metres; the
+/// friction in range) and returns how its mass is given.
+///
+/// # Errors
+/// The key and the problem, for [`ScenarioError::Invalid`].
+fn validate_object(o: &RawObject) -> Result<MassSpec, (&'static str, String)> {
+    let mass = match (o.density_kg_m3, o.mass_kg) {
+        (Some(_), Some(_)) => {
+            return Err((
+                "object.mass_kg",
+                "and `object.density_kg_m3` are both given; give one".to_string(),
+            ))
+        }
+        (Some(d), None) => MassSpec::Density(d),
+        (None, Some(m)) => MassSpec::Mass(m),
+        (None, None) => MassSpec::Default,
+    };
+    match mass {
+        MassSpec::Density(d) if !(d.is_finite() && d > 0.0) => {
+            return Err(("object.density_kg_m3", format!("must be positive, got {d}")))
+        }
+        MassSpec::Mass(m) if !(m.is_finite() && m > 0.0) => {
+            return Err(("object.mass_kg", format!("must be positive, got {m}")))
+        }
+        _ => {}
+    }
+    // A URDF's lengths are metres by its format: another unit would be silently ignored.
+    let is_urdf =
+        crate::mesh::MeshFormat::from_path(&o.mesh) == Some(crate::mesh::MeshFormat::Urdf);
+    if let (true, Some(u)) = (is_urdf, o.units.filter(|&u| u != LengthUnit::M)) {
+        return Err((
+            "object.units",
+            format!(
+                "is \"{}\", but a URDF's lengths are metres (its meshes' `scale` gives their \
+                 unit); remove `units` or set it to \"m\"",
+                u.name()
+            ),
+        ));
+    }
+    // Coulomb friction between a hand and an object: 0 is frictionless; rubber on rubber
+    // rarely exceeds ~1.5, so 2 bounds any plausible value.
+    if !(o.friction.is_finite() && o.friction > 0.0 && o.friction <= 2.0) {
+        return Err((
+            "object.friction",
+            format!("must be in (0, 2], got {}", o.friction),
+        ));
+    }
+    Ok(mass)
+}
+
+/// Loads the scenario's hand (a bundled one by name unless a file of that name is beside the
+/// scenario) with its overrides, naming the scenario for a problem its override caused.
+///
+/// # Errors
+/// [`ScenarioError`]: the hand file's own, or [`ScenarioError::Invalid`] for an override.
+fn load_hand(raw: RawHand, dir: &Path, path: &Path) -> Result<(PathBuf, Hand), ScenarioError> {
+    let overrides: Vec<(String, f64)> = raw.overrides.into_iter().collect();
+    let file = raw.file.unwrap_or_else(|| PathBuf::from("thesis"));
+    let bundled = file
+        .to_str()
+        .and_then(crate::hand::bundled)
+        .filter(|_| !dir.join(&file).is_file());
+    let (hand_file, loaded) = match bundled {
+        Some((name, text)) => {
+            let label = PathBuf::from(format!("<bundled hand {name}>"));
+            let hand = Hand::parse(text, &label, &overrides);
+            (label, hand)
+        }
+        None => {
+            let f = dir.join(&file);
+            let hand = Hand::load(&f, &overrides);
+            (f, hand)
+        }
+    };
+    let hand = loaded.map_err(|e| match e {
+        // The override was written in the scenario: name the scenario.
+        HandError::BadOverride {
+            path: hand,
+            key,
+            problem,
+        } => ScenarioError::Invalid {
+            path: path.to_path_buf(),
+            key: format!("hand.overrides.\"{key}\""),
+            problem: format!("{problem} ({})", hand.display()),
+        },
+        // A value out of range that the scenario's override set: name the scenario.
+        HandError::Invalid {
+            path: hand,
+            key,
+            problem,
+        } if overrides.iter().any(|(k, _)| *k == key) => ScenarioError::Invalid {
+            path: path.to_path_buf(),
+            key: format!("hand.overrides.\"{key}\""),
+            problem: format!("{problem} ({} with this override)", hand.display()),
+        },
+        other => other.into(),
+    })?;
+    Ok((hand_file, hand))
 }
 
 /// Checks planner parameters against the hand and the friction (see

@@ -182,7 +182,7 @@ fn file_format(path: &Path) -> Result<MeshFormat, MeshError> {
 fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
     std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
-        message: crate::messages::io_message(&e),
+        error: e,
     })
 }
 
@@ -420,13 +420,11 @@ fn obj_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     Ok((raw, false))
 }
 
+/// Reads a PLY file (ASCII or binary) as triangles, its polygons fanned; whether it is binary.
 fn ply_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     use ply_rs_bw::parser::Parser;
-    use ply_rs_bw::ply::{DefaultElement, Encoding, Property};
-    let err = |detail: String| MeshError::Ply {
-        path: path.to_path_buf(),
-        detail: detail.split_whitespace().collect::<Vec<_>>().join(" "),
-    };
+    use ply_rs_bw::ply::{DefaultElement, Encoding};
+    let err = |detail: String| ply_err(path, detail);
     let parser = Parser::<DefaultElement>::new();
     let mut reader = std::io::BufReader::new(std::io::Cursor::new(bytes));
     let header = parser
@@ -442,61 +440,100 @@ fn ply_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
             )));
         }
     }
-    let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
-        // ply-rs-bw's messages carry the offending line and a nested parser dump; keep the line.
-        let m = e
-            .to_string()
-            .split_whitespace()
-            .collect::<Vec<_>>()
-            .join(" ");
-        let eof = e.kind() == std::io::ErrorKind::UnexpectedEof || m.contains("UnexpectedEof");
-        if eof {
-            return err(format!(
-                "unexpected end of file (truncated?): {}",
-                m.split(" Error: ").next().unwrap_or(&m)
-            ));
-        }
-        match m
-            .split_once("String: '")
-            .and_then(|(_, r)| r.split_once('\''))
-        {
-            Some((line, _)) => err(format!(
-                "cannot read the element line `{}`: not numbers of the types the header declares",
-                line.trim()
-            )),
-            None => err(m.split(" Error: ").next().unwrap_or(&m).to_string()),
-        }
-    })?;
+    let payload = parser
+        .read_payload(&mut reader, &header)
+        .map_err(|e| ply_payload_err(path, &e))?;
     let is_binary = header.encoding != Encoding::Ascii;
-    let scalar = |p: Option<&Property>| -> Option<f64> {
-        Some(match p? {
-            Property::Float(v) => f64::from(*v),
-            Property::Double(v) => *v,
-            Property::Char(v) => f64::from(*v),
-            Property::UChar(v) => f64::from(*v),
-            Property::Short(v) => f64::from(*v),
-            Property::UShort(v) => f64::from(*v),
-            Property::Int(v) => f64::from(*v),
-            Property::UInt(v) => f64::from(*v),
-            _ => return None,
-        })
-    };
     let vertices = payload
         .get("vertex")
         .ok_or_else(|| err("no `vertex` element".to_string()))?;
+    let points = ply_points(vertices, path)?;
+    let faces = payload
+        .get("face")
+        .ok_or_else(|| err("no `face` element: a point cloud is not a surface".to_string()))?;
+    let raw = ply_triangles(faces, &points, path)?;
+    Ok((raw, is_binary))
+}
+
+/// [`MeshError::Ply`] for `path` with `detail` on one line.
+fn ply_err(path: &Path, detail: String) -> MeshError {
+    MeshError::Ply {
+        path: path.to_path_buf(),
+        detail: detail.split_whitespace().collect::<Vec<_>>().join(" "),
+    }
+}
+
+/// The error for a PLY payload that does not read: a truncated file, or the element line that
+/// does not fit the header's types.
+fn ply_payload_err(path: &Path, e: &std::io::Error) -> MeshError {
+    let err = |detail: String| ply_err(path, detail);
+    // ply-rs-bw's messages carry the offending line and a nested parser dump; keep the line.
+    let m = e
+        .to_string()
+        .split_whitespace()
+        .collect::<Vec<_>>()
+        .join(" ");
+    let eof = e.kind() == std::io::ErrorKind::UnexpectedEof || m.contains("UnexpectedEof");
+    if eof {
+        return err(format!(
+            "unexpected end of file (truncated?): {}",
+            m.split(" Error: ").next().unwrap_or(&m)
+        ));
+    }
+    match m
+        .split_once("String: '")
+        .and_then(|(_, r)| r.split_once('\''))
+    {
+        Some((line, _)) => err(format!(
+            "cannot read the element line `{}`: not numbers of the types the header declares",
+            line.trim()
+        )),
+        None => err(m.split(" Error: ").next().unwrap_or(&m).to_string()),
+    }
+}
+
+/// A PLY scalar property as a number (`None` for a list or a missing property).
+fn ply_scalar(p: Option<&ply_rs_bw::ply::Property>) -> Option<f64> {
+    use ply_rs_bw::ply::Property;
+    Some(match p? {
+        Property::Float(v) => f64::from(*v),
+        Property::Double(v) => *v,
+        Property::Char(v) => f64::from(*v),
+        Property::UChar(v) => f64::from(*v),
+        Property::Short(v) => f64::from(*v),
+        Property::UShort(v) => f64::from(*v),
+        Property::Int(v) => f64::from(*v),
+        Property::UInt(v) => f64::from(*v),
+        _ => return None,
+    })
+}
+
+/// The PLY `vertex` elements' `x, y, z`.
+fn ply_points(
+    vertices: &[ply_rs_bw::ply::DefaultElement],
+    path: &Path,
+) -> Result<Vec<[f32; 3]>, MeshError> {
     let mut points = Vec::with_capacity(vertices.len());
     for (i, v) in vertices.iter().enumerate() {
         let mut p = [0f32; 3];
         for (k, key) in ["x", "y", "z"].iter().enumerate() {
-            let c = scalar(v.get(*key))
-                .ok_or_else(|| err(format!("vertex {i} has no numeric `{key}`")))?;
+            let c = ply_scalar(v.get(*key))
+                .ok_or_else(|| ply_err(path, format!("vertex {i} has no numeric `{key}`")))?;
             p[k] = c as f32;
         }
         points.push(p);
     }
-    let faces = payload
-        .get("face")
-        .ok_or_else(|| err("no `face` element: a point cloud is not a surface".to_string()))?;
+    Ok(points)
+}
+
+/// The PLY `face` elements as triangles of `points`, each polygon fanned.
+fn ply_triangles(
+    faces: &[ply_rs_bw::ply::DefaultElement],
+    points: &[[f32; 3]],
+    path: &Path,
+) -> Result<Vec<[[f32; 3]; 3]>, MeshError> {
+    use ply_rs_bw::ply::Property;
+    let err = |detail: String| ply_err(path, detail);
     let mut raw = Vec::new();
     for (f, face) in faces.iter().enumerate() {
         let list = face
@@ -543,7 +580,7 @@ fn ply_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
             ]);
         }
     }
-    Ok((raw, is_binary))
+    Ok(raw)
 }
 
 impl LoadedMesh {
@@ -687,7 +724,7 @@ pub fn load_stl(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> 
     }
     let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
-        message: crate::messages::io_message(&e),
+        error: e,
     })?;
     parse_stl(&bytes, path, unit)
 }
@@ -719,63 +756,14 @@ fn stl_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
 
     let is_binary = binary_size == Some(len) || (!starts_solid && declared.is_some());
     let triangles = if is_binary {
-        let declared = declared.unwrap_or(0);
-        let expected = binary_size.unwrap_or(84);
-        if len < expected {
-            return Err(MeshError::Truncated {
-                path: p(),
-                declared,
-                expected,
-                actual: len,
-            });
-        }
-        if len > expected {
-            return Err(MeshError::TrailingBytes {
-                path: p(),
-                declared,
-                extra: len - expected,
-            });
-        }
-        // The header is free text; blank it so stl_io's ASCII probe cannot misread a binary file
-        // whose header begins with "solid ".
-        let mut patched = bytes.to_vec();
-        patched[..80].fill(0);
-        read_triangles(&patched, path, true)?
+        stl_binary(
+            bytes,
+            path,
+            declared.unwrap_or(0),
+            binary_size.unwrap_or(84),
+        )?
     } else if starts_solid {
-        let text = std::str::from_utf8(bytes).map_err(|e| MeshError::NotStl {
-            path: p(),
-            detail: format!(
-                "starts with \"solid\" but is not UTF-8 text (byte {}), and its size {} is not \
-                 that of a binary STL",
-                e.valid_up_to(),
-                len
-            ),
-        })?;
-        let original_text = text;
-        // stl_io wants "solid <name>"; a bare "solid" first line is valid STL too.
-        let trimmed = text.trim_start();
-        let first_line = trimmed.lines().next().unwrap_or("");
-        let text = if first_line.trim() == "solid" {
-            format!("solid unnamed{}", &trimmed[first_line.len()..])
-        } else {
-            trimmed.to_string()
-        };
-        read_triangles(text.as_bytes(), path, false).map_err(|e| match e {
-            // stl_io names no line: find the first line that breaks the grammar and name it.
-            MeshError::Ascii { path, detail } => MeshError::Ascii {
-                detail: match first_bad_ascii_line(original_text) {
-                    // stl_io's own words add nothing to a non-finite number but its Rust
-                    // names ("expected finite f32, got NaN which is Nan").
-                    Some((n, line, want)) if detail.contains("expected finite f32") => {
-                        format!("line {n} ({line}): {want}, with finite numbers")
-                    }
-                    Some((n, line, want)) => format!("line {n} ({line}): {want} ({detail})"),
-                    None => detail,
-                },
-                path,
-            },
-            e => e,
-        })?
+        stl_ascii(bytes, path)?
     } else {
         return Err(MeshError::NotStl {
             path: p(),
@@ -784,6 +772,77 @@ fn stl_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
     };
 
     Ok((triangles, is_binary))
+}
+
+/// The triangles of a binary STL whose header declares `declared` triangles, `expected` bytes.
+fn stl_binary(
+    bytes: &[u8],
+    path: &Path,
+    declared: u32,
+    expected: u64,
+) -> Result<Vec<[[f32; 3]; 3]>, MeshError> {
+    let p = || path.to_path_buf();
+    let len = bytes.len() as u64;
+    if len < expected {
+        return Err(MeshError::Truncated {
+            path: p(),
+            declared,
+            expected,
+            actual: len,
+        });
+    }
+    if len > expected {
+        return Err(MeshError::TrailingBytes {
+            path: p(),
+            declared,
+            extra: len - expected,
+        });
+    }
+    // The header is free text; blank it so stl_io's ASCII probe cannot misread a binary file
+    // whose header begins with "solid ".
+    let mut patched = bytes.to_vec();
+    patched[..80].fill(0);
+    read_triangles(&patched, path, true)
+}
+
+/// The triangles of an ASCII STL; a grammar error names the first line that breaks it.
+fn stl_ascii(bytes: &[u8], path: &Path) -> Result<Vec<[[f32; 3]; 3]>, MeshError> {
+    let p = || path.to_path_buf();
+    let len = bytes.len() as u64;
+    let text = std::str::from_utf8(bytes).map_err(|e| MeshError::NotStl {
+        path: p(),
+        detail: format!(
+            "starts with \"solid\" but is not UTF-8 text (byte {}), and its size {} is not \
+             that of a binary STL",
+            e.valid_up_to(),
+            len
+        ),
+    })?;
+    let original_text = text;
+    // stl_io wants "solid <name>"; a bare "solid" first line is valid STL too.
+    let trimmed = text.trim_start();
+    let first_line = trimmed.lines().next().unwrap_or("");
+    let text = if first_line.trim() == "solid" {
+        format!("solid unnamed{}", &trimmed[first_line.len()..])
+    } else {
+        trimmed.to_string()
+    };
+    read_triangles(text.as_bytes(), path, false).map_err(|e| match e {
+        // stl_io names no line: find the first line that breaks the grammar and name it.
+        MeshError::Ascii { path, detail } => MeshError::Ascii {
+            detail: match first_bad_ascii_line(original_text) {
+                // stl_io's own words add nothing to a non-finite number but its Rust
+                // names ("expected finite f32, got NaN which is Nan").
+                Some((n, line, want)) if detail.contains("expected finite f32") => {
+                    format!("line {n} ({line}): {want}, with finite numbers")
+                }
+                Some((n, line, want)) => format!("line {n} ({line}): {want} ({detail})"),
+                None => detail,
+            },
+            path,
+        },
+        e => e,
+    })
 }
 
 /// The first line of an ASCII STL that breaks its grammar (`solid`, then per facet `facet
@@ -875,18 +934,14 @@ fn read_triangles(
     Ok(out)
 }
 
-pub(super) fn build(
-    raw: Vec<[[f32; 3]; 3]>,
+/// The file's triangles in millimetres (`scale` per file unit), each coordinate checked to be
+/// finite and within [`COORDINATE_LIMIT_MM`].
+fn scaled_soup(
+    raw: &[[[f32; 3]; 3]],
     path: &Path,
-    unit: LengthUnit,
-    is_binary: bool,
-    format: MeshFormat,
-) -> Result<LoadedMesh, MeshError> {
+    scale: f64,
+) -> Result<Vec<[Point3<f64>; 3]>, MeshError> {
     let p = || path.to_path_buf();
-    if raw.is_empty() {
-        return Err(MeshError::NoTriangles { path: p() });
-    }
-    let scale = unit.to_mm();
     let mut soup = Vec::with_capacity(raw.len());
     for (i, tri) in raw.iter().enumerate() {
         let mut corners = [Point3::origin(); 3];
@@ -914,6 +969,32 @@ pub(super) fn build(
         }
         soup.push(corners);
     }
+    Ok(soup)
+}
+
+/// Drops the triangles without area relative to the mesh's squared diagonal `diag2`; how many.
+fn drop_collinear(mesh: &mut Mesh, diag2: f64) -> usize {
+    let before = mesh.triangles.len();
+    let keep: Vec<bool> = (0..before)
+        .map(|t| mesh.area_normal(t).norm() > 1e-14 * diag2)
+        .collect();
+    let mut it = keep.iter();
+    mesh.triangles.retain(|_| *it.next().unwrap_or(&false));
+    before - mesh.triangles.len()
+}
+
+pub(super) fn build(
+    raw: Vec<[[f32; 3]; 3]>,
+    path: &Path,
+    unit: LengthUnit,
+    is_binary: bool,
+    format: MeshFormat,
+) -> Result<LoadedMesh, MeshError> {
+    let p = || path.to_path_buf();
+    if raw.is_empty() {
+        return Err(MeshError::NoTriangles { path: p() });
+    }
+    let soup = scaled_soup(&raw, path, unit.to_mm())?;
     let (mut mesh, mut degenerate) = Mesh::from_triangles_welded(&soup);
     if mesh.triangles.is_empty() {
         return Err(MeshError::AllDegenerate {
@@ -925,13 +1006,7 @@ pub(super) fn build(
     // mesh size so that the rule does not depend on the unit.
     let (lo, hi) = mesh.bounds();
     let diag2 = (hi - lo).norm_squared();
-    let before = mesh.triangles.len();
-    let keep: Vec<bool> = (0..before)
-        .map(|t| mesh.area_normal(t).norm() > 1e-14 * diag2)
-        .collect();
-    let mut it = keep.iter();
-    mesh.triangles.retain(|_| *it.next().unwrap_or(&false));
-    degenerate += before - mesh.triangles.len();
+    degenerate += drop_collinear(&mut mesh, diag2);
     if mesh.triangles.is_empty() {
         return Err(MeshError::AllDegenerate {
             path: p(),

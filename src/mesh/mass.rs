@@ -116,7 +116,7 @@ fn surface_frame(mesh: &Mesh) -> (Point3<f64>, Matrix3<f64>) {
 
 /// Mass properties (unit density) of the solid a mesh encloses, taken as the union of its
 /// shells: the areas and area moments of `n` horizontal slices (each the union of what the
-/// shells cut, [`crate::slice::slice`]) integrated along Z by the midpoint rule.
+/// shells cut, [`super::slice::slice`]) integrated along Z by the midpoint rule.
 pub fn sliced_mass_properties(mesh: &Mesh, n: usize) -> MassProperties {
     sliced_mass_properties_with(mesh, n, 0.0)
 }
@@ -131,7 +131,7 @@ fn sliced_mass_properties_with(mesh: &Mesh, n: usize, join_mm: f64) -> MassPrope
     for k in 0..n {
         let z_abs = lo.z + (k as f64 + 0.5) * dz;
         let z = z_abs - reference.z;
-        let s = crate::slice::slice(mesh, &crate::slice::Plane::horizontal(z_abs)).joined(join_mm);
+        let s = super::slice::slice(mesh, &super::slice::Plane::horizontal(z_abs)).joined(join_mm);
         let (mut a, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
         for c in s.contours.iter().filter(|c| c.is_closed) {
             let np = c.points.len();

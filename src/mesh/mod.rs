@@ -15,6 +15,8 @@
 mod align;
 mod load;
 mod mass;
+pub mod primitives;
+pub mod slice;
 pub mod urdf;
 
 pub use align::{
@@ -34,12 +36,13 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     /// The file could not be opened or read.
-    #[error("{path}: cannot read: {message}")]
+    #[error("{path}: cannot read: {}", crate::messages::io_message(.error))]
     Io {
         /// The file.
         path: PathBuf,
-        /// What the operating system said.
-        message: String,
+        /// What the operating system said: not the error's `source()`, since the message
+        /// already says it in a few stable words, and `{:#}` would print it twice.
+        error: std::io::Error,
     },
     /// The path names a directory.
     #[error("{path}: is a directory, not a mesh file")]

@@ -206,10 +206,11 @@ struct Read {
     mass_kg: Option<f64>,
 }
 
+/// Reads a URDF: every link's geometry placed in the root link's frame, with notes and mass.
 fn read(path: &Path) -> Result<Read, MeshError> {
     let text = std::fs::read_to_string(path).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
-        message: crate::messages::io_message(&e),
+        error: e,
     })?;
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| urdf_err(path, format!("not well-formed XML: {e}")))?;
@@ -230,114 +231,17 @@ fn read(path: &Path) -> Result<Read, MeshError> {
     if links.is_empty() {
         return Err(urdf_err(path, "no <link>"));
     }
-    // Each child link's parent and the joint's origin.
-    let mut parent: HashMap<&str, (&str, Isometry3<f64>)> = HashMap::new();
-    for j in robot.children().filter(|c| c.has_tag_name("joint")) {
-        let link_of = |tag: &str| {
-            j.children()
-                .find(|c| c.has_tag_name(tag))
-                .and_then(|c| c.attribute("link"))
-        };
-        let (Some(p), Some(c)) = (link_of("parent"), link_of("child")) else {
-            let line = doc.text_pos_at(j.range().start).row;
-            return Err(urdf_err(
-                path,
-                format!("line {line}: <joint> without a parent or child link"),
-            ));
-        };
-        parent.insert(c, (p, origin(path, j)?));
-    }
-    let pose_of = |name: &str| -> Result<Isometry3<f64>, MeshError> {
-        let mut pose = Isometry3::identity();
-        let mut at = name;
-        for _ in 0..=parent.len() {
-            match parent.get(at) {
-                Some(&(p, o)) => {
-                    pose = o * pose;
-                    at = p;
-                }
-                None => return Ok(pose),
-            }
-        }
-        Err(urdf_err(
-            path,
-            format!("the joints form a loop through link `{name}`"),
-        ))
-    };
+    let parent = joint_parents(path, &doc, robot)?;
     let mut placed = Vec::new();
     let mut notes = Vec::new();
     let mut mass_kg = None;
     for link in links {
         let name = link.attribute("name").unwrap_or("");
-        if let Some(m) = link
-            .children()
-            .find(|c| c.has_tag_name("inertial"))
-            .and_then(|i| i.children().find(|c| c.has_tag_name("mass")))
-        {
-            let v = numbers(path, m, "value", 1)?.map_or(0.0, |v| v[0]);
-            if v < 0.0 {
-                let line = doc.text_pos_at(m.range().start).row;
-                return Err(urdf_err(
-                    path,
-                    format!("line {line}: link `{name}` has a negative mass ({v} kg)"),
-                ));
-            }
-            if v > 0.0 {
-                mass_kg = Some(mass_kg.unwrap_or(0.0) + v);
-            }
+        if let Some(v) = link_mass(path, &doc, link, name)? {
+            mass_kg = Some(mass_kg.unwrap_or(0.0) + v);
         }
-        let link_pose = pose_of(name)?;
-        let read_all = |tag: &str| -> Result<(Vec<Placed>, Vec<String>), MeshError> {
-            let mut ok = Vec::new();
-            let mut why = Vec::new();
-            for e in link.children().filter(|c| c.has_tag_name(tag)) {
-                match geometry(path, e)? {
-                    Ok(p) => ok.push(Placed {
-                        pose: link_pose * p.pose,
-                        ..p
-                    }),
-                    Err(w) => why.push(w),
-                }
-            }
-            Ok((ok, why))
-        };
-        let (visual, visual_why) = read_all("visual")?;
-        if visual_why.is_empty() && !visual.is_empty() {
-            placed.extend(visual);
-            continue;
-        }
-        let (collision, collision_why) = read_all("collision")?;
-        if !visual_why.is_empty() && !collision.is_empty() && collision_why.is_empty() {
-            notes.push(format!(
-                "link `{name}`: its visual {}; its collision geometry is used",
-                visual_why.join(", ")
-            ));
-            placed.extend(collision);
-        } else if !visual.is_empty() {
-            notes.push(format!(
-                "link `{name}`: part of its visual geometry is left out: {}",
-                visual_why.join(", ")
-            ));
-            placed.extend(visual);
-        } else if !collision.is_empty() {
-            if !collision_why.is_empty() {
-                notes.push(format!(
-                    "link `{name}`: part of its collision geometry is left out: {}",
-                    collision_why.join(", ")
-                ));
-            }
-            placed.extend(collision);
-        } else if !visual_why.is_empty() || !collision_why.is_empty() {
-            notes.push(format!(
-                "link `{name}`: no geometry read: {}",
-                visual_why
-                    .iter()
-                    .chain(&collision_why)
-                    .cloned()
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            ));
-        }
+        let link_pose = pose_in_root(path, &parent, name)?;
+        link_geometry(path, link, name, link_pose, &mut placed, &mut notes)?;
     }
     if placed.is_empty() {
         return Err(urdf_err(
@@ -360,6 +264,150 @@ fn read(path: &Path) -> Result<Read, MeshError> {
     })
 }
 
+/// Each child link's parent link and the joint's origin, from the URDF's `<joint>`s.
+fn joint_parents<'a>(
+    path: &Path,
+    doc: &roxmltree::Document,
+    robot: roxmltree::Node<'a, '_>,
+) -> Result<HashMap<&'a str, (&'a str, Isometry3<f64>)>, MeshError> {
+    let mut parent: HashMap<&str, (&str, Isometry3<f64>)> = HashMap::new();
+    for j in robot.children().filter(|c| c.has_tag_name("joint")) {
+        let link_of = |tag: &str| {
+            j.children()
+                .find(|c| c.has_tag_name(tag))
+                .and_then(|c| c.attribute("link"))
+        };
+        let (Some(p), Some(c)) = (link_of("parent"), link_of("child")) else {
+            let line = doc.text_pos_at(j.range().start).row;
+            return Err(urdf_err(
+                path,
+                format!("line {line}: <joint> without a parent or child link"),
+            ));
+        };
+        parent.insert(c, (p, origin(path, j)?));
+    }
+    Ok(parent)
+}
+
+/// The pose of link `name` in the root link's frame: its joints' origins composed up the tree.
+///
+/// # Errors
+/// [`MeshError::Urdf`] when the joints form a loop.
+fn pose_in_root(
+    path: &Path,
+    parent: &HashMap<&str, (&str, Isometry3<f64>)>,
+    name: &str,
+) -> Result<Isometry3<f64>, MeshError> {
+    let mut pose = Isometry3::identity();
+    let mut at = name;
+    for _ in 0..=parent.len() {
+        match parent.get(at) {
+            Some(&(p, o)) => {
+                pose = o * pose;
+                at = p;
+            }
+            None => return Ok(pose),
+        }
+    }
+    Err(urdf_err(
+        path,
+        format!("the joints form a loop through link `{name}`"),
+    ))
+}
+
+/// A link's `<inertial><mass value>` `[kg]` when it is positive (`None` when absent or 0).
+///
+/// # Errors
+/// [`MeshError::Urdf`] for a malformed or negative mass.
+fn link_mass(
+    path: &Path,
+    doc: &roxmltree::Document,
+    link: roxmltree::Node,
+    name: &str,
+) -> Result<Option<f64>, MeshError> {
+    let Some(m) = link
+        .children()
+        .find(|c| c.has_tag_name("inertial"))
+        .and_then(|i| i.children().find(|c| c.has_tag_name("mass")))
+    else {
+        return Ok(None);
+    };
+    let v = numbers(path, m, "value", 1)?.map_or(0.0, |v| v[0]);
+    if v < 0.0 {
+        let line = doc.text_pos_at(m.range().start).row;
+        return Err(urdf_err(
+            path,
+            format!("line {line}: link `{name}` has a negative mass ({v} kg)"),
+        ));
+    }
+    Ok((v > 0.0).then_some(v))
+}
+
+/// Adds a link's geometry at `link_pose` to `placed`: its visual geometry when all of it is
+/// read, else its collision geometry where that is complete, else what can be read of either,
+/// with a note in `notes` saying what was used instead of what.
+fn link_geometry(
+    path: &Path,
+    link: roxmltree::Node,
+    name: &str,
+    link_pose: Isometry3<f64>,
+    placed: &mut Vec<Placed>,
+    notes: &mut Vec<String>,
+) -> Result<(), MeshError> {
+    let read_all = |tag: &str| -> Result<(Vec<Placed>, Vec<String>), MeshError> {
+        let mut ok = Vec::new();
+        let mut why = Vec::new();
+        for e in link.children().filter(|c| c.has_tag_name(tag)) {
+            match geometry(path, e)? {
+                Ok(p) => ok.push(Placed {
+                    pose: link_pose * p.pose,
+                    ..p
+                }),
+                Err(w) => why.push(w),
+            }
+        }
+        Ok((ok, why))
+    };
+    let (visual, visual_why) = read_all("visual")?;
+    if visual_why.is_empty() && !visual.is_empty() {
+        placed.extend(visual);
+        return Ok(());
+    }
+    let (collision, collision_why) = read_all("collision")?;
+    if !visual_why.is_empty() && !collision.is_empty() && collision_why.is_empty() {
+        notes.push(format!(
+            "link `{name}`: its visual {}; its collision geometry is used",
+            visual_why.join(", ")
+        ));
+        placed.extend(collision);
+    } else if !visual.is_empty() {
+        notes.push(format!(
+            "link `{name}`: part of its visual geometry is left out: {}",
+            visual_why.join(", ")
+        ));
+        placed.extend(visual);
+    } else if !collision.is_empty() {
+        if !collision_why.is_empty() {
+            notes.push(format!(
+                "link `{name}`: part of its collision geometry is left out: {}",
+                collision_why.join(", ")
+            ));
+        }
+        placed.extend(collision);
+    } else if !visual_why.is_empty() || !collision_why.is_empty() {
+        notes.push(format!(
+            "link `{name}`: no geometry read: {}",
+            visual_why
+                .iter()
+                .chain(&collision_why)
+                .cloned()
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
+    Ok(())
+}
+
 /// The mesh files a URDF names, as far as they can be found: what decides its object besides
 /// the URDF itself (a batch's input hash reads them).
 pub fn referenced_files(path: &Path) -> Vec<PathBuf> {
@@ -378,7 +426,7 @@ pub fn referenced_files(path: &Path) -> Vec<PathBuf> {
 
 /// Triangles of a primitive in metres, centred on its frame.
 fn primitive(shape: &Shape) -> Vec<[[f64; 3]; 3]> {
-    use crate::objects;
+    use super::primitives as objects;
     let mm = |m: f64| m * 1000.0;
     let mut mesh = match *shape {
         Shape::Box(s) => {

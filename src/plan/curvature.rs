@@ -324,6 +324,22 @@ pub fn grade_side(
     out.trend_above_deg = ta.to_degrees();
     out.trend_below_deg = tb.to_degrees();
 
+    let (grade, category) = blended_grade(p, slope_deg, (ta, da), (tb, db));
+    out.category = category;
+    out.grade = Ok(grade);
+    out
+}
+
+/// The grade of a side and its dominant category from the trends above and below (each a trend
+/// `[rad]` and the distance to its nearest turn `[mm]`): the four categories their signs make,
+/// blended by how strong each trend is, the straight one (Cat_1, or Cat_5 when sloped) graded
+/// by the slope `slope_deg`.
+fn blended_grade(
+    p: &CurvatureParams,
+    slope_deg: f64,
+    (ta, da): (f64, f64),
+    (tb, db): (f64, f64),
+) -> (f64, Category) {
     let strength = |t: f64, d: f64| -> (i8, f64) {
         let deg = t.to_degrees();
         let k =
@@ -366,13 +382,12 @@ pub fn grade_side(
             ((0, 0), -1.0),
             |best, (cat, w)| if w > best.1 { (cat, w) } else { best },
         );
-    out.category = if da == 0 && db == 0 && excess > 0.0 {
+    let category = if da == 0 && db == 0 && excess > 0.0 {
         Category::Cat5
     } else {
         Category::from_signs(da, db)
     };
-    out.grade = Ok(grade);
-    out
+    (grade, category)
 }
 
 /// Angle of a direction from "straight on" along the walk, outward positive: `atan2(ds, dz)`
@@ -410,12 +425,9 @@ impl WalkStart<'_> {
     /// or bottom.
     fn walk(&self, forward: bool, vertical: Vertical, z_end: f64, p: &CurvatureParams) -> Walk {
         let WalkStart {
-            contour: c,
-            touch,
-            side,
+            contour: c, side, ..
         } = *self;
         let up = vertical == Vertical::Up;
-        let n = c.points.len();
         let seg_count = c.segment_count();
         let mut result = Walk {
             trend: 0.0,
@@ -424,25 +436,7 @@ impl WalkStart<'_> {
             sharp: false,
             reached_end: None,
         };
-        // The first vertex reached, and the direction of travel along the touched segment.
-        let (mut vertex, first_dir) = if forward {
-            let v = (touch.segment + 1) % n;
-            (v, c.points[v] - touch.point)
-        } else {
-            (touch.segment, c.points[touch.segment] - touch.point)
-        };
-        let (a, b) = c.segment(touch.segment);
-        let seg_dir = if forward { b - a } else { a - b };
-        let mut prev = angle_of(
-            if first_dir.norm() > 0.0 {
-                first_dir
-            } else {
-                seg_dir
-            },
-            side,
-            vertical,
-        );
-        let mut dist = first_dir.norm();
+        let (mut vertex, mut prev, mut dist) = self.first_step(forward, vertical);
         let mut counted = 0usize;
         let mut skips = 0usize;
         let is_end = |z: f64| {
@@ -460,16 +454,8 @@ impl WalkStart<'_> {
                 result.reached_end = Some(dist);
             }
             // The segment leaving `vertex` in the walk's direction.
-            let next = if forward {
-                if !c.is_closed && vertex + 1 >= n {
-                    break;
-                }
-                (vertex + 1) % n
-            } else {
-                if !c.is_closed && vertex == 0 {
-                    break;
-                }
-                (vertex + n - 1) % n
+            let Some(next) = next_vertex(c, vertex, forward) else {
+                break;
             };
             let v = c.points[next] - c.points[vertex];
             let len = v.norm();
@@ -497,6 +483,54 @@ impl WalkStart<'_> {
             vertex = next;
         }
         result
+    }
+
+    /// The walk's first step, from the touch point along the touched segment: the first vertex
+    /// reached, the direction's angle there (the segment's own where the touch is on that
+    /// vertex) and the distance walked `[mm]`.
+    fn first_step(&self, forward: bool, vertical: Vertical) -> (usize, f64, f64) {
+        let WalkStart {
+            contour: c,
+            touch,
+            side,
+        } = *self;
+        let n = c.points.len();
+        // The first vertex reached, and the direction of travel along the touched segment.
+        let (vertex, first_dir) = if forward {
+            let v = (touch.segment + 1) % n;
+            (v, c.points[v] - touch.point)
+        } else {
+            (touch.segment, c.points[touch.segment] - touch.point)
+        };
+        let (a, b) = c.segment(touch.segment);
+        let seg_dir = if forward { b - a } else { a - b };
+        let prev = angle_of(
+            if first_dir.norm() > 0.0 {
+                first_dir
+            } else {
+                seg_dir
+            },
+            side,
+            vertical,
+        );
+        (vertex, prev, first_dir.norm())
+    }
+}
+
+/// The vertex after `vertex` along `c` (backwards unless `forward`); `None` at an open
+/// contour's end.
+fn next_vertex(c: &Contour, vertex: usize, forward: bool) -> Option<usize> {
+    let n = c.points.len();
+    if forward {
+        if !c.is_closed && vertex + 1 >= n {
+            return None;
+        }
+        Some((vertex + 1) % n)
+    } else {
+        if !c.is_closed && vertex == 0 {
+            return None;
+        }
+        Some((vertex + n - 1) % n)
     }
 }
 

@@ -3,7 +3,8 @@
 //! - [`domain`]: stage 1 (3.4.2) — vertical slices, Effective Elevation, Indexed Elevations.
 //! - [`curvature`]: stage 2 (3.4.3.1) — curvature pattern grades.
 //! - [`diameter`]: stage 2 (3.4.3.2) — Effective Diameter grades.
-//! - [`kinematics`]: the hand's graspable diameter range (eq. 3.2 and its largest counterpart).
+//! - [`kinematics`]: the hand's graspable diameter range (eq. 3.2 and its largest counterpart),
+//!   which lives with the hand ([`crate::hand::kinematics`]: the hand file's validation needs it).
 //! - [`palm_grade`]: significance factors (3.4.3.3) and stage 3 (3.4.4): palm grades, sorting.
 //! - [`palm`]: palm positioning (3.5); [`finger`]: ALS finger positioning (3.6);
 //!   [`search`]: the walk over the sorted domain (3.7).
@@ -16,21 +17,23 @@ pub mod diameter;
 pub mod domain;
 pub mod finger;
 pub mod geom2;
-pub mod kinematics;
+pub use crate::hand::kinematics;
 pub mod palm;
 pub mod palm_grade;
 pub mod params;
 pub mod search;
+pub mod timings;
 
 pub use curvature::{CurvatureParams, SideGrade};
 pub use domain::{Domain, Touch};
 pub use palm_grade::{GradedDomain, Grades};
 pub use params::PlannerParams;
+pub use timings::StageTimings;
 
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::report::StageTimings;
 use std::time::Instant;
+use timings::ms;
 
 /// A grade of an indexed elevation: a number (larger is better), or ungraspable.
 pub type Grade = Option<f64>;
@@ -205,8 +208,4 @@ pub fn plan(
     let found = search::search(mesh, hand, &graded, params, max_grasps.max(1));
     timings.search = ms(t);
     (graded, found)
-}
-
-fn ms(t: Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1000.0
 }

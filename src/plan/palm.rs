@@ -104,6 +104,69 @@ pub fn place_palm_on(
     let (z_lo, z_hi) = (centre_z + h_lo - m, centre_z + h_hi + m);
 
     // Palm domain: right-side points in range, plus crossings of the range's ends.
+    let domain = palm_domain(vslice, z_lo, z_hi);
+    let first = *domain
+        .iter()
+        .max_by(|a, b| a.x.total_cmp(&b.x).then(b.y.total_cmp(&a.y)))
+        .ok_or(PalmRejection::NoContact)?;
+
+    let (second, pitch) = second_contact(&domain, first, centre_z);
+    let (second, pitch) = if pitch.abs() > pitch_range_rad + 1e-12 {
+        if second.is_some() && domain.len() > 1 {
+            return Err(PalmRejection::PitchOutOfRange);
+        }
+        (None, 0.0)
+    } else {
+        (second, pitch)
+    };
+
+    // Up axis of the palm in the slice, and its outward normal (away from the object).
+    let up = Vector2::new(-pitch.sin(), pitch.cos());
+    let back = Vector2::new(pitch.cos(), pitch.sin());
+    // Finger_1's point on the contact line at elevation z1, then the palm centre.
+    let t = (z1 - first.y) / up.y;
+    let p1 = first + up * t;
+    let mut centre = p1 - up * h1;
+    let mut backed_off_mm = 0.0;
+    if back_off {
+        let depth = penetration_depth(vslice, centre, up, back, hand.palm_z_range_mm());
+        if depth > PENETRATION_TOL_MM {
+            centre += back * depth;
+            backed_off_mm = depth;
+        }
+    }
+    let [p_lo, p_hi] = hand.palm_z_range_mm();
+    let outline = ConvexPolygon::new(vec![
+        centre + up * p_lo,
+        centre + up * p_hi,
+        centre + up * p_hi + back * hand.palm.offset_mm,
+        centre + up * p_lo + back * hand.palm.offset_mm,
+    ]);
+    if is_penetrated(vslice, &outline) {
+        return Err(PalmRejection::Penetration);
+    }
+
+    let u = plane.u;
+    let z = Vector3::z();
+    let x_p = u * pitch.cos() + z * pitch.sin();
+    let z_p = -u * pitch.sin() + z * pitch.cos();
+    let y_p = z_p.cross(&x_p);
+    let mut contacts = vec![first];
+    contacts.extend(second);
+    Ok(PalmPlacement {
+        approach_rad,
+        pitch_rad: pitch,
+        origin: plane.to_3d(&centre),
+        axes: [x_p, y_p, z_p],
+        contacts,
+        slice: vslice.clone(),
+        backed_off_mm,
+    })
+}
+
+/// The palm domain in `vslice`: the points on the object's right side (x > 0) between heights
+/// `z_lo` and `z_hi`, and where a contour crosses those heights there.
+fn palm_domain(vslice: &Slice, z_lo: f64, z_hi: f64) -> Vec<Point2<f64>> {
     let mut domain: Vec<Point2<f64>> = Vec::new();
     for c in &vslice.contours {
         for (i, p) in c.points.iter().enumerate() {
@@ -124,16 +187,23 @@ pub fn place_palm_on(
             }
         }
     }
-    let first = *domain
-        .iter()
-        .max_by(|a, b| a.x.total_cmp(&b.x).then(b.y.total_cmp(&a.y)))
-        .ok_or(PalmRejection::NoContact)?;
+    domain
+}
 
+/// The palm's second contact and its pitch `[rad]` about the first contact `first`, among the
+/// `domain` points (the palm centre at height `centre_z`): with the first at the midpoint, the
+/// second-outermost point; else the point on the other half the palm line reaches first.
+/// `(None, 0)` when there is none.
+fn second_contact(
+    domain: &[Point2<f64>],
+    first: Point2<f64>,
+    centre_z: f64,
+) -> (Option<Point2<f64>>, f64) {
     // The rotation about `first` that brings the palm line onto point p (≥ 0 when p is not
     // outside the line).
     let angle_to = |p: &Point2<f64>| (first.x - p.x).atan2((first.y - p.y).abs());
     let eps = 1e-9;
-    let (second, pitch) = if (first.y - centre_z).abs() <= eps {
+    if (first.y - centre_z).abs() <= eps {
         // Midpoint: the second-outermost point, either half.
         let second = domain
             .iter()
@@ -167,63 +237,21 @@ pub fn place_palm_on(
             Some((phi, p)) => (Some(p), if top_first { -phi } else { phi }),
             None => (None, 0.0),
         }
-    };
-    let (second, pitch) = if pitch.abs() > pitch_range_rad + 1e-12 {
-        if second.is_some() && domain.len() > 1 {
-            return Err(PalmRejection::PitchOutOfRange);
-        }
-        (None, 0.0)
-    } else {
-        (second, pitch)
-    };
-
-    // Up axis of the palm in the slice, and its outward normal (away from the object).
-    let up = Vector2::new(-pitch.sin(), pitch.cos());
-    let back = Vector2::new(pitch.cos(), pitch.sin());
-    // Finger_1's point on the contact line at elevation z1, then the palm centre.
-    let t = (z1 - first.y) / up.y;
-    let p1 = first + up * t;
-    let mut centre = p1 - up * h1;
-    let mut backed_off_mm = 0.0;
-    if back_off {
-        let depth = penetration_depth(vslice, centre, up, back, hand.palm_z_range_mm());
-        if depth > PENETRATION_TOL_MM {
-            centre += back * depth;
-            backed_off_mm = depth;
-        }
     }
-    let [p_lo, p_hi] = hand.palm_z_range_mm();
-    let outline = ConvexPolygon::new(vec![
-        centre + up * p_lo,
-        centre + up * p_hi,
-        centre + up * p_hi + back * hand.palm.offset_mm,
-        centre + up * p_lo + back * hand.palm.offset_mm,
-    ]);
+}
+
+/// Returns true if and only if a segment of `vslice` enters the palm `outline` by more than
+/// [`PENETRATION_TOL_MM`].
+fn is_penetrated(vslice: &Slice, outline: &ConvexPolygon) -> bool {
     for c in &vslice.contours {
         for i in 0..c.segment_count() {
             let (a, b) = c.segment(i);
             if outline.is_penetrated_by(a, b, PENETRATION_TOL_MM) {
-                return Err(PalmRejection::Penetration);
+                return true;
             }
         }
     }
-
-    let u = plane.u;
-    let z = Vector3::z();
-    let x_p = u * pitch.cos() + z * pitch.sin();
-    let z_p = -u * pitch.sin() + z * pitch.cos();
-    let y_p = z_p.cross(&x_p);
-    let mut contacts = vec![first];
-    contacts.extend(second);
-    Ok(PalmPlacement {
-        approach_rad,
-        pitch_rad: pitch,
-        origin: plane.to_3d(&centre),
-        axes: [x_p, y_p, z_p],
-        contacts,
-        slice: vslice.clone(),
-        backed_off_mm,
-    })
+    false
 }
 
 impl PalmPlacement {

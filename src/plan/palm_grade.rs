@@ -117,71 +117,18 @@ pub fn rank_with(
     let low = *finger_offsets.iter().min().unwrap_or(&0);
 
     // Largest Span Height between consecutive ungraspable indices (ends count one step out).
-    let mut last_bad: i64 = 0;
-    let mut largest = 0i64;
-    for i in 1..=n as i64 + 1 {
-        if i == n as i64 + 1 || combined[(i - 1) as usize].is_none() {
-            largest = largest.max(i - last_bad);
-            last_bad = i;
-        }
-    }
+    let largest = largest_span_steps(&combined);
     let largest_span_mm = largest as f64 * step;
     let finger_span_mm = (spread - low) as f64 * step;
 
-    let mut palm: Vec<Grade> = vec![None; n];
-    if rules.is_extended() {
-        let o = hand.fingers.offset_mm;
-        let inner_range = [domain.span_mm[0] + o, domain.span_mm[1] - o];
-        for (i0, slot) in palm.iter_mut().enumerate() {
-            let i = i0 as i64;
-            let mut sum = 0.0;
-            let mut ok = true;
-            for &off in &finger_offsets {
-                let j = i - off;
-                if j < 0 || j >= n as i64 {
-                    ok = false;
-                    break;
-                }
-                let g = combined[j as usize];
-                let is_outer = spread != low && (off == spread || off == low);
-                let z = domain.elevations[j as usize];
-                let inside = z >= inner_range[0] - 1e-9 && z <= inner_range[1] + 1e-9;
-                if !is_outer && (g.is_none() || !inside) {
-                    ok = false;
-                    break;
-                }
-                sum += g.unwrap_or(0.0);
-            }
-            if ok {
-                *slot = Some(sum / finger_offsets.len() as f64);
-            }
-        }
+    let palm = if rules.is_extended() {
+        extended_palm_grades(&domain, &combined, &finger_offsets, hand.fingers.offset_mm)
     } else if largest_span_mm > finger_span_mm {
-        for (i0, slot) in palm.iter_mut().enumerate() {
-            let i = i0 as i64;
-            let (lo, hi) = (i - spread, i - low);
-            if lo < 0 || hi >= n as i64 {
-                continue;
-            }
-            if (lo..=hi).any(|j| combined[j as usize].is_none()) {
-                continue;
-            }
-            let sum: f64 = finger_offsets
-                .iter()
-                .map(|&o| combined[(i - o) as usize].unwrap_or(0.0))
-                .sum();
-            *slot = Some(sum / finger_offsets.len() as f64);
-        }
-    }
-    let mut sorted: Vec<(i64, usize)> = palm
-        .iter()
-        .enumerate()
-        // Grades are compared at 1e-6: two elevations a symmetry makes equal differ by
-        // round-off (1e-13), which must not decide their order in one frame and not another.
-        .filter_map(|(i, g)| g.map(|g| ((g * 1e6).round() as i64, i + 1)))
-        .collect();
-    sorted.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.cmp(&a.1)));
-    let sorted_indices: Vec<usize> = sorted.into_iter().map(|(_, i)| i).collect();
+        thesis_palm_grades(&combined, &finger_offsets)
+    } else {
+        vec![None; n]
+    };
+    let sorted_indices = sorted_by_grade(&palm);
 
     let reason = sorted_indices.is_empty().then(|| {
         explain(
@@ -210,6 +157,101 @@ pub fn rank_with(
         reason,
         curvature_relaxed: vec![false; n],
     }
+}
+
+/// The number of steps of the Largest Span Height: the longest run between consecutive
+/// ungraspable indices of `combined`, the ends counting one step out (thesis 3.4.4).
+fn largest_span_steps(combined: &[Grade]) -> i64 {
+    let n = combined.len();
+    let mut last_bad: i64 = 0;
+    let mut largest = 0i64;
+    for i in 1..=n as i64 + 1 {
+        if i == n as i64 + 1 || combined[(i - 1) as usize].is_none() {
+            largest = largest.max(i - last_bad);
+            last_bad = i;
+        }
+    }
+    largest
+}
+
+/// Palm grades under the extended rules: every finger on an index of the object, the inner
+/// fingers on graded indices within the Effective Elevation (`offset_mm`, the finger offset,
+/// inside the domain's span), the outer ones anywhere (an ungraded one counts 0).
+fn extended_palm_grades(
+    domain: &Domain,
+    combined: &[Grade],
+    finger_offsets: &[i64],
+    offset_mm: f64,
+) -> Vec<Grade> {
+    let n = combined.len();
+    let spread = *finger_offsets.iter().max().unwrap_or(&0);
+    let low = *finger_offsets.iter().min().unwrap_or(&0);
+    let mut palm: Vec<Grade> = vec![None; n];
+    let o = offset_mm;
+    let inner_range = [domain.span_mm[0] + o, domain.span_mm[1] - o];
+    for (i0, slot) in palm.iter_mut().enumerate() {
+        let i = i0 as i64;
+        let mut sum = 0.0;
+        let mut ok = true;
+        for &off in finger_offsets {
+            let j = i - off;
+            if j < 0 || j >= n as i64 {
+                ok = false;
+                break;
+            }
+            let g = combined[j as usize];
+            let is_outer = spread != low && (off == spread || off == low);
+            let z = domain.elevations[j as usize];
+            let inside = z >= inner_range[0] - 1e-9 && z <= inner_range[1] + 1e-9;
+            if !is_outer && (g.is_none() || !inside) {
+                ok = false;
+                break;
+            }
+            sum += g.unwrap_or(0.0);
+        }
+        if ok {
+            *slot = Some(sum / finger_offsets.len() as f64);
+        }
+    }
+    palm
+}
+
+/// Palm grades under the thesis's rules: the mean combined grade of the fingers' indices where
+/// every index the fingers span is graded.
+fn thesis_palm_grades(combined: &[Grade], finger_offsets: &[i64]) -> Vec<Grade> {
+    let n = combined.len();
+    let spread = *finger_offsets.iter().max().unwrap_or(&0);
+    let low = *finger_offsets.iter().min().unwrap_or(&0);
+    let mut palm: Vec<Grade> = vec![None; n];
+    for (i0, slot) in palm.iter_mut().enumerate() {
+        let i = i0 as i64;
+        let (lo, hi) = (i - spread, i - low);
+        if lo < 0 || hi >= n as i64 {
+            continue;
+        }
+        if (lo..=hi).any(|j| combined[j as usize].is_none()) {
+            continue;
+        }
+        let sum: f64 = finger_offsets
+            .iter()
+            .map(|&o| combined[(i - o) as usize].unwrap_or(0.0))
+            .sum();
+        *slot = Some(sum / finger_offsets.len() as f64);
+    }
+    palm
+}
+
+/// The 1-based indices with a palm grade, best first (ties: the higher index first).
+fn sorted_by_grade(palm: &[Grade]) -> Vec<usize> {
+    let mut sorted: Vec<(i64, usize)> = palm
+        .iter()
+        .enumerate()
+        // Grades are compared at 1e-6: two elevations a symmetry makes equal differ by
+        // round-off (1e-13), which must not decide their order in one frame and not another.
+        .filter_map(|(i, g)| g.map(|g| ((g * 1e6).round() as i64, i + 1)))
+        .collect();
+    sorted.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.cmp(&a.1)));
+    sorted.into_iter().map(|(_, i)| i).collect()
 }
 
 fn explain(

@@ -188,12 +188,7 @@ fn search_scheduled(
     // The palm's vertical slice depends on the approach angle only: cut once per angle, when
     // the search first needs it (by whichever thread gets there first).
     let vslices: Vec<OnceLock<Slice>> = angles.iter().map(|_| OnceLock::new()).collect();
-    let candidates: Vec<(usize, usize)> = graded
-        .sorted_indices
-        .iter()
-        .flat_map(|&index| (0..angles.len()).map(move |a| (index, a)))
-        .take(budget)
-        .collect();
+    let candidates = candidate_order(graded, angles.len(), budget);
     // Every finger plane of every candidate is cut through one index of the mesh's triangles.
     let index = SliceIndex::new(mesh);
     let evaluate = |&(index_z, a): &(usize, usize)| {
@@ -226,23 +221,7 @@ fn search_scheduled(
             tried += 1;
             match result {
                 Ok((palm, fingers)) => {
-                    let mut relaxations: Vec<Relaxation> = fingers
-                        .iter()
-                        .flat_map(|f| f.relaxations.iter().copied())
-                        .collect();
-                    if finger_indices(graded, index)
-                        .any(|j| graded.curvature_relaxed.get(j - 1) == Some(&true))
-                    {
-                        relaxations.push(Relaxation::CurvatureGraded);
-                    }
-                    if palm.backed_off_mm > 0.0 {
-                        relaxations.push(Relaxation::PalmBackedOff);
-                    }
-                    if rules.is_extended() && uses_outer_elevation(graded, index, hand) {
-                        relaxations.push(Relaxation::OuterFingerBeyondElevation);
-                    }
-                    relaxations.sort();
-                    relaxations.dedup();
+                    let relaxations = relaxations_of(graded, index, hand, rules, &palm, &fingers);
                     let go_on = on_grasp(Grasp {
                         elevation_index: index,
                         elevation_mm: graded.domain.elevations[index - 1],
@@ -265,6 +244,50 @@ fn search_scheduled(
         start = end;
     }
     (tried, rejections)
+}
+
+/// The relaxations of the extended rules a grasp at elevation `index` uses, sorted, once each:
+/// its fingers' own, a finger on an index whose curvature grade was relaxed, a backed-off palm,
+/// an outer finger beyond the Effective Elevation.
+fn relaxations_of(
+    graded: &GradedDomain,
+    index: usize,
+    hand: &Hand,
+    rules: RuleSet,
+    palm: &PalmPlacement,
+    fingers: &[FingerPlacement],
+) -> Vec<Relaxation> {
+    let mut relaxations: Vec<Relaxation> = fingers
+        .iter()
+        .flat_map(|f| f.relaxations.iter().copied())
+        .collect();
+    if finger_indices(graded, index).any(|j| graded.curvature_relaxed.get(j - 1) == Some(&true)) {
+        relaxations.push(Relaxation::CurvatureGraded);
+    }
+    if palm.backed_off_mm > 0.0 {
+        relaxations.push(Relaxation::PalmBackedOff);
+    }
+    if rules.is_extended() && uses_outer_elevation(graded, index, hand) {
+        relaxations.push(Relaxation::OuterFingerBeyondElevation);
+    }
+    relaxations.sort();
+    relaxations.dedup();
+    relaxations
+}
+
+/// The search's candidates in order, at most `budget`: each sorted elevation index (1-based)
+/// with each of the `angle_count` approach angles.
+fn candidate_order(
+    graded: &GradedDomain,
+    angle_count: usize,
+    budget: usize,
+) -> Vec<(usize, usize)> {
+    graded
+        .sorted_indices
+        .iter()
+        .flat_map(|&index| (0..angle_count).map(move |a| (index, a)))
+        .take(budget)
+        .collect()
 }
 
 /// One candidate of the search: Finger_1's elevation and the approach angle, with the palm's
@@ -369,7 +392,7 @@ fn palm_backoff_in_finger_planes(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::report::StageTimings;
+    use crate::plan::StageTimings;
 
     #[test]
     fn every_schedule_gives_the_one_at_a_time_search() {

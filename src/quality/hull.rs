@@ -372,33 +372,7 @@ fn quickhull(
 /// (or are dropped, being inside). Returns the new facets' ids; `None` on round-off (a new
 /// facet degenerate, or a horizon that does not close).
 fn add_point(b: &mut Builder, from: u32, p: u32) -> Option<Vec<u32>> {
-    b.stamp += 1;
-    let stamp = b.stamp;
-    b.facets[from as usize].seen = stamp;
-    b.facets[from as usize].visible = true;
-    let mut visible = vec![from];
-    let mut i = 0;
-    while i < visible.len() {
-        let f = visible[i];
-        i += 1;
-        for k in 0..DIM {
-            let g = b.facets[f as usize].nb[k];
-            if b.facets[g as usize].seen == stamp {
-                continue;
-            }
-            let d = b.distance(g as usize, p);
-            if d.abs() <= b.tol {
-                // Coplanar within round-off: joggle more (as qhull's QJ does).
-                return None;
-            }
-            let vis = d > b.tol;
-            b.facets[g as usize].seen = stamp;
-            b.facets[g as usize].visible = vis;
-            if vis {
-                visible.push(g);
-            }
-        }
-    }
+    let visible = visible_from(b, from, p)?;
     let first_new = b.facets.len();
     // Each new facet's ridges through `p`, to be paired with the one new facet sharing each.
     let mut open: Vec<(u128, u32, u8)> = Vec::new();
@@ -409,24 +383,7 @@ fn add_point(b: &mut Builder, from: u32, p: u32) -> Option<Vec<u32>> {
                 continue;
             }
             // The ridge (sorted, as every facet's vertices are) with `p` put in its place.
-            let old = b.facets[f as usize].v;
-            let mut v = [0u32; DIM];
-            let mut pos = 0;
-            let mut j = 0;
-            for (i, &x) in old.iter().enumerate() {
-                if i == k {
-                    continue;
-                }
-                if x < p {
-                    v[j] = x;
-                    j += 1;
-                    pos = j;
-                } else {
-                    v[j + 1] = x;
-                    j += 1;
-                }
-            }
-            v[pos] = p;
+            let (v, pos) = ridge_with(&b.facets[f as usize].v, k, p);
             let mut nf = b.facet(v)?;
             let id = b.facets.len() as u32;
             nf.nb[pos] = g;
@@ -468,6 +425,62 @@ fn add_point(b: &mut Builder, from: u32, p: u32) -> Option<Vec<u32>> {
         }
     }
     Some(new)
+}
+
+/// The facets `p` is beyond, found from `from` across neighbours (each marked visible and
+/// seen); `None` when `p` is coplanar with one within round-off (joggle more).
+fn visible_from(b: &mut Builder, from: u32, p: u32) -> Option<Vec<u32>> {
+    b.stamp += 1;
+    let stamp = b.stamp;
+    b.facets[from as usize].seen = stamp;
+    b.facets[from as usize].visible = true;
+    let mut visible = vec![from];
+    let mut i = 0;
+    while i < visible.len() {
+        let f = visible[i];
+        i += 1;
+        for k in 0..DIM {
+            let g = b.facets[f as usize].nb[k];
+            if b.facets[g as usize].seen == stamp {
+                continue;
+            }
+            let d = b.distance(g as usize, p);
+            if d.abs() <= b.tol {
+                // Coplanar within round-off: joggle more (as qhull's QJ does).
+                return None;
+            }
+            let vis = d > b.tol;
+            b.facets[g as usize].seen = stamp;
+            b.facets[g as usize].visible = vis;
+            if vis {
+                visible.push(g);
+            }
+        }
+    }
+    Some(visible)
+}
+
+/// A facet's vertices `facet` (sorted) without the `k`-th, with `p` in its sorted place: the
+/// new facet's vertices and `p`'s position among them.
+fn ridge_with(facet: &[u32; DIM], k: usize, p: u32) -> ([u32; DIM], usize) {
+    let mut v = [0u32; DIM];
+    let mut pos = 0;
+    let mut j = 0;
+    for (i, &x) in facet.iter().enumerate() {
+        if i == k {
+            continue;
+        }
+        if x < p {
+            v[j] = x;
+            j += 1;
+            pos = j;
+        } else {
+            v[j + 1] = x;
+            j += 1;
+        }
+    }
+    v[pos] = p;
+    (v, pos)
 }
 
 /// The unit normal of the hyperplane through the six points `p`, or `None` when they span

@@ -26,7 +26,7 @@
 //! Contacts whose edge wrenches agree (rapier can report one contact twice) are merged first:
 //! `P + P = 2P` exactly for a convex `P`.
 
-use super::Wrench;
+use super::{QualityError, Wrench};
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, HashMap};
 
@@ -377,7 +377,7 @@ pub struct Search {
 
 /// Epsilon of `W = Σᵢ conv({0} ∪ per_contact[i])` by the expanding polytope, adding at most
 /// `max_points` support points (`Err` with the reason beyond, or when round-off stops it).
-pub fn epsilon(per_contact: &[Vec<Wrench>], max_points: usize) -> Result<Search, String> {
+pub fn epsilon(per_contact: &[Vec<Wrench>], max_points: usize) -> Result<Search, QualityError> {
     let outside = |note: String| Search {
         epsilon: 0.0,
         bracket: (0.0, 0.0),
@@ -421,15 +421,15 @@ pub fn epsilon(per_contact: &[Vec<Wrench>], max_points: usize) -> Result<Search,
             });
         }
         if added >= max_points {
-            return Err(format!(
-                "not settled after {added} support points (epsilon between {lower:.6} and {upper:.6})"
-            ));
+            return Err(QualityError::NotSettled {
+                added,
+                lower,
+                upper,
+            });
         }
         let beyond = dot(&n, &s) - poly.facets[f as usize].plane;
         if beyond <= tol_vis {
-            return Err(format!(
-                "round-off stopped the search (epsilon between {lower:.9} and {upper:.9})"
-            ));
+            return Err(QualityError::RoundOff { lower, upper });
         }
         if poly.add(s, f, tol_vis).is_none() {
             // Round-off in the beneath–beyond step (a new facet nearly flat): the hull is taken of
@@ -437,14 +437,12 @@ pub fn epsilon(per_contact: &[Vec<Wrench>], max_points: usize) -> Result<Search,
             facets += poly.facets.len();
             let mut points = std::mem::take(&mut poly.points);
             points.push(s);
-            poly = Polytope::hull(points).ok_or_else(|| {
-                format!("the hull failed on the inner polytope (epsilon between {lower:.9} and {upper:.9})")
-            })?;
+            poly = Polytope::hull(points).ok_or(QualityError::InnerHull { lower, upper })?;
             rebuilds += 1;
         }
         added += 1;
     }
-    Err("the inner polytope lost its facets".to_string())
+    Err(QualityError::FacetsLost)
 }
 
 enum Start {
@@ -456,7 +454,7 @@ enum Start {
 /// The initial inner polytope: the hull of support points of `W`, grown (in the
 /// directions of the facets the origin is beyond) until the origin is strictly inside; or the
 /// proof that it cannot be (a direction in which `W` does not reach past the origin).
-fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, String> {
+fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, QualityError> {
     let all: Vec<Wrench> = per_contact.iter().flatten().copied().collect();
     let rank = super::affine_rank(&all.iter().copied().chain([[0.0; DIM]]).collect::<Vec<_>>());
     if rank < DIM {
@@ -488,7 +486,7 @@ fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, String> {
             let p0 = points[0];
             let m = nalgebra::DMatrix::from_fn(DIM, points.len(), |r, c| points[c][r] - p0[r]);
             let svd = m.svd(true, false);
-            let u = svd.u.ok_or("SVD failed")?;
+            let u = svd.u.ok_or(QualityError::Svd)?;
             let mut grew = false;
             for (k, sv) in svd.singular_values.iter().enumerate() {
                 if *sv <= 1e-9 * width * (points.len() as f64).sqrt() {
@@ -501,11 +499,11 @@ fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, String> {
                 }
             }
             if !grew {
-                return Err("the support points do not span 6 dimensions".to_string());
+                return Err(QualityError::SupportSpan);
             }
             continue;
         }
-        let facets = hull_facets(&points).ok_or("the hull failed on the initial polytope")?;
+        let facets = hull_facets(&points).ok_or(QualityError::InitialHull)?;
         // Facets the origin is not strictly inside of: W must reach past the origin there.
         let mut grew = false;
         for (n, offset) in facets.iter().map(|f| (f.1, f.2)) {
@@ -524,10 +522,10 @@ fn initial(per_contact: &[Vec<Wrench>], width: f64) -> Result<Start, String> {
         if !grew {
             return Polytope::hull(points)
                 .map(Start::Polytope)
-                .ok_or_else(|| "the initial polytope is degenerate".to_string());
+                .ok_or(QualityError::InitialDegenerate);
         }
     }
-    Err("no initial polytope around the origin after 200 rounds".to_string())
+    Err(QualityError::NoInitialPolytope)
 }
 
 /// The hull's simplicial facets of `points` ([`super::hull`]): vertex indices, unit normal,

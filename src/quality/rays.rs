@@ -28,7 +28,7 @@
 //! and a dense tableau solves one in tens of microseconds; a general sparse solver (microlp,
 //! measured) took 0.8 ms, which at a thousand rays would cost more than the physics check.
 
-use super::Wrench;
+use super::{QualityError, Wrench};
 use nalgebra::{Matrix6, Vector6};
 use rayon::prelude::*;
 
@@ -54,7 +54,7 @@ pub struct RayVolume {
 /// The largest `t` with `c + t·u ∈ W`, `W = Σᵢ conv({0} ∪ edgesᵢ)`, where `c` lies in `W` and
 /// `u` is a unit vector; an error when the programme is infeasible (`c` outside `W`) or
 /// unbounded, which a bounded `W` with `c` inside cannot be.
-pub fn ray_exit(per_contact: &[Vec<Wrench>], c: &Wrench, u: &Wrench) -> Result<f64, String> {
+pub fn ray_exit(per_contact: &[Vec<Wrench>], c: &Wrench, u: &Wrench) -> Result<f64, QualityError> {
     RayCaster::new(per_contact, c)?.exit(u)
 }
 
@@ -76,7 +76,7 @@ pub struct RayCaster {
 
 impl RayCaster {
     /// The first phase for `W` and `c`; an error when `c` is outside `W`.
-    pub fn new(per_contact: &[Vec<Wrench>], c: &Wrench) -> Result<RayCaster, String> {
+    pub fn new(per_contact: &[Vec<Wrench>], c: &Wrench) -> Result<RayCaster, QualityError> {
         let contacts: Vec<&Vec<Wrench>> = per_contact.iter().filter(|e| !e.is_empty()).collect();
         let k = contacts.len();
         let n_alpha: usize = contacts.iter().map(|e| e.len()).sum();
@@ -133,29 +133,12 @@ impl RayCaster {
         }
         simplex(&mut tab, &mut basis, width, rows, col_art, tol)?;
         if tab[obj + cols] < -1e-9 * scale {
-            return Err("the centre is outside the wrench space".into());
+            return Err(QualityError::CentreOutside);
         }
-        // Artificials still basic (at 0, up to round-off) leave the basis on their row's
-        // largest entry.
-        for r in 0..DIM {
-            if basis[r] >= col_art {
-                let row = &tab[r * width..r * width + col_art];
-                let (j, a) = row.iter().enumerate().fold((0, 0.0f64), |b, (j, v)| {
-                    if v.abs() > b.1 {
-                        (j, v.abs())
-                    } else {
-                        b
-                    }
-                });
-                if a > 1e-9 * scale {
-                    tab[r * width + cols] = 0.0;
-                    pivot(&mut tab, &mut basis, width, rows, r, j);
-                }
-            }
-        }
+        drive_out_artificials(&mut tab, &mut basis, width, rows, col_art, scale);
         if basis[..DIM].iter().any(|&b| b >= col_art) {
             // A wrench row that no edge reaches: W is not full-dimensional.
-            return Err("the wrench space spans fewer than 6 dimensions".into());
+            return Err(QualityError::FewerDimensions);
         }
         Ok(RayCaster {
             tab,
@@ -170,7 +153,7 @@ impl RayCaster {
     }
 
     /// The largest `t` with `c + t·u ∈ W`, `u` a unit vector.
-    pub fn exit(&self, u: &Wrench) -> Result<f64, String> {
+    pub fn exit(&self, u: &Wrench) -> Result<f64, QualityError> {
         let (width, rows, col_t, col_art) = (self.width, self.rows, self.col_t, self.col_art);
         let mut tab = self.tab.clone();
         let mut basis = self.basis.clone();
@@ -197,7 +180,37 @@ impl RayCaster {
         if t.is_finite() && t >= 0.0 {
             Ok(t)
         } else {
-            Err(format!("the ray programme ended at t = {t}"))
+            Err(QualityError::RayEnd { t })
+        }
+    }
+}
+
+/// Moves the artificials still basic after the first phase (at 0, up to round-off) out of the
+/// basis, each on its row's largest entry; one whose row has none stays (its wrench row is
+/// reached by no edge). Columns `col_art..` are the artificials, the last the right-hand side.
+fn drive_out_artificials(
+    tab: &mut [f64],
+    basis: &mut [usize],
+    width: usize,
+    rows: usize,
+    col_art: usize,
+    scale: f64,
+) {
+    let cols = col_art + DIM;
+    for r in 0..DIM {
+        if basis[r] >= col_art {
+            let row = &tab[r * width..r * width + col_art];
+            let (j, a) = row.iter().enumerate().fold((0, 0.0f64), |b, (j, v)| {
+                if v.abs() > b.1 {
+                    (j, v.abs())
+                } else {
+                    b
+                }
+            });
+            if a > 1e-9 * scale {
+                tab[r * width + cols] = 0.0;
+                pivot(tab, basis, width, rows, r, j);
+            }
         }
     }
 }
@@ -236,7 +249,7 @@ fn simplex(
     rows: usize,
     enter_below: usize,
     tol: f64,
-) -> Result<(), String> {
+) -> Result<(), QualityError> {
     let obj = rows * width;
     let rhs = width - 1;
     let mut stalled = 0;
@@ -271,13 +284,13 @@ fn simplex(
             }
         }
         let Some((r, ratio)) = leave else {
-            return Err("unbounded ray".into());
+            return Err(QualityError::UnboundedRay);
         };
         let gain = ratio * -tab[obj + j];
         stalled = if gain > tol { 0 } else { stalled + 1 };
         pivot(tab, basis, width, rows, r, j);
     }
-    Err("the simplex method did not finish in 10000 pivots".into())
+    Err(QualityError::SimplexPivots)
 }
 
 /// `W`'s centre: the sum of each `Pᵢ`'s vertex centroid.
@@ -343,7 +356,7 @@ pub fn directions(rays: usize) -> Vec<Wrench> {
 }
 
 /// The volume of `W` from `rays` rays (rounded down to pairs, at least one pair).
-pub fn volume(per_contact: &[Vec<Wrench>], rays: usize) -> Result<RayVolume, String> {
+pub fn volume(per_contact: &[Vec<Wrench>], rays: usize) -> Result<RayVolume, QualityError> {
     let zero = RayVolume {
         volume: 0.0,
         rel_se: 0.0,
@@ -355,11 +368,11 @@ pub fn volume(per_contact: &[Vec<Wrench>], rays: usize) -> Result<RayVolume, Str
         .flatten()
         .any(|v| !v.is_finite())
     {
-        return Err("a wrench is not finite".into());
+        return Err(QualityError::WrenchNotFinite);
     }
     let cov = spread(per_contact);
     if cov.iter().any(|v| !v.is_finite()) {
-        return Err("the wrench spread is not finite".into());
+        return Err(QualityError::SpreadNotFinite);
     }
     let eig = cov.symmetric_eigenvalues();
     let (lo, hi) = eig
@@ -370,7 +383,7 @@ pub fn volume(per_contact: &[Vec<Wrench>], rays: usize) -> Result<RayVolume, Str
     }
     let l = cov
         .cholesky()
-        .ok_or("the wrench spread is not positive definite")?
+        .ok_or(QualityError::SpreadNotPositiveDefinite)?
         .l();
     let jacobian: f64 = (0..DIM).map(|i| l[(i, i)]).product();
     // The rays are shot in the whitened frame, `L⁻¹W`, whose spread is the identity: its
@@ -386,7 +399,7 @@ pub fn volume(per_contact: &[Vec<Wrench>], rays: usize) -> Result<RayVolume, Str
     let caster = RayCaster::new(&whitened, &whiten(&centre(per_contact)))?;
     // At least two pairs, for a standard error.
     let dirs = directions(rays.max(4));
-    let exits: Vec<Result<f64, String>> = dirs.par_iter().map(|g| caster.exit(g)).collect();
+    let exits: Vec<Result<f64, QualityError>> = dirs.par_iter().map(|g| caster.exit(g)).collect();
     // The first error in the directions' order, so that the message is the same every run.
     let radii: Vec<f64> = exits.into_iter().collect::<Result<_, _>>()?;
     let pairs: Vec<f64> = radii

@@ -21,7 +21,7 @@
 //!   largest diameter of 0. A hand whose range is empty (it wraps no circle, or none larger than
 //!   eq. 3.2's) is refused when its hand file is read, with the reason.
 
-use crate::hand::Hand;
+use super::Hand;
 use nalgebra::{Point2, Rotation2, Vector2};
 
 /// The graspable diameter range of a hand `[mm]`.

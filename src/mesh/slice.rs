@@ -1,0 +1,1155 @@
+//! Plane ∩ mesh: closed contours with projected outward normals (thesis 3.3.1, Fig. 3.2–3.4).
+//!
+//! Input: a [`Mesh`] and a [`Plane`]. Output: a [`Slice`], every contour as an ordered polyline in
+//! the plane's 2D coordinates `(u, v)` `[mm]`, with the outward normal of each segment: the
+//! triangle's normal projected onto the plane and normalised (thesis 3.3.1).
+//!
+//! Robust chaining (why not parry's `intersection_with_local_plane`: the planner also needs each
+//! segment's outward normal and the contour orientation):
+//! - A vertex exactly on the plane counts as above it (symbolic perturbation), so every triangle
+//!   is cut by zero or two of its edges and no case is special. In effect the cut is taken an
+//!   infinitesimal distance on the plane's negative side: a plane lying in a face facing its
+//!   normal (a top cap) gives that face's outline; one lying in a face facing away (a bottom cap)
+//!   gives nothing, as a plane just below the object would.
+//! - A crossing point is identified by its mesh edge, and computed from the edge's vertices in
+//!   index order, so the two triangles sharing an edge produce the bit-identical point.
+//! - A segment is oriented by the triangle's winding, not by geometry, so a zero-length segment
+//!   (a vertex on the plane) still chains; zero-length segments are removed afterwards.
+//!
+//! Orientation: seen from the plane's normal side, an outer boundary runs counter-clockwise
+//! (positive signed area, outward normals on its right) and a hole clockwise.
+
+use crate::mesh::Mesh;
+use nalgebra::{Point2, Point3, Vector2, Vector3};
+use std::collections::{HashMap, HashSet};
+
+/// A cutting plane with an orthonormal in-plane frame.
+///
+/// 2D coordinates are `((p - origin)·u, (p - origin)·v)`; the normal is `u × v`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    /// A point on the plane `[mm]`.
+    pub origin: Point3<f64>,
+    /// First in-plane axis (unit).
+    pub u: Vector3<f64>,
+    /// Second in-plane axis (unit, orthogonal to `u`).
+    pub v: Vector3<f64>,
+}
+
+impl Plane {
+    /// A plane through `origin` spanned by `u` and `v` (orthonormalised: `v` is made orthogonal
+    /// to `u`).
+    ///
+    /// # Panics
+    /// If `u` and `v` are parallel or zero.
+    pub fn new(origin: Point3<f64>, u: Vector3<f64>, v: Vector3<f64>) -> Plane {
+        let u = u.normalize();
+        let v = (v - u * u.dot(&v)).normalize();
+        assert!(
+            u.iter().chain(v.iter()).all(|c| c.is_finite()),
+            "degenerate plane frame"
+        );
+        Plane { origin, u, v }
+    }
+
+    /// The vertical plane through the Z axis at `angle_rad` from +X (thesis 3.4.2, Fig. 3.10).
+    ///
+    /// `u = (cos a, sin a, 0)` points to the slice's right side, `v = +Z` up, so 2D coordinates
+    /// are (signed distance from the axis, elevation).
+    pub fn vertical(angle_rad: f64) -> Plane {
+        let (s, c) = angle_rad.sin_cos();
+        Plane {
+            origin: Point3::origin(),
+            u: Vector3::new(c, s, 0.0),
+            v: Vector3::z(),
+        }
+    }
+
+    /// The horizontal plane at height `z_mm`; 2D coordinates are (x, y).
+    pub fn horizontal(z_mm: f64) -> Plane {
+        Plane {
+            origin: Point3::new(0.0, 0.0, z_mm),
+            u: Vector3::x(),
+            v: Vector3::y(),
+        }
+    }
+
+    /// A finger slice plane (thesis 3.6.2.1): the plane in which a finger line turns about its
+    /// joint axes, through `through`, normal to the palm's up axis after pitching by `pitch_rad`.
+    ///
+    /// The palm approaches along −X; its up axis is `(−sin p, 0, cos p)`, so a negative pitch
+    /// leans the palm's top away from the object (as on the cup, thesis 5.3: −7°). In-plane
+    /// axes: `u` is the pitched +X, `v` is +Y; at zero pitch this is [`Plane::horizontal`].
+    pub fn finger(through: Point3<f64>, pitch_rad: f64) -> Plane {
+        let (s, c) = pitch_rad.sin_cos();
+        Plane {
+            origin: through,
+            u: Vector3::new(c, 0.0, s),
+            v: Vector3::y(),
+        }
+    }
+
+    /// The unit normal `u × v`.
+    pub fn normal(&self) -> Vector3<f64> {
+        self.u.cross(&self.v)
+    }
+
+    /// Signed distance of `p` from the plane along the normal `[mm]`.
+    pub fn distance(&self, p: &Point3<f64>) -> f64 {
+        (p - self.origin).dot(&self.normal())
+    }
+
+    /// The 2D coordinates of `p` (projected onto the plane).
+    pub fn to_2d(&self, p: &Point3<f64>) -> Point2<f64> {
+        let d = p - self.origin;
+        Point2::new(d.dot(&self.u), d.dot(&self.v))
+    }
+
+    /// The 3D point of 2D coordinates `q`.
+    pub fn to_3d(&self, q: &Point2<f64>) -> Point3<f64> {
+        self.origin + self.u * q.x + self.v * q.y
+    }
+}
+
+/// One connected piece of a slice: an ordered polyline with per-segment outward normals.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Contour {
+    /// Vertices in order `[mm]`. A closed contour does not repeat its first point.
+    pub points: Vec<Point2<f64>>,
+    /// Outward unit normal of segment `i` (from `points[i]` to `points[i + 1]`, wrapping when
+    /// closed): `points.len()` normals when closed, one fewer when open.
+    pub normals: Vec<Vector2<f64>>,
+    /// True if and only if the contour closes on itself (always, for a closed manifold mesh).
+    pub is_closed: bool,
+}
+
+impl Contour {
+    /// Number of segments.
+    pub fn segment_count(&self) -> usize {
+        self.normals.len()
+    }
+
+    /// Segment `i` as its two endpoints.
+    pub fn segment(&self, i: usize) -> (Point2<f64>, Point2<f64>) {
+        let n = self.points.len();
+        (self.points[i], self.points[(i + 1) % n])
+    }
+
+    /// Shoelace signed area `[mm²]`: positive for a counter-clockwise (outer) boundary, negative
+    /// for a hole; for an open contour, the area closed by the chord.
+    pub fn signed_area(&self) -> f64 {
+        let n = self.points.len();
+        let mut a = 0.0;
+        for i in 0..n {
+            let (p, q) = (self.points[i], self.points[(i + 1) % n]);
+            a += p.x * q.y - q.x * p.y;
+        }
+        0.5 * a
+    }
+
+    /// Returns true if and only if the contour is closed and clockwise: the boundary of a hole.
+    pub fn is_hole(&self) -> bool {
+        self.is_closed && self.signed_area() < 0.0
+    }
+
+    /// Total length `[mm]`.
+    pub fn length(&self) -> f64 {
+        (0..self.segment_count())
+            .map(|i| {
+                let (a, b) = self.segment(i);
+                (b - a).norm()
+            })
+            .sum()
+    }
+}
+
+/// The result of cutting a mesh with a plane.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Slice {
+    /// The cutting plane.
+    pub plane: Plane,
+    /// Every contour, sorted by decreasing absolute area (ties by first point).
+    pub contours: Vec<Contour>,
+    /// Index of the outermost contour: the closed, counter-clockwise contour of largest area;
+    /// `None` when the plane misses the mesh or no contour closes.
+    pub outermost: Option<usize>,
+}
+
+impl Slice {
+    /// Returns true if and only if the plane missed the mesh.
+    pub fn is_empty(&self) -> bool {
+        self.contours.is_empty()
+    }
+}
+
+/// A mesh edge as its two vertex indices, smaller first.
+type Edge = (u32, u32);
+
+/// A cut through one triangle: it enters the triangle across `from` and leaves across `to`.
+#[derive(Debug, Clone, Copy)]
+struct Segment {
+    from: Edge,
+    to: Edge,
+    triangle: usize,
+}
+
+/// Contour segments shorter than this are merged away `[mm]`.
+const TINY_SEGMENT_MM: f64 = 1e-9;
+
+/// Cuts `mesh` with `plane`.
+pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
+    let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
+    cut(mesh, plane, 0..mesh.triangles.len(), |i| dist[i as usize])
+}
+
+/// [`slice`] with the triangles the plane may cut found through `index` (built once for the
+/// mesh): the same slice, bit for bit, at a cost that grows with the triangles cut rather than
+/// with the mesh (a search slices thousands of finger planes of one mesh).
+///
+/// `index` must have been built from `mesh` ([`SliceIndex::new`]).
+pub fn slice_indexed(mesh: &Mesh, index: &SliceIndex, plane: &Plane) -> Slice {
+    slice_indexed_within(mesh, index, plane, 0.0)
+}
+
+/// [`slice_indexed`], with the raw cut simplified within `tol_mm` ([`Contour::simplified`])
+/// before its open ends are joined and its overlapping pieces united, where it has any: the
+/// union and the joining cost grow with the points, and a slice of a many-shell or open mesh
+/// has many. A slice in closed pieces that do not overlap is the exact cut.
+pub fn slice_indexed_within(mesh: &Mesh, index: &SliceIndex, plane: &Plane, tol_mm: f64) -> Slice {
+    let tris = index.candidates(plane);
+    // A distance is a few flops, the same bits each time it is taken: cheaper than a table.
+    cut_within(
+        mesh,
+        plane,
+        tris.into_iter(),
+        |i| plane.distance(&mesh.vertices[i as usize]),
+        tol_mm,
+    )
+}
+
+/// A multiplicative hash for the slicer's edge tables (FxHash's mixing): SipHash's protection
+/// against chosen keys is not needed for mesh edges, and it was a fifth of the search's time.
+/// Only lookups use these tables, never their iteration order, so results do not depend on it.
+#[derive(Default, Clone, Copy)]
+struct EdgeHasher(u64);
+
+impl std::hash::Hasher for EdgeHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+    fn write_u32(&mut self, i: u32) {
+        self.write_u64(i as u64);
+    }
+    fn write_u64(&mut self, i: u64) {
+        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, i: usize) {
+        self.write_u64(i as u64);
+    }
+}
+
+type EdgeBuild = std::hash::BuildHasherDefault<EdgeHasher>;
+
+/// A bounding-volume hierarchy over a mesh's triangles: which triangles a plane may cut.
+///
+/// Built once per mesh (O(n log n)); a query visits the boxes the plane crosses, about the
+/// square root of the triangle count for a plane through a closed surface. Deterministic: the
+/// split is a median by centroid with ties broken by triangle index.
+#[derive(Debug, Clone)]
+pub struct SliceIndex {
+    nodes: Vec<BvhNode>,
+    order: Vec<u32>,
+    triangles: usize,
+}
+
+#[derive(Debug, Clone)]
+struct BvhNode {
+    min: Vector3<f64>,
+    max: Vector3<f64>,
+    /// Leaf: `order[start..start + count]`; inner: children at `start` and `start + 1`.
+    start: u32,
+    count: u32,
+}
+
+/// Triangles per leaf of a [`SliceIndex`].
+const BVH_LEAF: usize = 8;
+
+impl SliceIndex {
+    /// Builds the index of `mesh`'s triangles.
+    pub fn new(mesh: &Mesh) -> SliceIndex {
+        let boxes: Vec<(Vector3<f64>, Vector3<f64>)> = mesh
+            .triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.vertices[i as usize].coords);
+                (a.inf(&b).inf(&c), a.sup(&b).sup(&c))
+            })
+            .collect();
+        let mut order: Vec<u32> = (0..mesh.triangles.len() as u32).collect();
+        let mut nodes = vec![BvhNode {
+            min: Vector3::zeros(),
+            max: Vector3::zeros(),
+            start: 0,
+            count: 0,
+        }];
+        // Iterative build: (node, range of `order`).
+        let mut stack = vec![(0usize, 0usize, order.len())];
+        while let Some((node, lo, hi)) = stack.pop() {
+            let (mut bmin, mut bmax) = (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            );
+            let (mut cmin, mut cmax) = (bmin, bmax);
+            for &t in &order[lo..hi] {
+                let (a, b) = &boxes[t as usize];
+                bmin = bmin.inf(a);
+                bmax = bmax.sup(b);
+                let c = (a + b) * 0.5;
+                cmin = cmin.inf(&c);
+                cmax = cmax.sup(&c);
+            }
+            nodes[node].min = bmin;
+            nodes[node].max = bmax;
+            if hi - lo <= BVH_LEAF {
+                nodes[node].start = lo as u32;
+                nodes[node].count = (hi - lo) as u32;
+                continue;
+            }
+            let ext = cmax - cmin;
+            let axis = if ext.x >= ext.y && ext.x >= ext.z {
+                0
+            } else if ext.y >= ext.z {
+                1
+            } else {
+                2
+            };
+            let key = |t: &u32| {
+                let (a, b) = &boxes[*t as usize];
+                a[axis] + b[axis]
+            };
+            let mid = lo + (hi - lo) / 2;
+            order[lo..hi]
+                .select_nth_unstable_by(mid - lo, |x, y| key(x).total_cmp(&key(y)).then(x.cmp(y)));
+            let first = nodes.len();
+            for _ in 0..2 {
+                nodes.push(BvhNode {
+                    min: Vector3::zeros(),
+                    max: Vector3::zeros(),
+                    start: 0,
+                    count: 0,
+                });
+            }
+            nodes[node].start = first as u32;
+            nodes[node].count = 0;
+            stack.push((first, lo, mid));
+            stack.push((first + 1, mid, hi));
+        }
+        SliceIndex {
+            nodes,
+            order,
+            triangles: mesh.triangles.len(),
+        }
+    }
+
+    /// The triangles whose bounding box `plane` crosses (a superset of those it cuts), in
+    /// increasing index order.
+    fn candidates(&self, plane: &Plane) -> Vec<usize> {
+        let n = plane.normal();
+        let na = n.abs();
+        let o = plane.origin.coords;
+        let mut out = Vec::new();
+        if self.triangles == 0 {
+            return out;
+        }
+        let mut stack = vec![0usize];
+        while let Some(i) = stack.pop() {
+            let node = &self.nodes[i];
+            let c = (node.min + node.max) * 0.5;
+            let e = (node.max - node.min) * 0.5;
+            let d = n.dot(&(c - o));
+            let r = na.dot(&e);
+            // Generous slack: the exact side test is made per vertex afterwards.
+            let slack = 1e-6 * (1.0 + r + d.abs());
+            if d - r > slack || d + r < -slack {
+                continue;
+            }
+            if node.count > 0 {
+                let (s, k) = (node.start as usize, node.count as usize);
+                out.extend(self.order[s..s + k].iter().map(|&t| t as usize));
+            } else {
+                stack.push(node.start as usize);
+                stack.push(node.start as usize + 1);
+            }
+        }
+        out.sort_unstable();
+        out
+    }
+}
+
+/// The cut of `mesh` by `plane` through the triangles `tris` (in increasing index order), with
+/// `dist` the signed distance of a vertex from the plane.
+fn cut(
+    mesh: &Mesh,
+    plane: &Plane,
+    tris: impl Iterator<Item = usize>,
+    dist: impl Fn(u32) -> f64,
+) -> Slice {
+    cut_within(mesh, plane, tris, dist, 0.0)
+}
+
+/// [`cut`], simplifying the contours within `tol_mm` first when they need joining or uniting.
+fn cut_within(
+    mesh: &Mesh,
+    plane: &Plane,
+    tris: impl Iterator<Item = usize>,
+    dist: impl Fn(u32) -> f64,
+    tol_mm: f64,
+) -> Slice {
+    let n = plane.normal();
+    let above = |i: u32| dist(i) >= 0.0;
+
+    let segments = crossing_segments(mesh, tris, above);
+
+    let point = |e: Edge| -> Point3<f64> {
+        let (i, j) = e;
+        let (di, dj) = (dist(i), dist(j));
+        let (pi, pj) = (mesh.vertices[i as usize], mesh.vertices[j as usize]);
+        if di == 0.0 {
+            pi
+        } else if dj == 0.0 {
+            pj
+        } else {
+            let t = di / (di - dj);
+            pi + (pj - pi) * t
+        }
+    };
+
+    // Open chains first (from segments nothing leads into), then the closed loops that remain.
+    let mut contours: Vec<Contour> = chains(&segments)
+        .into_iter()
+        .map(|(chain, is_closed)| {
+            build_contour(&chain, &segments, &point, mesh, plane, &n, is_closed)
+        })
+        .collect();
+    contours.retain(|c| c.points.len() >= 2 && !c.normals.is_empty());
+    if tol_mm > 0.0 && (contours.iter().any(|c| !c.is_closed) || has_overlapping_outers(&contours))
+    {
+        contours = contours.iter().map(|c| c.simplified(tol_mm)).collect();
+    }
+    // A closed single-shell mesh never takes this path, so its slices are exactly the cut.
+    let mut repaired = false;
+    if contours.iter().any(|c| !c.is_closed) {
+        let tol = join_tolerance(&contours);
+        repaired = join_open(&mut contours, tol);
+    }
+    if repaired || has_overlapping_outers(&contours) {
+        contours = union_closed(contours);
+    }
+    finish(*plane, contours)
+}
+
+/// The segments the plane cuts from the triangles `tris`, each oriented by its triangle's
+/// winding (`above` says which side of the plane a vertex is on, a vertex on it counting above).
+fn crossing_segments(
+    mesh: &Mesh,
+    tris: impl Iterator<Item = usize>,
+    above: impl Fn(u32) -> bool,
+) -> Vec<Segment> {
+    let mut segments: Vec<Segment> = Vec::new();
+    for t in tris {
+        let tri = &mesh.triangles[t];
+        let s = [above(tri[0]), above(tri[1]), above(tri[2])];
+        if s[0] == s[1] && s[1] == s[2] {
+            continue;
+        }
+        // The lone vertex: the one whose side differs from both others.
+        let k = if s[1] == s[2] {
+            0
+        } else if s[0] == s[2] {
+            1
+        } else {
+            2
+        };
+        let (a, next, prev) = (tri[k], tri[(k + 1) % 3], tri[(k + 2) % 3]);
+        let e_next = edge(a, next);
+        let e_prev = edge(prev, a);
+        // Lone vertex above: the segment runs from the edge to `next` to the edge from `prev`;
+        // below, the other way. This makes the direction n × (triangle normal).
+        let (from, to) = if s[k] {
+            (e_next, e_prev)
+        } else {
+            (e_prev, e_next)
+        };
+        segments.push(Segment {
+            from,
+            to,
+            triangle: t,
+        });
+    }
+    segments
+}
+
+/// The segments chained end to start: open chains first (from segments nothing leads into),
+/// then the closed loops that remain; each as its segment indices and whether it closes.
+fn chains(segments: &[Segment]) -> Vec<(Vec<usize>, bool)> {
+    let mut by_from: HashMap<Edge, usize, EdgeBuild> =
+        HashMap::with_capacity_and_hasher(segments.len(), EdgeBuild::default());
+    let mut ends: HashSet<Edge, EdgeBuild> =
+        HashSet::with_capacity_and_hasher(segments.len(), EdgeBuild::default());
+    for (i, s) in segments.iter().enumerate() {
+        by_from.entry(s.from).or_insert(i);
+        ends.insert(s.to);
+    }
+
+    let mut used = vec![false; segments.len()];
+    let mut out = Vec::new();
+    let has_predecessor = |i: usize| ends.contains(&segments[i].from);
+    let starts = (0..segments.len())
+        .filter(|&i| !has_predecessor(i))
+        .chain(0..segments.len());
+    for first in starts {
+        if used[first] {
+            continue;
+        }
+        let mut chain = Vec::new();
+        let mut cur = first;
+        let mut is_closed = false;
+        loop {
+            used[cur] = true;
+            chain.push(cur);
+            match by_from.get(&segments[cur].to) {
+                Some(&nx) if nx == first => {
+                    is_closed = true;
+                    break;
+                }
+                Some(&nx) if !used[nx] => cur = nx,
+                _ => break,
+            }
+        }
+        out.push((chain, is_closed));
+    }
+    out
+}
+
+/// Sorts contours (decreasing absolute area, ties by first point) and finds the outermost.
+fn finish(plane: Plane, mut contours: Vec<Contour>) -> Slice {
+    contours.sort_by(|a, b| {
+        b.signed_area()
+            .abs()
+            .total_cmp(&a.signed_area().abs())
+            .then(a.points[0].x.total_cmp(&b.points[0].x))
+            .then(a.points[0].y.total_cmp(&b.points[0].y))
+    });
+    let outermost = contours
+        .iter()
+        .position(|c| c.is_closed && c.signed_area() > 0.0);
+    Slice {
+        plane,
+        contours,
+        outermost,
+    }
+}
+
+fn edge(a: u32, b: u32) -> Edge {
+    (a.min(b), a.max(b))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn build_contour(
+    chain: &[usize],
+    segments: &[Segment],
+    point: &impl Fn(Edge) -> Point3<f64>,
+    mesh: &Mesh,
+    plane: &Plane,
+    n: &Vector3<f64>,
+    is_closed: bool,
+) -> Contour {
+    let mut points: Vec<Point2<f64>> = Vec::with_capacity(chain.len() + 1);
+    let mut normals: Vec<Vector2<f64>> = Vec::with_capacity(chain.len());
+    for &s in chain {
+        let seg = segments[s];
+        points.push(plane.to_2d(&point(seg.from)));
+        let m = mesh.area_normal(seg.triangle);
+        let m2 = Vector2::new(m.dot(&plane.u), m.dot(&plane.v));
+        normals.push(if m2.norm() > 1e-12 * m.norm() {
+            m2.normalize()
+        } else {
+            // A triangle almost parallel to the plane: its projection says nothing; use the
+            // perpendicular of the travel direction, which is outward by construction.
+            let dir = n.cross(&m);
+            Vector2::new(dir.dot(&plane.v), -dir.dot(&plane.u))
+                .try_normalize(0.0)
+                .unwrap_or_else(Vector2::x)
+        });
+    }
+    if !is_closed {
+        let last = *chain.last().expect("a chain has a segment");
+        points.push(plane.to_2d(&point(segments[last].to)));
+    }
+    // Merge tiny segments: drop segment i and one of its two end points, keeping the indexing
+    // of points and normals aligned (segment i runs from points[i] to the next point).
+    let mut i = 0;
+    while normals.len() > 1 && i < normals.len() {
+        let np = points.len();
+        let j = if is_closed { (i + 1) % np } else { i + 1 };
+        if (points[j] - points[i]).norm() <= TINY_SEGMENT_MM {
+            normals.remove(i);
+            // Removing the start of the contour, or the end of an open one, would shift the
+            // segment numbering; remove the (coincident) other end point instead.
+            if j == 0 || (!is_closed && j == np - 1) {
+                points.remove(i);
+            } else {
+                points.remove(j);
+            }
+        } else {
+            i += 1;
+        }
+    }
+    Contour {
+        points,
+        normals,
+        is_closed,
+    }
+}
+
+impl Contour {
+    /// A contour from a polyline, with each segment's outward normal taken from the geometry:
+    /// the material lies on the left of the direction of travel (counter-clockwise outer
+    /// boundaries, clockwise holes), so the outward normal is the travel direction turned
+    /// clockwise. For a cut through a triangle this is the triangle's projected normal (the
+    /// segment lies in the triangle, so the normal's projection is perpendicular to it).
+    pub fn from_polyline(points: Vec<Point2<f64>>, is_closed: bool) -> Contour {
+        let n = points.len();
+        let segments = if is_closed { n } else { n.saturating_sub(1) };
+        let normals = (0..segments)
+            .map(|i| {
+                let d = points[(i + 1) % n] - points[i];
+                Vector2::new(d.y, -d.x)
+                    .try_normalize(0.0)
+                    .unwrap_or_else(Vector2::x)
+            })
+            .collect();
+        Contour {
+            points,
+            normals,
+            is_closed,
+        }
+    }
+
+    /// Axis-aligned bounds `(min, max)` of the points.
+    fn bounds(&self) -> (Point2<f64>, Point2<f64>) {
+        self.points.iter().fold(
+            (
+                Point2::new(f64::INFINITY, f64::INFINITY),
+                Point2::new(f64::NEG_INFINITY, f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        )
+    }
+}
+
+/// How far apart two open ends of a slice may be and still be joined `[mm]`: twice the upper
+/// quartile of the slice's own segment lengths, the mesh's resolution in this plane (a quad cut
+/// through its diagonal gives one long and one short segment, hence the quartile rather than
+/// the median). A missing triangle leaves a gap about one segment long; a real opening (a cup's
+/// rim, a slot cut on purpose) is many segments wide. (A triangle's edges are no measure here: a
+/// cylinder's side triangles may be as tall as the object.)
+fn join_tolerance(contours: &[Contour]) -> f64 {
+    let mut lengths: Vec<f64> = contours
+        .iter()
+        .flat_map(|c| {
+            (0..c.segment_count()).map(move |i| {
+                let (a, b) = c.segment(i);
+                (b - a).norm()
+            })
+        })
+        .collect();
+    if lengths.is_empty() {
+        return 0.0;
+    }
+    let q = (3 * lengths.len()) / 4;
+    let (_, quartile, _) = lengths.select_nth_unstable_by(q, f64::total_cmp);
+    2.0 * *quartile
+}
+
+/// Joins open contours end to start where an end lies within `tol` of a start (its own start
+/// closes it), nearest pairs first; the gap becomes a straight segment. Returns true if and
+/// only if anything was joined. Contours that stay open are kept as they are, so the caller
+/// can report them.
+pub fn join_open(contours: &mut Vec<Contour>, tol: f64) -> bool {
+    let open: Vec<usize> = (0..contours.len())
+        .filter(|&i| !contours[i].is_closed)
+        .collect();
+    if open.is_empty() || tol.is_nan() || tol <= 0.0 {
+        return false;
+    }
+    let Some((next, has_prev)) = links(contours, &open, tol) else {
+        return false;
+    };
+    // Follow the links: paths from chains with no predecessor, then the cycles left.
+    let mut done: HashSet<usize> = HashSet::new();
+    let mut joined: Vec<Contour> = Vec::new();
+    let starts = open
+        .iter()
+        .copied()
+        .filter(|i| !has_prev.contains(i))
+        .chain(open.iter().copied());
+    for s in starts {
+        if done.contains(&s) {
+            continue;
+        }
+        let mut points: Vec<Point2<f64>> = Vec::new();
+        let mut cur = s;
+        let mut is_closed = false;
+        loop {
+            done.insert(cur);
+            for p in &contours[cur].points {
+                // A link that closes no gap (the end is the next start) adds no point twice.
+                if points
+                    .last()
+                    .is_none_or(|q: &Point2<f64>| (q - p).norm() > TINY_SEGMENT_MM)
+                {
+                    points.push(*p);
+                }
+            }
+            match next.get(&cur) {
+                Some(&n) if n == s => {
+                    is_closed = true;
+                    break;
+                }
+                Some(&n) if !done.contains(&n) => cur = n,
+                _ => break,
+            }
+        }
+        if is_closed
+            && points.len() > 1
+            && (points[0] - points[points.len() - 1]).norm() <= TINY_SEGMENT_MM
+        {
+            points.pop();
+        }
+        if points.len() >= 2 {
+            joined.push(Contour::from_polyline(points, is_closed));
+        }
+    }
+    contours.retain(|c| c.is_closed);
+    contours.extend(joined);
+    true
+}
+
+/// The links that join the `open` contours end to start within `tol`, nearest first (each end
+/// and each start used once): each contour's successor, and the contours with a predecessor.
+/// `None` when no ends are that close.
+fn links(
+    contours: &[Contour],
+    open: &[usize],
+    tol: f64,
+) -> Option<(HashMap<usize, usize>, HashSet<usize>)> {
+    let first = |i: usize| contours[i].points[0];
+    let last = |i: usize| *contours[i].points.last().expect("a contour has points");
+    // Candidate links (end of a → start of b), nearest first; ties broken by index so the
+    // result is deterministic.
+    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
+    for &a in open {
+        for &b in open {
+            let d = (first(b) - last(a)).norm();
+            if d <= tol {
+                pairs.push((d, a, b));
+            }
+        }
+    }
+    if pairs.is_empty() {
+        return None;
+    }
+    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
+    let mut next: HashMap<usize, usize> = HashMap::new();
+    let mut has_prev: HashSet<usize> = HashSet::new();
+    for &(_, a, b) in &pairs {
+        if next.contains_key(&a) || has_prev.contains(&b) {
+            continue;
+        }
+        next.insert(a, b);
+        has_prev.insert(b);
+    }
+    Some((next, has_prev))
+}
+
+/// Returns true if and only if two closed outer (counter-clockwise) contours have overlapping
+/// bounds: overlapping or nested shells, whose union must be taken. The contours of one closed
+/// shell never overlap, except an island inside a hole, which the union leaves as it is.
+fn has_overlapping_outers(contours: &[Contour]) -> bool {
+    let outers: Vec<(Point2<f64>, Point2<f64>)> = contours
+        .iter()
+        .filter(|c| c.is_closed && c.signed_area() > 0.0)
+        .map(Contour::bounds)
+        .collect();
+    outers.iter().enumerate().any(|(i, a)| {
+        outers[i + 1..]
+            .iter()
+            .any(|b| a.0.x <= b.1.x && b.0.x <= a.1.x && a.0.y <= b.1.y && b.0.y <= a.1.y)
+    })
+}
+
+/// The union of the closed contours by the non-zero winding rule (i_overlay): overlapping
+/// shells become one outline, a hole stays a hole where no other shell fills it. Open contours
+/// are kept as they are.
+fn union_closed(contours: Vec<Contour>) -> Vec<Contour> {
+    use i_overlay::core::fill_rule::FillRule;
+    use i_overlay::float::simplify::SimplifyShape;
+    map_closed(contours, |rings| rings.simplify_shape(FillRule::NonZero))
+}
+
+/// Applies a polygon operation of i_overlay to the closed contours (as float rings) and turns
+/// its output back into contours with geometric normals; open contours are kept as they are.
+fn map_closed(
+    contours: Vec<Contour>,
+    op: impl FnOnce(Vec<Vec<[f64; 2]>>) -> Vec<Vec<Vec<[f64; 2]>>>,
+) -> Vec<Contour> {
+    let (closed, open): (Vec<Contour>, Vec<Contour>) =
+        contours.into_iter().partition(|c| c.is_closed);
+    let rings: Vec<Vec<[f64; 2]>> = closed
+        .iter()
+        .map(|c| c.points.iter().map(|p| [p.x, p.y]).collect())
+        .collect();
+    let mut out: Vec<Contour> = op(rings)
+        .into_iter()
+        .flatten()
+        .filter(|ring| ring.len() >= 3)
+        .map(|ring| {
+            Contour::from_polyline(
+                ring.into_iter().map(|[x, y]| Point2::new(x, y)).collect(),
+                true,
+            )
+        })
+        .collect();
+    out.extend(open);
+    out
+}
+
+impl Slice {
+    /// The slice with open ends within `tol_mm` of each other joined (straight across the gap)
+    /// and the closed contours then united; unchanged when nothing joins. Unlike [`Self::bridged`]
+    /// no gap between closed pieces is filled: the area stays the cut's.
+    pub fn joined(self, tol_mm: f64) -> Slice {
+        let mut contours = self.contours;
+        if join_open(&mut contours, tol_mm) {
+            finish(self.plane, union_closed(contours))
+        } else {
+            Slice { contours, ..self }
+        }
+    }
+
+    /// Returns the number of contours that do not close.
+    pub fn open_count(&self) -> usize {
+        self.contours.iter().filter(|c| !c.is_closed).count()
+    }
+
+    /// The slice as a finger of width `gap_mm` meets it: open ends within `gap_mm` of each other
+    /// joined, and, where the slice is in several pieces, every gap narrower than `gap_mm`
+    /// between pieces filled (a morphological closing: the region grown by `gap_mm / 2` and
+    /// shrunk back, so concave corners get a bevel of that size and convex ones stay). A
+    /// finger cannot enter a perforation or a slot narrower than itself, so for the planner it
+    /// is solid. A slice in one closed piece is returned unchanged.
+    pub fn bridged(self, gap_mm: f64) -> Slice {
+        self.bridged_within(gap_mm, 0.0)
+    }
+
+    /// [`Slice::bridged`], then [`Slice::simplified`] within `tol_mm`; a slice that needs its
+    /// pieces bridged or its ends joined is simplified before as well (the morphological closing
+    /// costs by the point, and closes nothing a finger could feel). A slice in one closed piece
+    /// is only simplified.
+    pub fn bridged_within(self, gap_mm: f64, tol_mm: f64) -> Slice {
+        self.bridged_prepared(gap_mm, tol_mm).simplified(tol_mm)
+    }
+
+    /// [`Slice::bridged`], the slice simplified within `tol_mm` first if (and only if) it needs
+    /// its pieces bridged or its ends joined: a slice in one closed piece is the exact cut.
+    pub fn bridged_prepared(self, gap_mm: f64, tol_mm: f64) -> Slice {
+        let needs_overlay = self.contours.iter().any(|c| !c.is_closed)
+            || self
+                .contours
+                .iter()
+                .filter(|c| c.is_closed && c.signed_area() > 0.0)
+                .count()
+                >= 2;
+        let s = if needs_overlay && tol_mm > 0.0 {
+            self.simplified(tol_mm)
+        } else {
+            self
+        };
+        s.bridged_exact(gap_mm)
+    }
+
+    fn bridged_exact(self, gap_mm: f64) -> Slice {
+        let plane = self.plane;
+        let outermost = self.outermost;
+        let mut contours = self.contours;
+        let joined = join_open(&mut contours, gap_mm);
+        let pieces = contours
+            .iter()
+            .filter(|c| c.is_closed && c.signed_area() > 0.0)
+            .count();
+        if pieces < 2 || gap_mm.is_nan() || gap_mm <= 0.0 {
+            return if joined {
+                finish(plane, union_closed(contours))
+            } else {
+                Slice {
+                    plane,
+                    contours,
+                    outermost,
+                }
+            };
+        }
+        finish(plane, close_gaps(contours, 0.5 * gap_mm))
+    }
+}
+
+impl Slice {
+    /// The slice with every contour simplified within `tol_mm` ([`Contour::simplified`]): what a
+    /// finger that does not feel relief shallower than `tol_mm` meets (issue 30), and far fewer
+    /// segments for the search to test on a finely meshed or scanned object. `tol_mm <= 0`
+    /// returns the slice unchanged.
+    pub fn simplified(self, tol_mm: f64) -> Slice {
+        if tol_mm.is_nan() || tol_mm <= 0.0 || self.contours.iter().all(|c| c.points.len() <= 3) {
+            return self;
+        }
+        let contours = self.contours.iter().map(|c| c.simplified(tol_mm)).collect();
+        finish(self.plane, contours)
+    }
+}
+
+impl Contour {
+    /// The contour with the dents a finger does not feel filled: Douglas–Peucker, one-sided.
+    /// A point is dropped where it lies on the material's side of the simplified polyline by
+    /// at most `tol_mm` (a tooth gap, a groove, a scanner's pit shallower than that), or off it
+    /// by at most [`COLLINEAR_MM`] (the vertices of a finely divided flat face); a point that
+    /// stands out beyond the polyline is never dropped, so the contour never moves into the
+    /// object (a convex arc keeps every vertex, and the finger meets what is there). Points
+    /// kept are original points. A closed contour is split at its first point and the point
+    /// farthest from it, and keeps at least three points; an open one keeps its ends. Normals
+    /// are taken from the geometry ([`Contour::from_polyline`]: material on the left of the
+    /// direction of travel, the slicer's orientation). A contour with nothing to drop is
+    /// returned as it is.
+    pub fn simplified(&self, tol_mm: f64) -> Contour {
+        let n = self.points.len();
+        if n <= 3 || tol_mm.is_nan() || tol_mm <= 0.0 {
+            return self.clone();
+        }
+        let p = &self.points;
+        let mut keep = vec![false; n];
+        // Spans (i, j) of indices to simplify, j > i, indices taken modulo n.
+        let mut spans = Vec::new();
+        if self.is_closed {
+            let far = (1..n)
+                .max_by(|&a, &b| {
+                    (p[a] - p[0])
+                        .norm_squared()
+                        .total_cmp(&(p[b] - p[0]).norm_squared())
+                        .then(b.cmp(&a))
+                })
+                .unwrap_or(1);
+            keep[0] = true;
+            keep[far] = true;
+            spans.push((0, far));
+            spans.push((far, n));
+        } else {
+            keep[0] = true;
+            keep[n - 1] = true;
+            spans.push((0, n - 1));
+        }
+        while let Some((i, j)) = spans.pop() {
+            if j <= i + 1 {
+                continue;
+            }
+            let (a, b) = (p[i % n], p[j % n]);
+            let (mut worst, mut at) = (0.0, i);
+            for k in i + 1..j {
+                // Positive outward (right of the travel a → b), negative into the material.
+                let s = outward_offset(p[k % n], a, b);
+                let excess = (s - COLLINEAR_MM).max(-s - tol_mm);
+                if excess > worst {
+                    worst = excess;
+                    at = k;
+                }
+            }
+            if worst > 0.0 {
+                keep[at % n] = true;
+                spans.push((i, at));
+                spans.push((at, j));
+            }
+        }
+        let kept = keep.iter().filter(|&&k| k).count();
+        if kept == n {
+            return self.clone();
+        }
+        if self.is_closed && kept < 3 {
+            return self.clone();
+        }
+        let points: Vec<Point2<f64>> = (0..n).filter(|&k| keep[k]).map(|k| p[k]).collect();
+        Contour::from_polyline(points, self.is_closed)
+    }
+}
+
+/// How far off a straight line a point may be dropped on the outer side of a contour `[mm]`:
+/// the vertices of a finely divided flat face, written in any frame, are this close to it.
+pub const COLLINEAR_MM: f64 = 1e-6;
+
+/// The signed distance of `q` from the line through `a` and `b`, positive on the right of the
+/// direction `a → b` (outside the material) `[mm]`; the distance to `a` when `a = b`.
+fn outward_offset(q: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> f64 {
+    let d = b - a;
+    let len = d.norm();
+    if len == 0.0 {
+        return (q - a).norm();
+    }
+    let w = q - a;
+    -(d.x * w.y - d.y * w.x) / len
+}
+
+/// Morphological closing of the closed contours by a polygon of inradius `r` (i_overlay's outline
+/// offset, grown then shrunk); open contours are kept as they are.
+fn close_gaps(contours: Vec<Contour>, r: f64) -> Vec<Contour> {
+    use i_overlay::mesh::float::outline::offset::OutlineOffset;
+    use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
+    // Bevel joins: the structuring element is then a polygon rather than a disc (convex corners
+    // come back exactly, a bridged gap's edge is straight to within r (1 - cos(turn / 2))), and
+    // the offset makes no arc points, which on a slice of many pieces costs several times more
+    // than the rest of the planner.
+    map_closed(contours, |rings| {
+        let grown = rings.outline(&OutlineStyle::new(r).line_join(LineJoin::Bevel));
+        grown.outline(&OutlineStyle::new(-r).line_join(LineJoin::Bevel))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::objects::{cylinder, prism};
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn planes_map_points_both_ways() {
+        let p = Point3::new(3.0, 4.0, 5.0);
+        let table = [
+            (Plane::vertical(0.0), Point2::new(3.0, 5.0), -4.0),
+            (Plane::vertical(FRAC_PI_2), Point2::new(4.0, 5.0), 3.0),
+            (Plane::horizontal(2.0), Point2::new(3.0, 4.0), 3.0),
+        ];
+        for (plane, q, distance) in table {
+            assert!((plane.to_2d(&p) - q).norm() < 1e-12, "{plane:?}");
+            assert!((plane.distance(&p) - distance).abs() < 1e-12, "{plane:?}");
+            let back = plane.to_3d(&plane.to_2d(&p));
+            assert!((plane.distance(&back)).abs() < 1e-12, "{plane:?}");
+        }
+    }
+
+    #[test]
+    fn a_box_cut_three_ways() {
+        // 40 (x) × 100 (y) × 80 (z) mm about the z axis.
+        let b = prism(40.0, 100.0, 80.0);
+        // (plane, contours, area, length): a cut across the middle, two vertical cuts through the
+        // axis (s along x, then along y) and a plane above the box.
+        let table = [
+            (Plane::horizontal(40.0), 1, 4000.0, 280.0),
+            (Plane::vertical(0.0), 1, 3200.0, 240.0),
+            (Plane::vertical(FRAC_PI_2), 1, 8000.0, 360.0),
+            (Plane::horizontal(90.0), 0, 0.0, 0.0),
+        ];
+        for (plane, count, area, length) in table {
+            let s = slice(&b, &plane);
+            assert_eq!(s.contours.len(), count, "{plane:?}");
+            assert_eq!(s.open_count(), 0, "{plane:?}");
+            let a: f64 = s.contours.iter().map(Contour::signed_area).sum();
+            let l: f64 = s.contours.iter().map(Contour::length).sum();
+            assert!(
+                (a - area).abs() < 1e-6,
+                "{plane:?}: area {a}, expected {area}"
+            );
+            assert!(
+                (l - length).abs() < 1e-6,
+                "{plane:?}: length {l}, expected {length}"
+            );
+            assert!(s.contours.iter().all(|c| !c.is_hole()));
+        }
+    }
+
+    #[test]
+    fn an_indexed_slice_is_the_plain_slice_bit_for_bit() {
+        // Planes at every tilt and height through a cup (many triangles, open top) and the
+        // chapter 4 object, including planes through vertices (Z = 0, the top) and planes that
+        // miss: the index must hand over exactly the triangles the plain cut uses.
+        for mesh in [
+            crate::objects::frustum(56.0, 80.0, 110.0),
+            crate::objects::chapter4(&crate::objects::Chapter4Dims::default()),
+            crate::objects::uv_sphere(30.0, 24),
+        ] {
+            let index = SliceIndex::new(&mesh);
+            let (lo, hi) = mesh.bounds();
+            let mut planes = 0;
+            for k in 0..=24 {
+                let z = lo.z - 1.0 + (hi.z - lo.z + 2.0) * k as f64 / 24.0;
+                for pitch_deg in [-12.0f64, 0.0, 7.0, 30.0, 90.0] {
+                    let plane = Plane::finger(Point3::new(3.0, -2.0, z), pitch_deg.to_radians());
+                    assert_eq!(
+                        slice_indexed(&mesh, &index, &plane),
+                        slice(&mesh, &plane),
+                        "z {z}, pitch {pitch_deg}"
+                    );
+                    planes += 1;
+                }
+            }
+            for z in [lo.z, hi.z] {
+                let plane = Plane::horizontal(z);
+                assert_eq!(slice_indexed(&mesh, &index, &plane), slice(&mesh, &plane));
+            }
+            assert_eq!(planes, 125);
+        }
+    }
+
+    #[test]
+    fn a_cylinder_cut_across_is_nearly_a_circle() {
+        let c = cylinder(40.0, 124.0);
+        let s = slice(&c, &Plane::horizontal(62.0));
+        assert_eq!(s.contours.len(), 1);
+        let area = s.contours[0].signed_area();
+        let circle = PI * 20.0 * 20.0;
+        assert!(
+            area < circle && area > 0.99 * circle,
+            "area {area}, circle {circle}"
+        );
+        // Every outward normal points away from the axis.
+        let c0 = &s.contours[0];
+        for i in 0..c0.segment_count() {
+            let (a, b) = c0.segment(i);
+            let mid = (a.coords + b.coords) / 2.0;
+            assert!(c0.normals[i].dot(&mid) > 0.0, "segment {i}");
+        }
+    }
+
+    #[test]
+    fn polylines_count_their_segments() {
+        let square = vec![
+            Point2::new(0.0, 0.0),
+            Point2::new(1.0, 0.0),
+            Point2::new(1.0, 1.0),
+            Point2::new(0.0, 1.0),
+        ];
+        let table = [(true, 4, 1.0, 4.0), (false, 3, 1.0, 3.0)];
+        for (closed, segments, area, length) in table {
+            let c = Contour::from_polyline(square.clone(), closed);
+            assert_eq!(c.segment_count(), segments);
+            assert_eq!(c.signed_area(), area);
+            assert_eq!(c.length(), length);
+        }
+        // Counter-clockwise: the first segment's outward normal points down (−y).
+        let c = Contour::from_polyline(square.clone(), true);
+        assert_eq!(c.normals[0], Vector2::new(0.0, -1.0));
+        let mut reversed = square;
+        reversed.reverse();
+        assert!(Contour::from_polyline(reversed, true).is_hole());
+    }
+}
