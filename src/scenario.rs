@@ -62,7 +62,7 @@ pub enum ScenarioError {
 }
 
 /// A parsed, validated scenario with paths resolved.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, serde::Serialize)]
 pub struct Scenario {
     /// The scenario file.
     pub path: PathBuf,
@@ -83,7 +83,7 @@ pub struct Scenario {
 }
 
 /// The object to grasp.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ObjectSpec {
     /// The STL file, resolved against the scenario's folder.
     pub mesh: PathBuf,
@@ -93,7 +93,7 @@ pub struct ObjectSpec {
     pub mass: MassSpec,
     /// Coulomb friction coefficient between hand and object (thesis: 0.3).
     pub friction: f64,
-    /// How the object's own frame is chosen ([`FrameRule`]; `[object] frame`).
+    /// How the object's own frame is chosen ([`FrameRule`](crate::mesh::FrameRule); `[object] frame`).
     pub frame: crate::mesh::FrameRule,
 }
 
@@ -112,7 +112,7 @@ impl ObjectSpec {
 }
 
 /// The object's mass, from a density or given outright.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub enum MassSpec {
     /// Uniform density `[kg/m³]`.
     Density(f64),
@@ -172,7 +172,7 @@ impl Outcome {
 }
 
 /// What a scenario expects, with optional reference values for the planned grasp.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Expect {
     /// Expected outcome.

@@ -274,7 +274,7 @@ fn search_axis(
             !stopped
         },
     );
-    t.search += ms(t0);
+    t.search += crate::plan::timings::ms(t0);
     AxisPlan {
         aligned,
         rules,
@@ -326,10 +326,6 @@ fn choose(candidates: &[Candidate]) -> Option<usize> {
     first_with(Verdict::Hold)
         .or_else(|| first_with(Verdict::Slip))
         .or_else(|| (!candidates.is_empty()).then_some(0))
-}
-
-fn ms(t: std::time::Instant) -> f64 {
-    t.elapsed().as_secs_f64() * 1000.0
 }
 
 /// Why a scenario's `[sim] override_angles` cannot be checked.

@@ -208,8 +208,12 @@ pub fn input_hash(item: &Item, template: &Scenario, options: &RunOptions) -> Str
     }
     match super::scenario_for(item, template) {
         Ok(s) => {
-            // The parsed scenario: its hand (file contents parsed), and for a mesh the template.
-            part("scenario", format!("{s:?}").as_bytes());
+            // The parsed scenario: its hand (file contents parsed), and for a mesh the template,
+            // serialised (a path that is not UTF-8 cannot be: then its Debug text).
+            match serde_json::to_vec(&s) {
+                Ok(json) => part("scenario", &json),
+                Err(_) => part("scenario (debug)", format!("{s:?}").as_bytes()),
+            }
             match std::fs::read(&s.object.mesh) {
                 Ok(bytes) => part("mesh", &bytes),
                 Err(e) => part("mesh unreadable", e.to_string().as_bytes()),
@@ -302,5 +306,12 @@ mod tests {
         let mut inch = template.clone();
         inch.object.units = crate::mesh::LengthUnit::Inch;
         assert_ne!(h2, input_hash(&item, &inch, &opts));
+        // A setting deep in a group of the serialised scenario counts, and so does the hand.
+        let mut step = template.clone();
+        step.sim.solver.timestep_s *= 0.5;
+        assert_ne!(h2, input_hash(&item, &step, &opts));
+        let mut hand = template.clone();
+        hand.hand.palm.offset_mm += 1.0;
+        assert_ne!(h2, input_hash(&item, &hand, &opts));
     }
 }

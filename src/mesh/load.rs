@@ -19,7 +19,7 @@ use std::path::Path;
 const COORDINATE_LIMIT_MM: f64 = 1e9;
 
 /// The length unit of a mesh file's coordinates.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LengthUnit {
     /// Millimetres (the default, and the planner's unit).
@@ -79,7 +79,7 @@ pub struct LoadedMesh {
     pub degenerate_dropped: usize,
     /// Edge statistics of what was kept, as the file has it (before small holes are closed).
     pub topology: Topology,
-    /// Holes closed because their boundary spans at most [`SMALL_HOLE_MM`]: a missing triangle,
+    /// Holes closed because their boundary spans at most `SMALL_HOLE_MM`: a missing triangle,
     /// a perforation, a scan's pinhole.
     pub holes_filled: usize,
     /// True if and only if the file was wound inside-out and grasp-sim flipped it.

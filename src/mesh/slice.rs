@@ -202,7 +202,7 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
     cut(mesh, plane, 0..mesh.triangles.len(), |i| dist[i as usize])
 }
 
-/// [`slice`] with the triangles the plane may cut found through `index` (built once for the
+/// [`slice()`] with the triangles the plane may cut found through `index` (built once for the
 /// mesh): the same slice, bit for bit, at a cost that grows with the triangles cut rather than
 /// with the mesh (a search slices thousands of finger planes of one mesh).
 ///

@@ -42,7 +42,7 @@ pub struct RunFlags {
 }
 
 /// How to run a scenario.
-#[derive(Clone)]
+#[derive(Debug, Clone)]
 pub struct RunOptions {
     /// Skip the physics check.
     pub no_sim: bool,
@@ -89,24 +89,6 @@ impl From<RunFlags> for RunOptions {
             report: None,
             folder: None,
         }
-    }
-}
-
-/// Everything but `folder`, as a derived `Debug` would write it: a batch's input hash is this
-/// text (`batch::input_hash`), and where the outputs go does not change what is computed, so
-/// results files written before `folder` existed still resume.
-impl std::fmt::Debug for RunOptions {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("RunOptions")
-            .field("no_sim", &self.no_sim)
-            .field("payload", &self.payload)
-            .field("quality", &self.quality)
-            .field("candidates", &self.candidates)
-            .field("max_checked", &self.max_checked)
-            .field("export_mjcf", &self.export_mjcf)
-            .field("export_urdf", &self.export_urdf)
-            .field("report", &self.report)
-            .finish()
     }
 }
 

@@ -395,7 +395,7 @@ const DISTAL_STEP_DEG: f64 = 0.25;
 
 /// An ALS whose phalanx 1 meets nothing (the extended rules'
 /// [`Relaxation::DistalContactOnly`]): joint 1 closes from its most open angle in
-/// [`DISTAL_STEP_DEG`] steps and, at each, phalanx 2 closes from straight; the ALS stops at the
+/// `DISTAL_STEP_DEG` steps and, at each, phalanx 2 closes from straight; the ALS stops at the
 /// first joint-1 angle at which phalanx 2 meets the object within joint 2's range (a contact
 /// beyond the range is passed over, closing on). Phalanx 1's body meeting the object first, or
 /// phalanx 2's body or tip inside it at its contact, is a rejection. This is a thin object pinched by the fingertips with the palm on its narrow face

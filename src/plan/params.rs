@@ -6,7 +6,7 @@ use crate::messages::keyed;
 use serde::Deserialize;
 
 /// Planner parameters (thesis chapter 3); defaults reproduce the thesis.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct PlannerParams {
     /// HeightStep between indexed elevations `[mm]`; must divide the finger gap (3.4.2).

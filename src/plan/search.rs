@@ -123,7 +123,7 @@ pub fn search(
 /// The approach angles tried at each elevation `[deg]`: the AngularStep grid 0, AngularStep, …
 /// (thesis 3.7), then the directions normal to the object's large flat side faces that the grid
 /// misses, so that a box is approached square to its faces however the alignment turned it
-/// about the axis (see [`face_directions_deg`]).
+/// about the axis (see `face_directions_deg`).
 pub fn approach_angles_deg(graded: &GradedDomain, params: &PlannerParams) -> Vec<f64> {
     let steps = (360.0 / params.angular_step_deg).round() as usize;
     let mut angles: Vec<f64> = (0..steps)

@@ -11,7 +11,7 @@ use crate::messages::keyed;
 use serde::Deserialize;
 
 /// Gravity directions for the hold test.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum GravityMode {
     /// −Z of the aligned object frame (the thesis's weight direction).
@@ -38,7 +38,7 @@ pub const DEFAULT_MAX_CLOSING_SHIFT_MM: f64 = 5.0;
 
 /// Physics check parameters (DESIGN.md section 5); used by the physics check. Each field of a
 /// group is the `[sim]` key of the same name.
-#[derive(Clone, PartialEq, Deserialize)]
+#[derive(Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(from = "flat::SimParams")]
 pub struct SimParams {
     /// Gravity direction(s).
@@ -62,7 +62,7 @@ pub struct SimParams {
 }
 
 /// The rapier solver: timestep, iterations and contact stiffness.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SolverParams {
     /// Physics timestep `[s]`.
     pub timestep_s: f64,
@@ -89,7 +89,7 @@ impl Default for SolverParams {
 }
 
 /// How the fingers are driven (motor torques, gains, squeeze) and how heavy they are.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FingerParams {
     /// Joint 1's motor target closes this far past its planned angle `[deg]`.
     pub squeeze_deg: f64,
@@ -129,7 +129,7 @@ impl Default for FingerParams {
 }
 
 /// How the fingers close before gravity comes on (docs/SIM.md, "What the closing does").
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ClosingParams {
     /// Time the fingers get to close before gravity is turned on `[s]`: with
     /// `close_until_stalled`, the longest they get.
@@ -158,7 +158,7 @@ impl Default for ClosingParams {
 }
 
 /// The hold: how long each gravity direction is held, and the thresholds of a `hold`.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct HoldParams {
     /// Hold time per gravity direction `[s]`.
     pub duration_s: f64,
@@ -191,7 +191,7 @@ impl Default for HoldParams {
 }
 
 /// The `fast` protocol's rest rule (docs/SIM.md, "Deciding early").
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct EarlyParams {
     /// `fast` protocol: the window over which the object's motion relative to the palm is
     /// measured before a direction can be decided `hold` or `slip` at rest, and the least hold
@@ -217,7 +217,7 @@ impl Default for EarlyParams {
 }
 
 /// The candidate search's policy: how many planned grasps a run checks.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct SelectionParams {
     /// A run checks the planner's candidates in search order until one holds or this many have
     /// been checked (1: only the first grasp, as the thesis would give it).
@@ -233,7 +233,7 @@ impl Default for SelectionParams {
 }
 
 /// Where the grasp comes from: the planner, or joint angles fixed by the scenario.
-#[derive(Debug, Clone, PartialEq, Default)]
+#[derive(Debug, Clone, PartialEq, Default, serde::Serialize)]
 pub struct InputParams {
     /// Skip the planner and close the fingers to these `[θ1, θ2]` per finger `[deg]`, with the
     /// palm upright at Finger_1's `override_index` (a sim-only scenario).
