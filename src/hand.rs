@@ -199,10 +199,13 @@ impl Hand {
     /// [`HandError`] naming the file: unreadable, bad TOML, unknown key or wrong type, an override
     /// naming no numeric key, or a value out of range.
     pub fn load(path: &Path, overrides: &[(String, f64)]) -> Result<Hand, HandError> {
-        let text = std::fs::read_to_string(path).map_err(|e| HandError::Io {
-            path: path.to_path_buf(),
-            error: e,
-        })?;
+        let text =
+            crate::files::read_regular_string(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
+                HandError::Io {
+                    path: path.to_path_buf(),
+                    error: e,
+                }
+            })?;
         Hand::parse(&text, path, overrides)
     }
 

@@ -26,6 +26,7 @@
 pub mod assets;
 pub mod batch;
 pub mod export;
+pub mod files;
 pub mod hand;
 pub mod mesh;
 mod messages;

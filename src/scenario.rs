@@ -267,10 +267,13 @@ impl Scenario {
                 message: "is a folder, not a scenario file (`grasp-sim batch FOLDER` runs every scenario, URDF or mesh in a folder)".to_string(),
             });
         }
-        let text = std::fs::read_to_string(path).map_err(|e| ScenarioError::Read {
-            path: path.to_path_buf(),
-            error: e,
-        })?;
+        let text =
+            crate::files::read_regular_string(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
+                ScenarioError::Read {
+                    path: path.to_path_buf(),
+                    error: e,
+                }
+            })?;
         Scenario::parse(&text, path)
     }
 

@@ -78,7 +78,8 @@ impl Summary {
     /// [`BatchError::Io`] when it cannot be read; [`BatchError::NotARecord`] for a complete
     /// line that is not a run report or an error line (naming its line number).
     pub fn read(path: &Path) -> Result<Summary, BatchError> {
-        let bytes = std::fs::read(path).map_err(|e| BatchError::io(path, e))?;
+        let bytes = crate::files::read_regular(path, crate::files::MAX_RESULTS_BYTES)
+            .map_err(|e| BatchError::io(path, e))?;
         Summary::parse(path, &bytes)
     }
 

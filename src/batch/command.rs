@@ -115,6 +115,11 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
         items = shard.of(&items);
     }
     let keys = super::keys(&items, &template, &options);
+    // One run per results file, plain or resumed (a merge writes it too).
+    let _lock = match &request.out {
+        Some(path) => Some(journal::RunLock::take(path)?),
+        None => None,
+    };
     if !request.merge.is_empty() {
         return merge(request, &keys);
     }

@@ -30,7 +30,8 @@ pub struct ReadRecords {
 /// [`BatchError::Io`] when the file cannot be read, [`BatchError::NotARecord`] for a complete
 /// line that is not a batch record.
 pub fn read_records(path: &Path) -> Result<ReadRecords, BatchError> {
-    let bytes = std::fs::read(path).map_err(|e| BatchError::io(path, e))?;
+    let bytes = crate::files::read_regular(path, crate::files::MAX_RESULTS_BYTES)
+        .map_err(|e| BatchError::io(path, e))?;
     parse_records(path, &bytes)
 }
 
@@ -73,6 +74,12 @@ impl Journal {
     /// another run holds it; [`BatchError::NotARecord`] when a line is not a batch record (the
     /// file was not written by `batch`: it is left untouched).
     pub fn open(path: &Path) -> Result<(Journal, ReadRecords), BatchError> {
+        // Opening a FIFO to append would block until a reader came: only a regular file, or
+        // none yet.
+        if path.exists() {
+            crate::files::check_regular(path, crate::files::MAX_RESULTS_BYTES)
+                .map_err(|e| BatchError::io(path, e))?;
+        }
         let file = OpenOptions::new()
             .read(true)
             .append(true)
@@ -80,7 +87,8 @@ impl Journal {
             .open(path)
             .map_err(|e| BatchError::io(path, e))?;
         lock(&file, path)?;
-        let bytes = std::fs::read(path).map_err(|e| BatchError::io(path, e))?;
+        let bytes = crate::files::read_regular(path, crate::files::MAX_RESULTS_BYTES)
+            .map_err(|e| BatchError::io(path, e))?;
         let read = parse_records(path, &bytes)?;
         if read.partial_bytes > 0 {
             file.set_len((bytes.len() - read.partial_bytes) as u64)
@@ -128,6 +136,7 @@ impl Journal {
 /// # Errors
 /// [`BatchError::Io`] naming `path`.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), BatchError> {
+    crate::files::check_replaceable(path).map_err(|e| BatchError::io(path, e))?;
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
@@ -144,6 +153,54 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), BatchError> {
             let _ = std::fs::remove_file(&tmp);
             BatchError::io(path, e)
         })
+}
+
+/// The lock every batch run that writes `--out FILE` holds for its whole run, plain or
+/// `--resume`: a file `.FILE.lock` beside it, locked with `flock` (released if the run dies),
+/// and removed at the end. A second run on the same file is refused at once, before it runs
+/// anything, instead of one run's lines replacing the other's.
+#[derive(Debug)]
+pub struct RunLock {
+    path: PathBuf,
+    file: Option<File>,
+}
+
+impl RunLock {
+    /// Takes the run lock of the results file `out`.
+    ///
+    /// # Errors
+    /// [`BatchError::Locked`] when another run holds it; [`BatchError::Io`] when the lock file
+    /// cannot be made.
+    pub fn take(out: &Path) -> Result<RunLock, BatchError> {
+        let dir = out
+            .parent()
+            .filter(|d| !d.as_os_str().is_empty())
+            .unwrap_or(Path::new("."));
+        let name = out
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let path = dir.join(format!(".{name}.lock"));
+        let file = OpenOptions::new()
+            .write(true)
+            .create(true)
+            .truncate(false)
+            .open(&path)
+            .map_err(|e| BatchError::io(&path, e))?;
+        lock(&file, out)?;
+        Ok(RunLock {
+            path,
+            file: Some(file),
+        })
+    }
+}
+
+impl Drop for RunLock {
+    fn drop(&mut self) {
+        // Removed while still held, so no other run can lock the name being removed.
+        let _ = std::fs::remove_file(&self.path);
+        drop(self.file.take());
+    }
 }
 
 #[cfg(unix)]

@@ -63,7 +63,7 @@ pub enum BatchError {
         why: String,
     },
     /// Another run is appending to the file.
-    #[error("{}: in use by another `grasp-sim batch --resume` (locked); one run per file", path.display())]
+    #[error("{}: in use by another `grasp-sim batch` (locked); one run per file", path.display())]
     Locked {
         /// The file.
         path: PathBuf,

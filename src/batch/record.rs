@@ -189,6 +189,20 @@ fn options_json<'a>(options: &'a RunOptions) -> Vec<u8> {
     serde_json::to_vec(&hashed).unwrap_or_default()
 }
 
+/// Feeds the file at `path` to `h` as it is read (regular files of at most `limit` bytes only,
+/// as loading reads them: a FIFO or `/dev/zero` never blocks the hash), then its length; or, when
+/// it cannot be read, why.
+fn stream_file(h: &mut Sha256, label: &str, path: &std::path::Path, limit: u64) {
+    h.update(label.as_bytes());
+    match crate::files::stream_regular(path, limit, &mut |b| h.update(b)) {
+        Ok(n) => h.update(n.to_le_bytes()),
+        Err(e) => {
+            h.update(b" unreadable: ");
+            h.update(e.to_string().as_bytes());
+        }
+    }
+}
+
 /// The hash of everything that decides an item's result (see the module docs), as
 /// `sha256:<hex>`.
 pub fn input_hash(item: &Item, template: &Scenario, options: &RunOptions) -> String {
@@ -200,37 +214,34 @@ pub fn input_hash(item: &Item, template: &Scenario, options: &RunOptions) -> Str
     };
     part("grasp-sim", env!("CARGO_PKG_VERSION").as_bytes());
     part("options", &options_json(options));
+    let scenario = super::scenario_for(item, template);
+    // The scenario file, as bytes; and the parsed scenario: its hand (file contents parsed),
+    // and for a mesh the template, serialised (a path that is not UTF-8 cannot be: then its
+    // Debug text).
+    let parsed = match &scenario {
+        Ok(s) => serde_json::to_vec(s).unwrap_or_else(|_| format!("{s:?}").into_bytes()),
+        Err(e) => format!("{e:#}").into_bytes(),
+    };
+    part(
+        if scenario.is_ok() {
+            "scenario"
+        } else {
+            "scenario error"
+        },
+        &parsed,
+    );
     if let Item::Scenario(p) = item {
-        match std::fs::read(p) {
-            Ok(text) => part("scenario file", &text),
-            Err(e) => part("scenario file unreadable", e.to_string().as_bytes()),
-        }
+        stream_file(&mut h, "scenario file", p, crate::files::MAX_TEXT_BYTES);
     }
-    match super::scenario_for(item, template) {
-        Ok(s) => {
-            // The parsed scenario: its hand (file contents parsed), and for a mesh the template,
-            // serialised (a path that is not UTF-8 cannot be: then its Debug text).
-            match serde_json::to_vec(&s) {
-                Ok(json) => part("scenario", &json),
-                Err(_) => part("scenario (debug)", format!("{s:?}").as_bytes()),
-            }
-            match std::fs::read(&s.object.mesh) {
-                Ok(bytes) => part("mesh", &bytes),
-                Err(e) => part("mesh unreadable", e.to_string().as_bytes()),
-            }
-            // A URDF's object is its meshes too.
-            if crate::mesh::MeshFormat::from_path(&s.object.mesh)
-                == Some(crate::mesh::MeshFormat::Urdf)
-            {
-                for f in crate::mesh::urdf::referenced_files(&s.object.mesh) {
-                    match std::fs::read(&f) {
-                        Ok(bytes) => part("urdf mesh", &bytes),
-                        Err(e) => part("urdf mesh unreadable", e.to_string().as_bytes()),
-                    }
-                }
+    if let Ok(s) = &scenario {
+        stream_file(&mut h, "mesh", &s.object.mesh, crate::files::MAX_MESH_BYTES);
+        // A URDF's object is its meshes too.
+        if crate::mesh::MeshFormat::from_path(&s.object.mesh) == Some(crate::mesh::MeshFormat::Urdf)
+        {
+            for f in crate::mesh::urdf::referenced_files(&s.object.mesh) {
+                stream_file(&mut h, "urdf mesh", &f, crate::files::MAX_MESH_BYTES);
             }
         }
-        Err(e) => part("scenario error", format!("{e:#}").as_bytes()),
     }
     let digest = h.finalize();
     let mut hex = String::with_capacity(7 + 64);

@@ -180,7 +180,7 @@ fn file_format(path: &Path) -> Result<MeshFormat, MeshError> {
 }
 
 fn read_bytes(path: &Path) -> Result<Vec<u8>, MeshError> {
-    std::fs::read(path).map_err(|e| MeshError::Io {
+    crate::files::read_regular(path, crate::files::MAX_MESH_BYTES).map_err(|e| MeshError::Io {
         path: path.to_path_buf(),
         error: e,
     })
@@ -722,9 +722,11 @@ pub fn load_stl(path: &Path, unit: LengthUnit) -> Result<LoadedMesh, MeshError> 
             path: path.to_path_buf(),
         });
     }
-    let bytes = std::fs::read(path).map_err(|e| MeshError::Io {
-        path: path.to_path_buf(),
-        error: e,
+    let bytes = crate::files::read_regular(path, crate::files::MAX_MESH_BYTES).map_err(|e| {
+        MeshError::Io {
+            path: path.to_path_buf(),
+            error: e,
+        }
     })?;
     parse_stl(&bytes, path, unit)
 }

@@ -208,10 +208,13 @@ struct Read {
 
 /// Reads a URDF: every link's geometry placed in the root link's frame, with notes and mass.
 fn read(path: &Path) -> Result<Read, MeshError> {
-    let text = std::fs::read_to_string(path).map_err(|e| MeshError::Io {
-        path: path.to_path_buf(),
-        error: e,
-    })?;
+    let text =
+        crate::files::read_regular_string(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
+            MeshError::Io {
+                path: path.to_path_buf(),
+                error: e,
+            }
+        })?;
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| urdf_err(path, format!("not well-formed XML: {e}")))?;
     let robot = doc.root_element();

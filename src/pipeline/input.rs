@@ -32,8 +32,9 @@ impl Item {
 /// else its meshes (`*.stl`, `*.obj`, `*.ply`).
 ///
 /// # Errors
-/// [`ScenarioError::Io`] for an input that does not exist, is neither a folder, a `.toml` nor
-/// a mesh file, or is a folder with none of these in it.
+/// [`ScenarioError::Io`] for an input that is neither a folder, a `.toml` nor a mesh file by its
+/// name (a missing `nope.stl` is an input, whose run says it is missing), or a folder with none
+/// of these in it.
 pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
     let mut items = Vec::new();
     for input in inputs {
@@ -44,7 +45,9 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
             })?;
             let mut found: Vec<Item> = entries
                 .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.is_file())
+                // Not only regular files: a FIFO or a broken link named like an input is one,
+                // and its line says why it cannot be read (rather than its being skipped).
+                .filter(|p| !p.is_dir())
                 .filter_map(classify)
                 .filter(|i| !is_hand_file(i.path()))
                 .collect();
@@ -68,6 +71,10 @@ pub fn expand(inputs: &[PathBuf]) -> Result<Vec<Item>, ScenarioError> {
                 message:
                     "neither a scenario (.toml) nor a mesh (.stl, .obj, .ply, .urdf)".to_string(),
             })?);
+        } else if let Some(item) = classify(input.clone()) {
+            // Named like an input but missing or not a regular file (a FIFO, a device): an
+            // input of its own, whose run says why it cannot be read; the others still run.
+            items.push(item);
         } else {
             return Err(ScenarioError::Io {
                 path: input.clone(),
@@ -89,7 +96,7 @@ fn is_urdf(path: &Path) -> bool {
 /// not a folder of one more scenario.
 fn is_hand_file(path: &Path) -> bool {
     path.extension().is_some_and(|e| e == "toml")
-        && std::fs::read_to_string(path)
+        && crate::files::read_regular_string(path, crate::files::MAX_TEXT_BYTES)
             .ok()
             .and_then(|t| t.parse::<toml::Table>().ok())
             .is_some_and(|t| t.contains_key("palm") && t.contains_key("finger"))

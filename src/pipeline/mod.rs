@@ -433,6 +433,9 @@ pub fn check_output_file(file: &std::path::Path) -> anyhow::Result<()> {
             file.join("results.jsonl").display()
         );
     }
+    if let Err(e) = crate::files::check_replaceable(file) {
+        anyhow::bail!("{}: {e}", file.display());
+    }
     let probe = dir.join(".grasp-sim-write-test");
     std::fs::write(&probe, b"")
         .and_then(|()| std::fs::remove_file(&probe))

@@ -70,3 +70,209 @@ fn an_input_past_the_time_bound_is_an_error_line_and_the_next_still_runs() {
         .unwrap();
     assert_eq!(out.status.code(), Some(0));
 }
+
+/// `mkfifo`: a FIFO that nothing writes to, which would block a reader for ever.
+fn fifo(path: &std::path::Path) {
+    let status = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .unwrap();
+    assert!(status.success());
+}
+
+/// A FIFO or a device behind an input's name is refused without being opened: in a single
+/// run, in `summarize`, and in `batch` (whose parent hashes its inputs), each with the input's
+/// own line, while the other inputs still run.
+#[test]
+fn special_files_as_inputs_are_refused_without_blocking() {
+    let dir = tempfile::tempdir().unwrap();
+    let (f, z) = (dir.path().join("f.stl"), dir.path().join("z.stl"));
+    fifo(&f);
+    std::os::unix::fs::symlink("/dev/zero", &z).unwrap();
+    for (input, what) in [
+        (&f, "not a regular file (a FIFO)"),
+        (&z, "not a regular file (a device)"),
+    ] {
+        let out = grasp_sim().arg("--no-sim").arg(input).output().unwrap();
+        refused(&out, &[input.file_name().unwrap().to_str().unwrap(), what]);
+    }
+    let out = grasp_sim().arg("summarize").arg(&f).output().unwrap();
+    refused(&out, &["f.stl", "not a regular file (a FIFO)"]);
+    let good = crate::root().join("assets/objects/cylinder_d40.stl");
+    let out = grasp_sim()
+        .args(["batch", "--no-sim", "--jobs", "1"])
+        .args([&f, &z, &good])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let lines: Vec<String> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(String::from)
+        .collect();
+    assert_eq!(lines.len(), 3, "{lines:?}");
+    assert!(
+        lines[0].contains("not a regular file (a FIFO)"),
+        "{}",
+        lines[0]
+    );
+    assert!(
+        lines[1].contains("not a regular file (a device)"),
+        "{}",
+        lines[1]
+    );
+    assert!(lines[2].contains("\"status\":\"feasible\""), "{}", lines[2]);
+}
+
+/// `batch nope.stl good.stl` runs the good one: the missing input is an error line of its own,
+/// as are a FIFO and a broken link inside a folder (they used to be skipped without a word).
+#[test]
+fn a_missing_input_costs_its_own_line_only() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = crate::root().join("assets/objects/cylinder_d40.stl");
+    let out = grasp_sim()
+        .current_dir(dir.path())
+        .args(["batch", "--no-sim", "--jobs", "1", "nope.stl"])
+        .arg(&good)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2, "{text}");
+    assert!(
+        lines[0].contains("nope.stl: cannot read: no such file"),
+        "{}",
+        lines[0]
+    );
+    assert!(lines[1].contains("\"status\":\"feasible\""), "{}", lines[1]);
+
+    let folder = dir.path().join("set");
+    std::fs::create_dir(&folder).unwrap();
+    std::fs::copy(&good, folder.join("a.stl")).unwrap();
+    fifo(&folder.join("b.stl"));
+    std::os::unix::fs::symlink("/nowhere", folder.join("c.stl")).unwrap();
+    let out = grasp_sim()
+        .args(["batch", "--no-sim", "--jobs", "1"])
+        .arg(&folder)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let errors: Vec<&str> = text.lines().filter(|l| l.contains("\"error\"")).collect();
+    assert_eq!(text.lines().count(), 3, "{text}");
+    assert!(errors[0].contains("b.stl: cannot read: not a regular file (a FIFO)"));
+    assert!(errors[1].contains("c.stl: cannot read: no such file"));
+}
+
+/// Outputs are renamed only onto a regular file or a new path: a device or a symbolic link as
+/// `--out` or `--csv` is refused before anything runs, and left as it was.
+#[test]
+fn outputs_never_replace_a_device_or_a_link() {
+    let dir = tempfile::tempdir().unwrap();
+    let link = dir.path().join("link.jsonl");
+    let target = dir.path().join("target.jsonl");
+    std::fs::write(&target, "").unwrap();
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let good = crate::root().join("assets/objects/cylinder_d40.stl");
+    let out = grasp_sim()
+        .args(["batch", "--no-sim", "--out", "/dev/null"])
+        .arg(&good)
+        .output()
+        .unwrap();
+    refused(&out, &["/dev/null", "not a regular file (a device)"]);
+    let out = grasp_sim()
+        .args(["batch", "--no-sim", "--out"])
+        .arg(&link)
+        .arg(&good)
+        .output()
+        .unwrap();
+    refused(&out, &["link.jsonl", "a symbolic link"]);
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    let results = dir.path().join("r.jsonl");
+    let ok = grasp_sim()
+        .args(["batch", "--no-sim", "--out"])
+        .arg(&results)
+        .arg(&good)
+        .output()
+        .unwrap();
+    assert_eq!(ok.status.code(), Some(0));
+    let out = grasp_sim()
+        .arg("summarize")
+        .arg(&results)
+        .arg("--csv")
+        .arg(&link)
+        .output()
+        .unwrap();
+    refused(&out, &["link.jsonl", "a symbolic link"]);
+    use std::os::unix::fs::FileTypeExt;
+    assert!(std::fs::metadata("/dev/null")
+        .unwrap()
+        .file_type()
+        .is_char_device());
+}
+
+/// Two batches on one `--out` cannot both run: the second is refused at once while the first
+/// holds the file, and the first's lines are all there at the end.
+#[test]
+fn a_second_batch_on_the_same_out_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let results = dir.path().join("r.jsonl");
+    let lock = dir.path().join(".r.jsonl.lock");
+    // Every bundled scenario with the payload search: tens of seconds.
+    let mut first = grasp_sim()
+        .args(["batch", "--in-process", "--payload", "--out"])
+        .arg(&results)
+        .arg("scenarios")
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    while !lock.exists() && t0.elapsed() < std::time::Duration::from_secs(60) {
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(lock.exists(), "the first batch took its lock");
+    let mut tested = 0;
+    for resume in [false, true] {
+        let mut second = grasp_sim();
+        second.args(["batch", "--no-sim", "--out"]).arg(&results);
+        if resume {
+            second.arg("--resume");
+        }
+        let out = second.arg("scenarios/cup.toml").output().unwrap();
+        if first.try_wait().unwrap().is_some() {
+            // The first finished before the second started: nothing was tested (a machine
+            // far faster than this suite assumes).
+            break;
+        }
+        refused(
+            &out,
+            &["r.jsonl", "in use by another `grasp-sim batch` (locked)"],
+        );
+        tested += 1;
+    }
+    assert!(
+        tested > 0,
+        "the first batch ended before the second started"
+    );
+    let status = first.wait().unwrap().code();
+    let scenarios = std::fs::read_dir(crate::root().join("scenarios"))
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "toml")
+        })
+        .count();
+    assert!(matches!(status, Some(0 | 1)), "{status:?}");
+    assert_eq!(
+        std::fs::read_to_string(&results).unwrap().lines().count(),
+        scenarios
+    );
+    assert!(!lock.exists(), "the lock file is removed at the end");
+}

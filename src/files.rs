@@ -1,0 +1,183 @@
+//! Reading input files safely: regular files only (a FIFO would block for ever, `/dev/zero`
+//! would never end), and at most a stated size, so that no input can hang the tool or exhaust
+//! its memory. Every reader of an input file (meshes, URDFs, scenarios, hands, results files,
+//! and the batch's input hash) goes through here.
+
+use std::io::{self, Read};
+use std::path::Path;
+
+/// The largest mesh file read `[bytes]`: 256 MiB, a binary STL of 5.6 million triangles (the
+/// largest scans of the real-object set are under 15 MB).
+pub const MAX_MESH_BYTES: u64 = 256 << 20;
+/// The largest scenario, hand or URDF file read `[bytes]`: 16 MiB.
+pub const MAX_TEXT_BYTES: u64 = 16 << 20;
+/// The largest results file read (`summarize`, `--resume`, `--merge`) `[bytes]`: 1 GiB.
+pub const MAX_RESULTS_BYTES: u64 = 1 << 30;
+
+/// `n` bytes in the largest binary unit that keeps it whole-ish: `256 MiB`, `16 MiB`, `1 GiB`.
+fn size(n: u64) -> String {
+    if n >= 1 << 30 && n.is_multiple_of(1 << 30) {
+        format!("{} GiB", n >> 30)
+    } else if n >= 1 << 20 {
+        format!("{} MiB", n >> 20)
+    } else {
+        format!("{n} bytes")
+    }
+}
+
+/// What a path that is not a regular file is, in words.
+fn kind(t: std::fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO";
+        }
+        if t.is_char_device() || t.is_block_device() {
+            return "a device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if t.is_dir() {
+        "a folder"
+    } else {
+        "not a file"
+    }
+}
+
+/// Checks that `path` is a regular file (following symbolic links) of at most `limit` bytes,
+/// without opening it; returns its length.
+///
+/// # Errors
+/// The operating system's error (no such file, permission denied), or one saying what the
+/// path is instead (`not a regular file (a FIFO)`) or how large it is against the limit.
+pub fn check_regular(path: &Path, limit: u64) -> io::Result<u64> {
+    let meta = std::fs::metadata(path)?;
+    if !meta.file_type().is_file() {
+        return Err(io::Error::other(format!(
+            "not a regular file ({})",
+            kind(meta.file_type())
+        )));
+    }
+    if meta.len() > limit {
+        return Err(too_large(meta.len(), limit));
+    }
+    Ok(meta.len())
+}
+
+fn too_large(len: u64, limit: u64) -> io::Error {
+    io::Error::other(format!(
+        "{} bytes, more than the {} a file may have here",
+        len,
+        size(limit)
+    ))
+}
+
+/// Reads a regular file of at most `limit` bytes whole (a file that grows past the limit while
+/// it is read is refused too).
+///
+/// # Errors
+/// As [`check_regular`], and any error reading it.
+pub fn read_regular(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
+    let len = check_regular(path, limit)?;
+    let mut bytes = Vec::with_capacity(len as usize);
+    std::fs::File::open(path)?
+        .take(limit + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(too_large(bytes.len() as u64, limit));
+    }
+    Ok(bytes)
+}
+
+/// Reads a regular UTF-8 text file of at most `limit` bytes.
+///
+/// # Errors
+/// As [`read_regular`]; text that is not UTF-8 is [`io::ErrorKind::InvalidData`], as
+/// [`std::fs::read_to_string`] reports it.
+pub fn read_regular_string(path: &Path, limit: u64) -> io::Result<String> {
+    String::from_utf8(read_regular(path, limit)?).map_err(|_| {
+        io::Error::new(
+            io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        )
+    })
+}
+
+/// Feeds a regular file of at most `limit` bytes to `sink` in chunks (for hashing without
+/// holding it); returns how many bytes it had.
+///
+/// # Errors
+/// As [`read_regular`].
+pub fn stream_regular(path: &Path, limit: u64, sink: &mut dyn FnMut(&[u8])) -> io::Result<u64> {
+    check_regular(path, limit)?;
+    let mut file = std::fs::File::open(path)?.take(limit + 1);
+    let mut buf = vec![0u8; 1 << 16];
+    let mut total = 0u64;
+    loop {
+        let n = file.read(&mut buf)?;
+        if n == 0 {
+            break;
+        }
+        total += n as u64;
+        if total > limit {
+            return Err(too_large(total, limit));
+        }
+        sink(&buf[..n]);
+    }
+    Ok(total)
+}
+
+/// Checks that writing `path` by a rename would replace a regular file or make a new one:
+/// renaming onto a device node or a symbolic link would replace the node or the link itself.
+///
+/// # Errors
+/// One saying what the path is instead.
+pub fn check_replaceable(path: &Path) -> io::Result<()> {
+    match std::fs::symlink_metadata(path) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => Ok(()),
+        Err(e) => Err(e),
+        Ok(m) if m.file_type().is_file() => Ok(()),
+        Ok(m) if m.file_type().is_symlink() => Err(io::Error::other(
+            "a symbolic link: outputs replace regular files only (give the file it points to)",
+        )),
+        Ok(m) => Err(io::Error::other(format!(
+            "not a regular file ({}): outputs replace regular files only",
+            kind(m.file_type())
+        ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn regular_files_are_read_and_others_refused_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("a.txt");
+        std::fs::write(&f, b"hello").unwrap();
+        assert_eq!(read_regular(&f, 5).unwrap(), b"hello");
+        let e = read_regular(&f, 4).unwrap_err().to_string();
+        assert_eq!(e, "5 bytes, more than the 4 bytes a file may have here");
+        let e = read_regular(dir.path(), 100).unwrap_err().to_string();
+        assert_eq!(e, "not a regular file (a folder)");
+        #[cfg(unix)]
+        {
+            let e = read_regular(Path::new("/dev/zero"), 100)
+                .unwrap_err()
+                .to_string();
+            assert_eq!(e, "not a regular file (a device)");
+        }
+        let mut seen: Vec<u8> = Vec::new();
+        assert_eq!(stream_regular(&f, 5, &mut |b| seen.extend(b)).unwrap(), 5);
+        assert_eq!(seen, b"hello");
+        std::fs::write(&f, [0xff, 0xfe]).unwrap();
+        let e = read_regular_string(&f, 5).unwrap_err();
+        assert_eq!(e.kind(), io::ErrorKind::InvalidData);
+        assert_eq!(size(MAX_MESH_BYTES), "256 MiB");
+        assert_eq!(size(MAX_RESULTS_BYTES), "1 GiB");
+    }
+}
