@@ -77,7 +77,7 @@ pub enum HandError {
 }
 
 /// A three-fingered hand with two phalanges per finger (Barrett-like).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Hand {
     /// Name of the hand.
@@ -98,7 +98,7 @@ pub struct Hand {
 }
 
 /// Palm dimensions.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Palm {
     /// Palm thickness from its centreline to its contact surface `[mm]`.
@@ -110,7 +110,7 @@ pub struct Palm {
 }
 
 /// Where the joint-1 axes are and how far each joint turns.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Joints {
     /// Distance of each joint-1 axis from the palm centre, sideways `[mm]`.
@@ -124,7 +124,7 @@ pub struct Joints {
 }
 
 /// Finger cross-section and spacing.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct FingerGeometry {
     /// Distance between the centrelines of adjacent fingers along the palm's up axis `[mm]`.
@@ -142,7 +142,7 @@ pub struct FingerGeometry {
 }
 
 /// One phalanx.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Phalanx {
     /// Length from its joint axis to the next joint axis, or to the tip `[mm]`.
@@ -154,7 +154,7 @@ pub struct Phalanx {
 }
 
 /// Which side of the palm a finger's joints are on.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Side {
     /// Joint 1 at +lateral (the palm frame's +Y).
@@ -164,7 +164,7 @@ pub enum Side {
 }
 
 /// One finger.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct Finger {
     /// Name (`finger_1` …).
