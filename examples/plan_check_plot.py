@@ -57,14 +57,15 @@ def main() -> int:
 
     fig = plt.figure(figsize=(7, 7))
     ax = fig.add_subplot(projection="3d")
+    ax.computed_zorder = False  # draw the palm frame over the object, not hidden inside it
     tris = obj.vertices[obj.faces]
-    ax.add_collection3d(Poly3DCollection(tris, facecolor="0.8", edgecolor="0.5", linewidth=0.2, alpha=0.5))
+    ax.add_collection3d(Poly3DCollection(tris, facecolor="0.85", edgecolor="0.6", linewidth=0.1, alpha=0.3, zorder=1))
     pose = plan.grasp.palm_pose
     origin, size = pose[:3, 3], 0.3 * np.ptp(obj.vertices, axis=0).max()
     for k, colour in enumerate(("red", "green", "blue")):
         tip = origin + size * pose[:3, k]
-        ax.plot(*zip(origin, tip), color=colour, linewidth=2)
-    ax.scatter(*origin, color="black", s=30, label="palm centre")
+        ax.plot(*zip(origin, tip), color=colour, linewidth=3, zorder=5)
+    ax.scatter(*origin, color="black", s=40, label="palm centre (frame: x red, y green, z blue)", zorder=6)
     lo, hi = obj.vertices.min(axis=0), obj.vertices.max(axis=0)
     centre, half = (lo + hi) / 2, (hi - lo).max() / 2 + size
     for axis, c in zip("xyz", centre):
