@@ -10,6 +10,7 @@ import numpy as np
 import numpy.typing as npt
 
 VERSION: str
+DEBUG_BUILD: bool
 
 class GraspSimError(Exception):
     """Any error of grasp-sim: its message is the one line the command line prints."""

@@ -655,6 +655,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("BadScenarioError", py.get_type::<BadScenarioError>())?;
     m.add("BadHandError", py.get_type::<BadHandError>())?;
     m.add("VERSION", env!("CARGO_PKG_VERSION"))?;
+    // The library's test hooks (`GRASP_SIM_TEST_FAULT`) exist in debug builds only.
+    m.add("DEBUG_BUILD", cfg!(debug_assertions))?;
     m.add_function(wrap_pyfunction!(load_hand, m)?)?;
     m.add_function(wrap_pyfunction!(load_mesh_file, m)?)?;
     m.add_function(wrap_pyfunction!(mesh_from_arrays, m)?)?;

@@ -254,6 +254,16 @@ def test_a_bad_batch_input_is_an_error_line_or_raises(tmp_path, monkeypatch):
         gs.batch([tmp_path / "missing.toml"])
 
 
+def test_a_panic_in_the_library_is_an_error_line_not_a_crash(monkeypatch):
+    if not gs._native.DEBUG_BUILD:
+        pytest.skip("the library's fault hook (GRASP_SIM_TEST_FAULT) is in debug builds only")
+    monkeypatch.chdir(ROOT)
+    monkeypatch.setenv("GRASP_SIM_TEST_FAULT", "panic:cylinder_d40")
+    lines = {r["batch"]["input"]: r for r in gs.batch(["scenarios/cylinder_d40.toml", "scenarios/cup.toml"])}
+    assert "panicked: test fault" in lines["scenarios/cylinder_d40.toml"]["error"]
+    assert lines["scenarios/cup.toml"]["sim"]["verdict"] == "hold"
+
+
 # --- Another Python thread makes progress while a check runs (the GIL is released).
 
 def test_another_thread_runs_while_a_check_runs(cup, cup_plan):
