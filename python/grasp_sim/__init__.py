@@ -397,9 +397,16 @@ def _scenario(obj: Object, hand: Hand, planner: Mapping[str, Any], sim: Mapping[
     return s
 
 
+def _plain(value: Any) -> Any:
+    """numpy scalars and arrays as the Python numbers and lists a scenario table holds."""
+    if isinstance(value, (np.generic, np.ndarray)):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not a scenario value (a number, string, bool or list)")
+
+
 def _run(label: str, scenario: Dict[str, Any], **flags: Any) -> Dict[str, Any]:
     try:
-        text = json.dumps(scenario, allow_nan=False)
+        text = json.dumps(scenario, allow_nan=False, default=_plain)
     except (TypeError, ValueError) as e:
         raise BadScenarioError(f"{label}: {e}") from None
     return json.loads(_native.run_table(text, label, **flags))
