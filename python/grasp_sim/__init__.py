@@ -137,7 +137,7 @@ class Object:
     ``mass_kg``)."""
 
     def __init__(self) -> None:  # use from_file, from_arrays or from_trimesh
-        self._tmp: Optional[tempfile.TemporaryDirectory] = None
+        self._tmp: Optional[tempfile.TemporaryDirectory[str]] = None
 
     @classmethod
     def from_file(
@@ -409,7 +409,8 @@ def _run(label: str, scenario: Dict[str, Any], **flags: Any) -> Dict[str, Any]:
         text = json.dumps(scenario, allow_nan=False, default=_plain)
     except (TypeError, ValueError) as e:
         raise BadScenarioError(f"{label}: {e}") from None
-    return json.loads(_native.run_table(text, label, **flags))
+    report: Dict[str, Any] = json.loads(_native.run_table(text, label, **flags))
+    return report
 
 
 def plan(obj: Any, hand: Union[None, str, "os.PathLike[str]", Hand] = None, *, candidates: int = 1,
@@ -504,7 +505,9 @@ def run_scenario(path: PathLike, *, units: str = "mm", gravity: Optional[str] = 
     Raises:
         GraspSimError (a subclass): the line the CLI prints after ``grasp-sim: error:``.
     """
-    return json.loads(_native.run_file(os.fspath(path), units, gravity, no_sim, payload, quality, candidates))
+    line = _native.run_file(os.fspath(path), units, gravity, no_sim, payload, quality, candidates)
+    report: Dict[str, Any] = json.loads(line)
+    return report
 
 
 def _stderr_bar(done: int, total: int, message: str) -> None:
