@@ -204,7 +204,7 @@ class Object:
             raise BadInputError(
                 f"<arrays>: vertices must be (N, 3) and faces (M, 3), got {v.shape} and {f.shape}"
             )
-        stl, mv, mf, info = _native.mesh_from_arrays(v, f, units, "<arrays>")
+        stl, (mv, mf, info) = _native.mesh_from_arrays(v, f, units, "<arrays>")
         o = cls()
         o._tmp = tempfile.TemporaryDirectory(prefix="grasp_sim_")
         o.path = os.path.join(o._tmp.name, f"{name}.stl")

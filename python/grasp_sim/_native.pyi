@@ -34,8 +34,8 @@ def load_mesh_file(
 
 def mesh_from_arrays(
     vertices: npt.NDArray[np.float64], faces: npt.NDArray[np.int64], units: str, label: str
-) -> Tuple[bytes, npt.NDArray[np.float64], npt.NDArray[np.int64], str]:
-    """``(binary STL, vertices [mm], faces, info_json)`` of arrays, validated by the loader."""
+) -> Tuple[bytes, Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64], str]]:
+    """``(binary STL, (vertices [mm], faces, info_json))`` of arrays, validated by the loader."""
 
 def run_table(
     scenario_json: str,

@@ -235,7 +235,7 @@ fn stl_bytes(
 
 /// Validates a mesh given as arrays (`vertices (N, 3)` in `units`, `faces (M, 3)` zero-based)
 /// through the loader, as a binary STL of those triangles; returns
-/// `(stl_bytes, vertices [mm], faces, info_json)`. The STL is what the pipeline reads.
+/// `(stl_bytes, (vertices [mm], faces, info_json))`. The STL is what the pipeline reads.
 #[pyfunction]
 fn mesh_from_arrays<'py>(
     py: Python<'py>,
@@ -243,12 +243,7 @@ fn mesh_from_arrays<'py>(
     faces: PyReadonlyArray2<'py, i64>,
     units: &str,
     label: PathBuf,
-) -> PyResult<(
-    Bound<'py, PyBytes>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<i64>>,
-    String,
-)> {
+) -> PyResult<(Bound<'py, PyBytes>, MeshOut<'py>)> {
     let unit = unit(units)?;
     let (vs, fs) = (vertices.as_array(), faces.as_array());
     if vs.ncols() != 3 || fs.ncols() != 3 {
@@ -270,9 +265,7 @@ fn mesh_from_arrays<'py>(
     })?;
     Ok((
         PyBytes::new(py, &stl),
-        v.into_pyarray(py),
-        f.into_pyarray(py),
-        info,
+        (v.into_pyarray(py), f.into_pyarray(py), info),
     ))
 }
 
