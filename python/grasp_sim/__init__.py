@@ -1,0 +1,559 @@
+"""grasp-sim from Python: plan enveloping grasps for a three-fingered hand and check them in a
+rapier3d physics scene (docs/PYTHON.md).
+
+The Rust library is the one implementation: this package converts arguments into the scenario
+the command line would read, runs it in Rust (the GIL released) and turns the JSON report into
+objects with numpy arrays. Units are the library's: millimetres and degrees for geometry and
+joint angles, SI for the physics check's figures.
+
+    import grasp_sim as gs
+    cup = gs.Object.from_file("assets/objects/cup.stl", frame="file")
+    plan = gs.plan(cup)                       # thesis hand, thesis planner defaults
+    print(plan.status, plan.grasp.joint_angles_deg)
+    print(gs.check(cup, plan).verdict)        # hold / slip / drop
+
+Errors are exceptions under :class:`GraspSimError` carrying the command line's one-line message.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import tempfile
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Mapping, Optional, Union
+
+import numpy as np
+
+from . import _native
+from ._native import BadHandError, BadInputError, BadScenarioError, GraspSimError
+
+__all__ = [
+    "GraspSimError",
+    "BadInputError",
+    "BadScenarioError",
+    "BadHandError",
+    "Hand",
+    "Object",
+    "Grasp",
+    "Plan",
+    "Check",
+    "plan",
+    "check",
+    "run_scenario",
+    "batch",
+    "__version__",
+]
+
+__version__: str = _native.VERSION
+
+PathLike = Union[str, "os.PathLike[str]"]
+"""A file path, as a string or a path object."""
+
+Progress = Callable[[int, int, str], Any]
+"""A progress callback: ``(done, total, message)``, the message as the CLI's batch shows it."""
+
+
+class Hand:
+    """A hand model: a bundled one (``"thesis"``, ``"bh8"``) or a hand TOML file.
+
+    ``params`` holds its parameters as the hand file has them, overrides applied and validated
+    (millimetres and degrees): ``hand.params["phalanx_1"]["length_mm"]``.
+    """
+
+    name: str
+    """The hand's ``name``."""
+    file: str
+    """What a scenario's ``[hand] file`` names it by: the bundled name, or the absolute path."""
+    overrides: Dict[str, float]
+    """The overrides applied (dotted keys of the hand file, as ``[hand] overrides``)."""
+    params: Dict[str, Any]
+    """Every parameter, as the hand file's tables: ``palm``, ``joints``, ``fingers``,
+    ``phalanx_1``, ``phalanx_2`` and the ``finger`` list."""
+
+    def __init__(self, name: str, file: str, overrides: Dict[str, float], params: Dict[str, Any]):
+        self.name, self.file, self.overrides, self.params = name, file, overrides, params
+
+    @classmethod
+    def load(cls, spec: PathLike = "thesis", overrides: Optional[Mapping[str, float]] = None) -> "Hand":
+        """Loads a bundled hand by name, or a hand TOML file, applying ``overrides``
+        (``{"phalanx_2.length_mm": 18.0}``) as a scenario's ``[hand] overrides`` would.
+
+        A name is a bundled hand unless a file of that name exists, as in ``[hand] file``.
+
+        Raises:
+            BadHandError: unreadable file, bad TOML, unknown key, a value out of range.
+        """
+        ov = {str(k): float(v) for k, v in (overrides or {}).items()}
+        name, file, params = _native.load_hand(os.fspath(spec), list(ov.items()))
+        return cls(name, file, ov, json.loads(params))
+
+    @property
+    def finger_names(self) -> List[str]:
+        """The fingers, in the thesis's order (finger_1, the thumb finger_2, finger_3)."""
+        return [f["name"] for f in self.params["finger"]]
+
+    def _table(self) -> Dict[str, Any]:
+        t: Dict[str, Any] = {"file": self.file}
+        if self.overrides:
+            t["overrides"] = dict(self.overrides)
+        return t
+
+    def __repr__(self) -> str:
+        return f"Hand({self.name!r}, file={self.file!r}, overrides={self.overrides!r})"
+
+
+def _to_hand(hand: Union[None, str, "os.PathLike[str]", Hand]) -> Hand:
+    if hand is None:
+        return Hand.load("thesis")
+    if isinstance(hand, Hand):
+        return hand
+    return Hand.load(hand)
+
+
+class Object:
+    """An object to grasp: a validated triangle mesh, read as the command line reads it.
+
+    ``vertices`` (N × 3, millimetres) and ``faces`` (M × 3, zero-based) are the mesh as the
+    planner sees it: welded, degenerate triangles dropped, small holes closed, wound outwards,
+    in the file's own frame (the frame every pose is given in).
+    """
+
+    name: str
+    """The scenario name the runs get (the file's stem, or ``"object"`` for arrays)."""
+    path: str
+    """The mesh file the runs read (for arrays: a binary STL of them in a temporary folder)."""
+    units: str
+    """The unit of the file's or the arrays' coordinates."""
+    vertices: np.ndarray
+    """Vertex positions ``[mm]``, N × 3 float64."""
+    faces: np.ndarray
+    """Triangles as vertex indices, M × 3 int64."""
+    info: Dict[str, Any]
+    """What loading found: ``triangles_read``, ``degenerate_dropped``, ``holes_filled``,
+    ``was_inverted``, ``volume_mm3``, edge counts and ``warnings``."""
+    object_params: Dict[str, Any]
+    """Further ``[object]`` keys the runs get (``frame``, ``friction``, ``density_kg_m3``,
+    ``mass_kg``)."""
+
+    def __init__(self) -> None:  # use from_file, from_arrays or from_trimesh
+        self._tmp: Optional[tempfile.TemporaryDirectory[str]] = None
+
+    @classmethod
+    def from_file(
+        cls,
+        path: PathLike,
+        units: str = "mm",
+        *,
+        name: Optional[str] = None,
+        **object_params: Any,
+    ) -> "Object":
+        """Reads and validates a mesh file (STL, OBJ, PLY, or the object a URDF describes).
+
+        Args:
+            path: the file.
+            units: ``"mm"``, ``"cm"``, ``"inch"`` or ``"m"``.
+            name: the runs' scenario name (default: the file's stem).
+            **object_params: further ``[object]`` keys: ``frame`` (``"file"`` keeps the file's
+                frame as the object's, docs/FRAMES.md), ``friction``, ``density_kg_m3``,
+                ``mass_kg``.
+
+        Raises:
+            BadInputError: the file cannot be read or fails validation (the CLI's message).
+        """
+        o = cls()
+        o.path = os.path.abspath(os.fspath(path))
+        o.units = units
+        o.name = name if name is not None else os.path.splitext(os.path.basename(o.path))[0]
+        v, f, info = _native.load_mesh_file(o.path, units)
+        o.vertices, o.faces, o.info = v, f, json.loads(info)
+        o.object_params = dict(object_params)
+        return o
+
+    @classmethod
+    def from_arrays(
+        cls,
+        vertices: Any,
+        faces: Any = None,
+        units: str = "mm",
+        *,
+        name: str = "object",
+        **object_params: Any,
+    ) -> "Object":
+        """A mesh from arrays: ``vertices`` (N × 3, in ``units``) and ``faces`` (M × 3,
+        zero-based indices), validated as a mesh file is; a ``trimesh.Trimesh`` may stand for
+        both.
+
+        The arrays give exactly the plan a file holding them gives: like every format they are
+        read as float32 triangles, then welded and repaired by the same loader.
+
+        Raises:
+            BadInputError: wrong shapes, NaN or infinite coordinates, a face index out of range
+                (faces are numbered from 1 in the message, as in files), no triangles.
+        """
+        if faces is None and hasattr(vertices, "vertices") and hasattr(vertices, "faces"):
+            vertices, faces = vertices.vertices, vertices.faces
+        if faces is None:
+            raise BadInputError("Object.from_arrays: faces missing (or give a trimesh.Trimesh)")
+        v = np.ascontiguousarray(np.asarray(vertices, dtype=np.float64))
+        f = np.asarray(faces)
+        if f.size and not np.issubdtype(f.dtype, np.integer):
+            raise BadInputError(f"<arrays>: faces must be integer indices, got dtype {f.dtype}")
+        f = np.ascontiguousarray(f.astype(np.int64, copy=False))
+        if v.ndim != 2 or f.ndim != 2:
+            raise BadInputError(
+                f"<arrays>: vertices must be (N, 3) and faces (M, 3), got {v.shape} and {f.shape}"
+            )
+        stl, (mv, mf, info) = _native.mesh_from_arrays(v, f, units, "<arrays>")
+        o = cls()
+        o._tmp = tempfile.TemporaryDirectory(prefix="grasp_sim_")
+        o.path = os.path.join(o._tmp.name, f"{name}.stl")
+        with open(o.path, "wb") as fh:
+            fh.write(stl)
+        o.units, o.name = units, name
+        o.vertices, o.faces, o.info = mv, mf, json.loads(info)
+        o.object_params = dict(object_params)
+        return o
+
+    @classmethod
+    def from_trimesh(cls, mesh: Any, units: str = "mm", **kwargs: Any) -> "Object":
+        """A ``trimesh.Trimesh`` (trimesh is optional: only its ``vertices`` and ``faces`` are
+        read)."""
+        return cls.from_arrays(mesh.vertices, mesh.faces, units, **kwargs)
+
+    def _table(self) -> Dict[str, Any]:
+        t: Dict[str, Any] = {"mesh": self.path, "units": self.units}
+        t.update({k: v for k, v in self.object_params.items() if v is not None})
+        return t
+
+    def __repr__(self) -> str:
+        return f"Object({self.name!r}, {len(self.vertices)} vertices, {len(self.faces)} faces)"
+
+
+def _to_object(obj: Any) -> Object:
+    if isinstance(obj, Object):
+        return obj
+    if isinstance(obj, (str, os.PathLike)):
+        return Object.from_file(obj)
+    if hasattr(obj, "vertices") and hasattr(obj, "faces"):
+        return Object.from_arrays(obj.vertices, obj.faces)
+    raise BadInputError(f"not an object: {type(obj).__name__} (give an Object, a path or a trimesh.Trimesh)")
+
+
+def _pose_matrix(pose: Mapping[str, Any]) -> np.ndarray:
+    """The 4 × 4 homogeneous matrix of a report's ``{position_mm, quaternion_wxyz}``."""
+    w, x, y, z = pose["quaternion_wxyz"]
+    m = np.eye(4)
+    m[:3, :3] = [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ]
+    m[:3, 3] = pose["position_mm"]
+    return m
+
+
+class Grasp:
+    """One planned grasp (the report's ``plan.grasp`` or an entry of ``plan.grasps``)."""
+
+    palm_pose: np.ndarray
+    """The palm frame in the object's (the mesh file's) frame, 4 × 4, millimetres: the palm
+    centre on its contact surface; x away from the object, y towards finger_1 and finger_3, z up
+    along the finger joint axes."""
+    palm_pose_aligned: np.ndarray
+    """The same in the planner's aligned frame."""
+    joint_angles_deg: np.ndarray
+    """``[θ1, θ2]`` per finger (3 × 2), interior angles: 180° straight, smaller more closed."""
+    axis: np.ndarray
+    """The principal axis the grasp wraps, in the object's frame."""
+    axis_name: str
+    rules: str
+    """The rule set that found it (``thesis``, ``extended``, ``pinch``)."""
+    relaxations: List[Any]
+    approach_angle_deg: float
+    palm_pitch_deg: float
+    elevation_index: int
+    elevation_mm: float
+    index: int
+    """Its place in the plan's ``candidates`` (0: the grasp reported)."""
+    raw: Dict[str, Any]
+    """The report's JSON object for this grasp."""
+
+    def __init__(self, raw: Dict[str, Any], index: int = 0, plan: Optional["Plan"] = None):
+        self.raw, self.index, self._plan = raw, index, plan
+        self.palm_pose = _pose_matrix(raw["palm_pose"])
+        self.palm_pose_aligned = _pose_matrix(raw["palm_pose_aligned"])
+        self.joint_angles_deg = np.array([[f["theta1_deg"], f["theta2_deg"]] for f in raw["fingers"]])
+        self.axis = np.array(raw.get("axis", [0.0, 0.0, 1.0]), dtype=float)
+        self.axis_name = raw.get("axis_name", "")
+        self.rules = raw.get("rules", "")
+        self.relaxations = list(raw.get("relaxations", []))
+        self.approach_angle_deg = raw["approach_angle_deg"]
+        self.palm_pitch_deg = raw["palm_pitch_deg"]
+        self.elevation_index = raw["elevation_index"]
+        self.elevation_mm = raw["elevation_mm"]
+
+    @property
+    def finger_names(self) -> List[str]:
+        return [f["name"] for f in self.raw["fingers"]]
+
+    def __repr__(self) -> str:
+        a = np.round(self.joint_angles_deg, 1).tolist()
+        return (f"Grasp(index {self.elevation_index}, approach {self.approach_angle_deg:g}°, "
+                f"pitch {self.palm_pitch_deg:.1f}°, angles {a}, rules {self.rules!r})")
+
+
+class Plan:
+    """What the planner found (``plan(...)``): the report's ``plan`` section, typed."""
+
+    status: str
+    """``"feasible"`` or ``"ungraspable"``."""
+    reason: Optional[str]
+    """Why ungraspable (``None`` when feasible)."""
+    grasp: Optional[Grasp]
+    """The grasp reported (``None`` when ungraspable)."""
+    candidates: List[Grasp]
+    """Every grasp collected, in search order (``candidates=N`` collects up to N); the first
+    is ``grasp``."""
+    candidates_tried: int
+    """Candidates the search tried."""
+    warnings: List[str]
+    report: Dict[str, Any]
+    """The whole run report, as the CLI's ``--json`` prints it."""
+
+    def __init__(self, report: Dict[str, Any], obj: Object, hand: Hand, planner_params: Dict[str, Any]):
+        self.report, self.object, self.hand, self.planner_params = report, obj, hand, planner_params
+        p = report["plan"]
+        self.status = p["status"]
+        self.reason = p.get("reason")
+        self.candidates_tried = p.get("candidates_tried", 0)
+        self.warnings = list(report.get("warnings", []))
+        self.grasp = Grasp(p["grasp"], 0, self) if p.get("grasp") else None
+        grasps = p.get("grasps") or ([p["grasp"]] if p.get("grasp") else [])
+        self.candidates = [Grasp(g, i, self) for i, g in enumerate(grasps)]
+        if self.grasp is not None and self.candidates:
+            self.candidates[0] = self.grasp
+
+    @property
+    def is_feasible(self) -> bool:
+        """True if and only if the planner found a grasp."""
+        return self.status == "feasible"
+
+    def __repr__(self) -> str:
+        return f"Plan({self.status!r}, {self.grasp if self.grasp else self.reason})"
+
+
+class Check:
+    """The physics check's result (``check(...)``): the report's ``sim`` section, typed."""
+
+    verdict: str
+    """``"hold"``, ``"slip"``, ``"drop"`` or ``"not_run"``."""
+    reason: Optional[str]
+    translation_mm: Optional[float]
+    """The object's largest translation relative to the palm during the hold."""
+    rotation_deg: Optional[float]
+    directions: List[Dict[str, Any]]
+    """Per gravity direction: its verdict, translation and rotation (``gravity="six"`` gives
+    six)."""
+    payload_margin: Optional[float]
+    """With ``payload=True``: the largest payload multiplier that still holds."""
+    closing: Optional[Dict[str, Any]]
+    """What the closing did to the planned grasp (docs/SIM.md)."""
+    grasp: Optional[Grasp]
+    """The grasp checked."""
+    sim: Dict[str, Any]
+    """The report's ``sim`` object."""
+    report: Dict[str, Any]
+    """The whole run report, as the CLI's ``--json`` prints it."""
+
+    def __init__(self, report: Dict[str, Any]):
+        self.report = report
+        s = self.sim = report["sim"]
+        self.verdict = s["verdict"]
+        self.reason = s.get("reason")
+        self.translation_mm = s.get("translation_mm")
+        self.rotation_deg = s.get("rotation_deg")
+        self.directions = list(s.get("directions", []))
+        self.payload_margin = s.get("payload_margin")
+        self.closing = s.get("closing")
+        g = report["plan"].get("grasp")
+        self.grasp = Grasp(g) if g else None
+
+    @property
+    def is_hold(self) -> bool:
+        """True if and only if the verdict is ``hold``."""
+        return self.verdict == "hold"
+
+    def __repr__(self) -> str:
+        return f"Check({self.verdict!r}, translation {self.translation_mm} mm, rotation {self.rotation_deg}°)"
+
+
+def _scenario(obj: Object, hand: Hand, planner: Mapping[str, Any], sim: Mapping[str, Any]) -> Dict[str, Any]:
+    s: Dict[str, Any] = {"name": obj.name, "object": obj._table(), "hand": hand._table()}
+    if planner:
+        s["planner"] = dict(planner)
+    if sim:
+        s["sim"] = dict(sim)
+    return s
+
+
+def _plain(value: Any) -> Any:
+    """numpy scalars and arrays as the Python numbers and lists a scenario table holds."""
+    if isinstance(value, (np.generic, np.ndarray)):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not a scenario value (a number, string, bool or list)")
+
+
+def _run(label: str, scenario: Dict[str, Any], **flags: Any) -> Dict[str, Any]:
+    try:
+        text = json.dumps(scenario, allow_nan=False, default=_plain)
+    except (TypeError, ValueError) as e:
+        raise BadScenarioError(f"{label}: {e}") from None
+    report: Dict[str, Any] = json.loads(_native.run_table(text, label, **flags))
+    return report
+
+
+def plan(obj: Any, hand: Union[None, str, "os.PathLike[str]", Hand] = None, *, candidates: int = 1,
+         **planner_params: Any) -> Plan:
+    """Plans a grasp with the thesis method (kinematic only: no physics check).
+
+    Args:
+        obj: an :class:`Object` (or a mesh path, or a ``trimesh.Trimesh``).
+        hand: a :class:`Hand`, a bundled hand's name or a hand file (default: the thesis hand).
+        candidates: collect up to this many feasible grasps in search order (``--candidates``).
+        **planner_params: ``[planner]`` keys of a scenario (docs/SCENARIO.md), e.g.
+            ``height_step_mm=2.5``, ``sf_c=0.6``, ``angular_step_deg=10.0``.
+
+    Raises:
+        BadScenarioError: an unknown key or a value out of range (the CLI's message).
+        BadHandError, BadInputError: a bad hand or mesh.
+    """
+    o, h = _to_object(obj), _to_hand(hand)
+    report = _run("grasp_sim.plan", _scenario(o, h, planner_params, {}), no_sim=True, candidates=candidates)
+    return Plan(report, o, h, dict(planner_params))
+
+
+def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
+          hand: Union[None, str, "os.PathLike[str]", Hand] = None, gravity: str = "down",
+          samples: int = 1, *, payload: bool = False, quality: bool = False,
+          planner_params: Optional[Mapping[str, Any]] = None, **sim_params: Any) -> Check:
+    """Checks a grasp in the rapier3d physics scene (docs/SIM.md).
+
+    Args:
+        obj: the object the grasp was planned on.
+        plan_or_grasp: a :class:`Plan` (its grasp is checked) or its first grasp; ``None``
+            plans and checks as the CLI does (candidates in search order until one holds), or
+            checks ``override_angles=[[θ1, θ2], ...]`` given in ``sim_params``.
+        hand: default: the plan's hand (else the thesis hand).
+        gravity: ``"down"`` (−Z of the aligned frame) or ``"six"`` (±X, ±Y, ±Z in turn).
+        samples: 1 (a robust verdict over perturbed samples is not in this version).
+        payload: also find the payload margin (several more physics runs).
+        quality: also compute the grasp's Ferrari–Canny quality (``report["quality"]``).
+        planner_params: default: the plan's.
+        **sim_params: ``[sim]`` keys of a scenario, e.g. ``torque_limit_nm=0.5``,
+            ``duration_s=2.0``, ``protocol="full"``.
+
+    Raises:
+        BadInputError: a grasp that is not a plan's first one, or ``samples`` other than 1.
+        BadScenarioError, BadHandError: as :func:`plan`.
+    """
+    if samples != 1:
+        raise BadInputError(f"samples: {samples}: only 1 is supported (no robust verdict in this version)")
+    o = _to_object(obj)
+    source: Optional[Plan] = None
+    if isinstance(plan_or_grasp, Grasp):
+        if plan_or_grasp._plan is None or plan_or_grasp.index != 0:
+            raise BadInputError(
+                "check: only a plan's first grasp can be checked (candidates[0]); "
+                f"this is candidates[{plan_or_grasp.index}]"
+            )
+        source = plan_or_grasp._plan
+    elif isinstance(plan_or_grasp, Plan):
+        source = plan_or_grasp
+    elif plan_or_grasp is not None:
+        raise BadInputError(f"check: not a Plan or Grasp: {type(plan_or_grasp).__name__}")
+    if source is not None and source.grasp is None:
+        raise BadInputError(f"check: the plan has no grasp ({source.reason})")
+    h = _to_hand(hand if hand is not None else (source.hand if source else None))
+    pp = dict(planner_params if planner_params is not None else (source.planner_params if source else {}))
+    sim = dict(sim_params)
+    sim["gravity"] = gravity
+    flags: Dict[str, Any] = {"payload": payload, "quality": quality}
+    if source is not None:
+        # The planner is deterministic: the same object, hand and parameters give the same
+        # first grasp, and checking only it (max_checked 1) checks the plan's grasp.
+        flags["max_checked"] = 1
+    report = _run("grasp_sim.check", _scenario(o, h, pp, sim), **flags)
+    result = Check(report)
+    if source is not None and source.grasp is not None:
+        got, want = report["plan"].get("grasp") or {}, source.grasp.raw
+        same = all(got.get(k) == want.get(k) for k in ("palm_pose", "fingers", "elevation_index"))
+        if not same:
+            raise GraspSimError("check: the grasp checked is not the plan's (the object, hand or planner parameters differ)")
+    return result
+
+
+def run_scenario(path: PathLike, *, units: str = "mm", gravity: Optional[str] = None,
+                 no_sim: bool = False, payload: bool = False, quality: bool = False,
+                 candidates: int = 1) -> Dict[str, Any]:
+    """Runs a scenario file (or a bare mesh with the built-in template) and returns exactly the
+    JSON object ``grasp-sim --json PATH`` prints (docs/OUTPUT.md).
+
+    The keyword arguments are the CLI's flags: ``--units`` (bare meshes), ``--gravity``,
+    ``--no-sim``, ``--payload``, ``--quality``, ``--candidates``.
+
+    Raises:
+        GraspSimError (a subclass): the line the CLI prints after ``grasp-sim: error:``.
+    """
+    line = _native.run_file(os.fspath(path), units, gravity, no_sim, payload, quality, candidates)
+    report: Dict[str, Any] = json.loads(line)
+    return report
+
+
+def _stderr_bar(done: int, total: int, message: str) -> None:
+    width = 30
+    filled = width * done // max(total, 1)
+    sys.stderr.write(f"\r[{'#' * filled}{'.' * (width - filled)}] {done}/{total} {message[-60:]:<60}")
+    if done == total:
+        sys.stderr.write("\n")
+    sys.stderr.flush()
+
+
+def batch(inputs: Union[PathLike, Iterable[PathLike]], jobs: Optional[int] = None,
+          out: Optional[PathLike] = None, resume: bool = False,
+          progress: Union[None, bool, Progress] = None, *, no_sim: bool = False,
+          payload: bool = False, quality: bool = False, units: Optional[str] = None,
+          template: Optional[PathLike] = None) -> Iterator[Dict[str, Any]]:
+    """Runs many objects (``grasp-sim batch --in-process``) and yields each one's JSON line, as
+    a dict, as it finishes (completion order; ``line["batch"]["input"]`` says which).
+
+    Args:
+        inputs: scenario files, meshes or folders (as ``grasp-sim batch``).
+        jobs: objects run at once (default: every core).
+        out: also write the results file (JSON Lines, input order) when the batch ends.
+        resume: continue the run in ``out``: its lines for current inputs are yielded first and
+            not run again.
+        progress: ``progress(done, total, message)`` after each object, or ``True`` for a bar
+            on stderr.
+        no_sim, payload, quality, units, template: the batch's flags.
+
+    The objects run on Rust threads with the GIL released; a bad input is a line with an
+    ``error`` (as in the CLI), not an exception. An object that cannot start (no such input,
+    a bad template or results file) raises at the call.
+    """
+    if isinstance(inputs, (str, os.PathLike)):
+        inputs = [inputs]
+    paths = [os.fspath(p) for p in inputs]
+    native = _native.Batch(
+        paths, jobs, None if out is None else os.fspath(out), resume, no_sim, payload, quality,
+        units, None if template is None else os.fspath(template),
+    )
+    callback: Optional[Progress] = _stderr_bar if progress is True else (progress or None)
+
+    def results() -> Iterator[Dict[str, Any]]:
+        for done, total, message, line in native:
+            if callback is not None:
+                callback(done, total, message)
+            yield json.loads(line)
+
+    return results()
