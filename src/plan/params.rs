@@ -60,6 +60,11 @@ impl Default for PlannerParams {
     }
 }
 
+/// The finest HeightStep accepted `[mm]` (thesis default 2.5): 1e-6 mm ran out of memory.
+pub const MIN_HEIGHT_STEP_MM: f64 = 0.1;
+/// The finest AngularStep accepted `[deg]` (thesis default 10): 1e-6° ran out of memory.
+pub const MIN_ANGULAR_STEP_DEG: f64 = 1.0;
+
 impl PlannerParams {
     /// Checks the parameters against the hand and the friction: the key and the problem of the
     /// first one out of range (a scenario reports it with its file, the tuner skips the setting).
@@ -73,6 +78,13 @@ impl PlannerParams {
             return Err((
                 "planner.height_step_mm",
                 format!("must be positive, got {step}"),
+            ));
+        }
+        // The work the steps imply: elevations x approach angles grow as their inverse product.
+        if step < MIN_HEIGHT_STEP_MM {
+            return Err((
+                "planner.height_step_mm",
+                format!("must be at least {MIN_HEIGHT_STEP_MM} mm (a finer index is more work than any finger can use), got {step}"),
             ));
         }
         let ratio = hand.fingers.gap_mm / step;
@@ -101,6 +113,12 @@ impl PlannerParams {
             }
         }
         let a = p.angular_step_deg;
+        if a.is_finite() && a > 0.0 && a < MIN_ANGULAR_STEP_DEG {
+            return Err((
+                "planner.angular_step_deg",
+                format!("must be at least {MIN_ANGULAR_STEP_DEG} (360 approach angles), got {a}"),
+            ));
+        }
         let turns = 360.0 / a;
         if !(a.is_finite() && a > 0.0 && a <= 360.0 && (turns - turns.round()).abs() < 1e-9) {
             return Err((

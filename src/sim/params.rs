@@ -433,6 +433,7 @@ impl SimParams {
         self.validate_positive()?;
         self.validate_counts()?;
         self.validate_bounds()?;
+        self.validate_work()?;
         self.input.validate(fingers)?;
         self.fingers.validate_squeeze()
     }
@@ -505,6 +506,31 @@ impl SimParams {
             return Err((
                 "sim.timestep_s",
                 format!("must be at most 0.05 s and a tenth of duration_s, got {timestep_s}"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The most physics steps one gravity direction's check may take, closing included: 83 times
+/// the defaults' 2400 (0.5 s of closing and 2 s of hold at 960 Hz), some 10 s of this machine's
+/// time per direction. A setting past it (a timestep of 1e-12 s, a hold of 1e9 s) would run for
+/// ever; it is refused, the limit stated.
+pub const MAX_STEPS_PER_DIRECTION: f64 = 200_000.0;
+
+impl SimParams {
+    /// The work the settings imply: the steps of one direction's check, at most
+    /// [`MAX_STEPS_PER_DIRECTION`].
+    fn validate_work(&self) -> Result<(), Invalid> {
+        let t = self.solver.timestep_s;
+        let steps = (self.closing.close_duration_s + self.hold.duration_s) / t;
+        if steps > MAX_STEPS_PER_DIRECTION {
+            return Err((
+                "sim.timestep_s",
+                format!(
+                    "close_duration_s + duration_s = {} s at a timestep of {t} s is {steps:.3e} steps per gravity direction; at most {MAX_STEPS_PER_DIRECTION} (lengthen the timestep or shorten the durations)",
+                    self.closing.close_duration_s + self.hold.duration_s
+                ),
             ));
         }
         Ok(())

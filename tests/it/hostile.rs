@@ -276,3 +276,42 @@ fn a_second_batch_on_the_same_out_is_refused() {
     );
     assert!(!lock.exists(), "the lock file is removed at the end");
 }
+
+/// Settings that are each in range by type but imply unbounded work are refused with the limit
+/// stated: a step so fine it would exhaust memory, a timestep or a hold that would never end.
+#[test]
+fn settings_whose_work_is_unbounded_are_refused_with_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = crate::root().join("assets/objects/cylinder_d40.stl");
+    for (table, key, needle) in [
+        (
+            "[planner]\nangular_step_deg = 1e-6",
+            "planner.angular_step_deg",
+            "at least 1",
+        ),
+        (
+            "[planner]\nheight_step_mm = 1e-6",
+            "planner.height_step_mm",
+            "at least 0.1 mm",
+        ),
+        (
+            "[sim]\ntimestep_s = 1e-12",
+            "sim.timestep_s",
+            "at most 200000",
+        ),
+        (
+            "[sim]\nprotocol = \"full\"\nduration_s = 1e9",
+            "sim.timestep_s",
+            "steps per gravity direction",
+        ),
+    ] {
+        let s = dir.path().join("s.toml");
+        std::fs::write(
+            &s,
+            format!("[object]\nmesh = \"{}\"\n{table}\n", mesh.display()),
+        )
+        .unwrap();
+        let out = grasp_sim().arg(&s).output().unwrap();
+        refused(&out, &["s.toml", key, needle]);
+    }
+}
