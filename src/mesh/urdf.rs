@@ -206,6 +206,55 @@ struct Read {
     mass_kg: Option<f64>,
 }
 
+/// The deepest element nesting read `[levels]`: a URDF needs four or five (robot, link,
+/// visual, geometry, mesh); the XML parser recurses per level, and some 5000 levels of an
+/// unknown element overflowed a worker thread's stack.
+pub const MAX_DEPTH: usize = 256;
+
+/// The nesting depth of `text`'s elements where it first exceeds `limit`, found by a scan of its
+/// tags that does not recurse (comments, processing instructions, declarations and CDATA
+/// skipped); `None` when it stays within.
+fn nesting_deeper_than(text: &str, limit: usize) -> Option<usize> {
+    let b = text.as_bytes();
+    let (mut i, mut depth) = (0usize, 0usize);
+    let skip_to = |from: usize, end: &[u8]| {
+        b[from..]
+            .windows(end.len())
+            .position(|w| w == end)
+            .map_or(b.len(), |k| from + k + end.len())
+    };
+    while i < b.len() {
+        if b[i] != b'<' {
+            i += 1;
+            continue;
+        }
+        let rest = &b[i..];
+        if rest.starts_with(b"<!--") {
+            i = skip_to(i + 4, b"-->");
+        } else if rest.starts_with(b"<![CDATA[") {
+            i = skip_to(i + 9, b"]]>");
+        } else if rest.starts_with(b"<?") {
+            i = skip_to(i + 2, b"?>");
+        } else if rest.starts_with(b"<!") {
+            i = skip_to(i + 2, b">");
+        } else if rest.starts_with(b"</") {
+            depth = depth.saturating_sub(1);
+            i = skip_to(i + 2, b">");
+        } else {
+            let end = skip_to(i + 1, b">");
+            let self_closing = end >= 2 && b[end - 2] == b'/';
+            if !self_closing {
+                depth += 1;
+                if depth > limit {
+                    return Some(depth);
+                }
+            }
+            i = end;
+        }
+    }
+    None
+}
+
 /// Reads a URDF: every link's geometry placed in the root link's frame, with notes and mass.
 fn read(path: &Path) -> Result<Read, MeshError> {
     let text =
@@ -215,6 +264,12 @@ fn read(path: &Path) -> Result<Read, MeshError> {
                 error: e,
             }
         })?;
+    if let Some(depth) = nesting_deeper_than(&text, MAX_DEPTH) {
+        return Err(urdf_err(
+            path,
+            format!("elements nested {depth} deep; a URDF is read to at most {MAX_DEPTH} levels"),
+        ));
+    }
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| urdf_err(path, format!("not well-formed XML: {e}")))?;
     let robot = doc.root_element();

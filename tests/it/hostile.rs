@@ -315,3 +315,56 @@ fn settings_whose_work_is_unbounded_are_refused_with_the_limit() {
         refused(&out, &["s.toml", key, needle]);
     }
 }
+
+/// A URDF with an unknown element nested 5000 deep (35 KB) overflowed the stack of the batch's
+/// parent while it hashed its inputs, losing the whole batch: it is now refused by its depth,
+/// in a single run and in a batch, and the other input still runs.
+#[test]
+fn a_deeply_nested_urdf_is_refused_by_its_depth() {
+    let dir = tempfile::tempdir().unwrap();
+    let deep = dir.path().join("deep.urdf");
+    let n = 5000;
+    let body = "<link name=\"a\"><collision><geometry><box size=\"0.02 0.02 0.02\"/></geometry></collision></link>";
+    std::fs::write(
+        &deep,
+        format!(
+            "<?xml version=\"1.0\"?>\n<!-- <not> <counted> -->\n<robot name=\"r\">{body}{}{}</robot>",
+            "<foo>".repeat(n),
+            "</foo>".repeat(n)
+        ),
+    )
+    .unwrap();
+    let out = grasp_sim().arg("--no-sim").arg(&deep).output().unwrap();
+    refused(
+        &out,
+        &["deep.urdf", "nested 257 deep", "at most 256 levels"],
+    );
+    let good = crate::root().join("assets/objects/cylinder_d40.stl");
+    let out = grasp_sim()
+        .args(["batch", "--no-sim", "--jobs", "1"])
+        .arg(&deep)
+        .arg(&good)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 2, "{text}");
+    assert!(lines[0].contains("at most 256 levels"), "{}", lines[0]);
+    assert!(lines[1].contains("\"status\":\"feasible\""), "{}", lines[1]);
+    // A shallow URDF of the same link reads (the scan counts comments and declarations as no
+    // level, and self-closing elements as none).
+    let shallow = dir.path().join("shallow.urdf");
+    std::fs::write(
+        &shallow,
+        format!("<?xml version=\"1.0\"?>\n<!-- <a> -->\n<robot name=\"r\">{body}</robot>"),
+    )
+    .unwrap();
+    let out = grasp_sim().arg("--no-sim").arg(&shallow).output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
