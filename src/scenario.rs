@@ -338,8 +338,13 @@ impl Scenario {
     }
 }
 
-/// Checks a scenario's `[object]` (one of density and mass, positive; a URDF in metres; the
-/// friction in range) and returns how its mass is given.
+/// The heaviest object a scenario may give `[kg]`.
+pub const MAX_MASS_KG: f64 = 10_000.0;
+/// The densest object a scenario may give `[kg/m³]`.
+pub const MAX_DENSITY_KG_M3: f64 = 100_000.0;
+
+/// Checks a scenario's `[object]` (one of density and mass, positive and at most the limits
+/// above; a URDF in metres; the friction in range) and returns how its mass is given.
 ///
 /// # Errors
 /// The key and the problem, for [`ScenarioError::Invalid`].
@@ -361,6 +366,20 @@ fn validate_object(o: &RawObject) -> Result<MassSpec, (&'static str, String)> {
         }
         MassSpec::Mass(m) if !(m.is_finite() && m > 0.0) => {
             return Err(("object.mass_kg", format!("must be positive, got {m}")))
+        }
+        // The physics check works in f32: past these an object's forces overflow and a check
+        // could say `hold` of 1e20 kg.
+        MassSpec::Density(d) if d > MAX_DENSITY_KG_M3 => {
+            return Err((
+                "object.density_kg_m3",
+                format!("must be at most {MAX_DENSITY_KG_M3} (osmium is 22590), got {d}"),
+            ))
+        }
+        MassSpec::Mass(m) if m > MAX_MASS_KG => {
+            return Err((
+                "object.mass_kg",
+                format!("must be at most {MAX_MASS_KG} kg (no hand holds more), got {m}"),
+            ))
         }
         _ => {}
     }

@@ -368,3 +368,34 @@ fn a_deeply_nested_urdf_is_refused_by_its_depth() {
         String::from_utf8_lossy(&out.stderr)
     );
 }
+
+/// `mass_kg = 1e20` was judged `hold` (the f32 physics overflowed) where 1e3 to 1e19 drop: a
+/// mass or density past any hand is refused, the limit stated, and 1e3 kg still drops.
+#[test]
+fn an_absurd_mass_is_refused_and_a_heavy_one_drops() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = crate::root().join("assets/objects/cylinder_d40.stl");
+    let write = |table: &str| {
+        let s = dir.path().join("m.toml");
+        std::fs::write(
+            &s,
+            format!("[object]\nmesh = \"{}\"\n{table}\n", mesh.display()),
+        )
+        .unwrap();
+        s
+    };
+    let out = grasp_sim().arg(write("mass_kg = 1e20")).output().unwrap();
+    refused(&out, &["m.toml", "object.mass_kg", "at most 10000 kg"]);
+    let out = grasp_sim()
+        .arg(write("density_kg_m3 = 1e9"))
+        .output()
+        .unwrap();
+    refused(&out, &["m.toml", "object.density_kg_m3", "at most 100000"]);
+    let out = grasp_sim()
+        .arg("--json")
+        .arg(write("mass_kg = 1000.0"))
+        .output()
+        .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["sim"]["verdict"], "drop", "{v}");
+}
