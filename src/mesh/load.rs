@@ -77,6 +77,9 @@ pub struct LoadedMesh {
     pub triangles_read: usize,
     /// Zero-area triangles dropped.
     pub degenerate_dropped: usize,
+    /// Triangles dropped because the file has the same face (the same three corners, wound the
+    /// same way) earlier: kept, they would count its volume and mass twice.
+    pub duplicates_dropped: usize,
     /// Edge statistics of what was kept, as the file has it (before small holes are closed).
     pub topology: Topology,
     /// Holes closed because their boundary spans at most `SMALL_HOLE_MM`: a missing triangle,
@@ -594,6 +597,12 @@ impl LoadedMesh {
             ));
         }
         let t = self.topology;
+        if self.duplicates_dropped > 0 {
+            w.push(format!(
+                "dropped {} duplicated faces of {} (each face counted once in the volume and mass)",
+                self.duplicates_dropped, self.triangles_read
+            ));
+        }
         if t.boundary_edges > 0 || t.non_manifold_edges > 0 {
             w.push(format!(
                 "surface is not a closed 2-manifold ({} boundary edges, {} non-manifold edges): \
@@ -985,6 +994,18 @@ fn drop_collinear(mesh: &mut Mesh, diag2: f64) -> usize {
     before - mesh.triangles.len()
 }
 
+/// Drops the triangles that repeat an earlier one's corners in the same cyclic order; how many.
+fn drop_duplicates(mesh: &mut Mesh) -> usize {
+    let before = mesh.triangles.len();
+    let mut seen = std::collections::HashSet::with_capacity(before);
+    mesh.triangles.retain(|t| {
+        // The rotation that puts the smallest index first keeps the winding.
+        let k = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+        seen.insert([t[k], t[(k + 1) % 3], t[(k + 2) % 3]])
+    });
+    before - mesh.triangles.len()
+}
+
 pub(super) fn build(
     raw: Vec<[[f32; 3]; 3]>,
     path: &Path,
@@ -1009,6 +1030,7 @@ pub(super) fn build(
     let (lo, hi) = mesh.bounds();
     let diag2 = (hi - lo).norm_squared();
     degenerate += drop_collinear(&mut mesh, diag2);
+    let duplicates = drop_duplicates(&mut mesh);
     if mesh.triangles.is_empty() {
         return Err(MeshError::AllDegenerate {
             path: p(),
@@ -1040,6 +1062,7 @@ pub(super) fn build(
         mesh,
         triangles_read: raw.len(),
         degenerate_dropped: degenerate,
+        duplicates_dropped: duplicates,
         topology,
         holes_filled,
         was_inverted,

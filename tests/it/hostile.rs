@@ -399,3 +399,41 @@ fn an_absurd_mass_is_refused_and_a_heavy_one_drops() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["sim"]["verdict"], "drop", "{v}");
 }
+
+/// Every face written twice doubled the volume and the mass: the repeats are dropped, the
+/// volume is the single mesh's, and a warning says how many.
+#[test]
+fn duplicated_faces_are_counted_once_and_warned_about() {
+    let dir = tempfile::tempdir().unwrap();
+    let once = grasp_sim::objects::cylinder(40.0, 124.0);
+    let mut twice = once.clone();
+    twice.triangles.extend(once.triangles.clone());
+    let (a, b) = (dir.path().join("once.stl"), dir.path().join("twice.stl"));
+    std::fs::write(&a, once.to_binary_stl()).unwrap();
+    std::fs::write(&b, twice.to_binary_stl()).unwrap();
+    let run = |p: &std::path::Path| {
+        let out = crate::grasp_sim()
+            .args(["--json", "--no-sim"])
+            .arg(p)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        (v, String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    let ((v1, _), (v2, err)) = (run(&a), run(&b));
+    assert_eq!(v1["object"]["volume_mm3"], v2["object"]["volume_mm3"]);
+    assert_eq!(v1["object"]["mass_kg"], v2["object"]["mass_kg"]);
+    let n = once.triangles.len();
+    assert!(
+        err.contains(&format!("dropped {n} duplicated faces of {}", 2 * n)),
+        "{err}"
+    );
+    let volume = v1["object"]["volume_mm3"].as_f64().unwrap();
+    // The faceted cylinder's volume against π r² h.
+    let analytic = std::f64::consts::PI * 20.0f64.powi(2) * 124.0;
+    assert!(
+        (volume - analytic).abs() < 1e-3 * analytic,
+        "{volume} {analytic}"
+    );
+}
