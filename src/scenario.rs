@@ -277,6 +277,36 @@ impl Scenario {
         Scenario::parse(&text, path)
     }
 
+    /// Reads a template for bare meshes (`batch --template`, `tune --template`): a scenario
+    /// whose `[object] mesh` each mesh replaces, so it may leave it out (or the whole
+    /// `[object]` table).
+    ///
+    /// # Errors
+    /// As [`Scenario::load`].
+    pub fn load_template(path: &Path) -> Result<Scenario, ScenarioError> {
+        let scenario = Scenario::load(path);
+        let text = match &scenario {
+            Err(ScenarioError::Parse { .. }) => {
+                crate::files::read_regular_string(path, crate::files::MAX_TEXT_BYTES).ok()
+            }
+            _ => None,
+        };
+        let Some(mut table) = text.and_then(|t| t.parse::<toml::Table>().ok()) else {
+            return scenario;
+        };
+        let object = table
+            .entry("object")
+            .or_insert_with(|| toml::Value::Table(toml::Table::new()));
+        match object.as_table_mut() {
+            Some(o) if !o.contains_key("mesh") => {
+                o.insert("mesh".into(), toml::Value::String(String::new()));
+            }
+            // The mesh is there (or `object` is not a table): the first error stands.
+            _ => return scenario,
+        }
+        Scenario::parse(&table.to_string(), path)
+    }
+
     /// Parses scenario TOML; relative paths resolve against `path`'s folder.
     ///
     /// # Errors

@@ -60,7 +60,7 @@ impl WorkerArgs {
     /// A bad template scenario.
     pub fn template(&self) -> Result<Scenario, crate::scenario::ScenarioError> {
         let mut template = match &self.template {
-            Some(p) => Scenario::load(p)?,
+            Some(p) => Scenario::load_template(p)?,
             None => super::default_template(),
         };
         if let Some(u) = self.units {

@@ -46,7 +46,7 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
         );
     }
     let template = match &request.template {
-        Some(p) => Scenario::load(p)?,
+        Some(p) => Scenario::load_template(p)?,
         None => batch::default_template(),
     };
     let items = batch::expand(&request.inputs)?;

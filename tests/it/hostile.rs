@@ -437,3 +437,42 @@ fn duplicated_faces_are_counted_once_and_warned_about() {
         "{volume} {analytic}"
     );
 }
+
+/// A `batch --template` need not carry a placeholder `[object] mesh` (each mesh replaces it):
+/// one with only its density, or with no `[object]` at all, runs; a typo in it is still refused.
+#[test]
+fn a_template_needs_no_placeholder_mesh() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = crate::root().join("assets/objects/cylinder_d40.stl");
+    for (body, mass) in [
+        ("[object]\ndensity_kg_m3 = 1000.0\n", 0.155_773_557),
+        ("[planner]\nsf_c = 0.5\n", 0.077_886_779),
+    ] {
+        let t = dir.path().join("t.toml");
+        std::fs::write(&t, body).unwrap();
+        let out = grasp_sim()
+            .args(["batch", "--no-sim", "--template"])
+            .arg(&t)
+            .arg(&good)
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let m = v["object"]["mass_kg"].as_f64().unwrap();
+        assert!((m - mass).abs() < 1e-6, "{body}: {m}");
+    }
+    let t = dir.path().join("t.toml");
+    std::fs::write(&t, "[object]\ndensity = 1000.0\n").unwrap();
+    let out = grasp_sim()
+        .args(["batch", "--no-sim", "--template"])
+        .arg(&t)
+        .arg(&good)
+        .output()
+        .unwrap();
+    refused(&out, &["t.toml", "density"]);
+}
