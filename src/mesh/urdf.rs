@@ -111,6 +111,18 @@ fn resolve(path: &Path, filename: &str) -> Option<PathBuf> {
             }
             here = d.parent().filter(|p| !p.as_os_str().is_empty());
         }
+        // A relative URDF path runs out of parents at its first component: the folders above
+        // that are looked in through the absolute path (so `package://` finds the same mesh
+        // whether the URDF was named relatively or not).
+        let absolute = std::path::absolute(dir).ok()?;
+        for d in absolute.ancestors() {
+            for candidate in [Some(rest), without_package].into_iter().flatten() {
+                let p = d.join(candidate);
+                if p.is_file() {
+                    return Some(p);
+                }
+            }
+        }
         return None;
     }
     let p = dir.join(filename);

@@ -476,3 +476,44 @@ fn a_template_needs_no_placeholder_mesh() {
         .unwrap();
     refused(&out, &["t.toml", "density"]);
 }
+
+/// `package://` found a mesh above the URDF's folder only when the URDF path was absolute: from
+/// a relative path the same mesh is found too.
+#[test]
+fn package_paths_resolve_above_a_relative_urdf() {
+    let dir = tempfile::tempdir().unwrap();
+    let root = dir.path();
+    std::fs::create_dir_all(root.join("pkg/meshes")).unwrap();
+    std::fs::create_dir_all(root.join("work/robots")).unwrap();
+    std::fs::write(
+        root.join("pkg/meshes/cyl.stl"),
+        grasp_sim::objects::cylinder(40.0, 124.0).to_binary_stl(),
+    )
+    .unwrap();
+    std::fs::write(
+        root.join("work/robots/obj.urdf"),
+        "<robot name=\"o\"><link name=\"a\"><collision><geometry><mesh filename=\"package://pkg/meshes/cyl.stl\" scale=\"0.001 0.001 0.001\"/></geometry></collision></link></robot>",
+    )
+    .unwrap();
+    for (cwd, arg) in [
+        (root.join("work"), "robots/obj.urdf".to_string()),
+        (
+            root.to_path_buf(),
+            root.join("work/robots/obj.urdf").display().to_string(),
+        ),
+    ] {
+        let out = grasp_sim()
+            .current_dir(&cwd)
+            .args(["--json", "--no-sim", &arg])
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{arg}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(v["object"]["triangles"], 576, "{arg}");
+    }
+}
