@@ -301,7 +301,9 @@ fn read(path: &Path) -> Result<Read, MeshError> {
     if links.is_empty() {
         return Err(urdf_err(path, "no <link>"));
     }
-    let parent = joint_parents(path, &doc, robot)?;
+    let names: std::collections::HashSet<&str> =
+        links.iter().filter_map(|l| l.attribute("name")).collect();
+    let parent = joint_parents(path, &doc, robot, &names)?;
     let mut placed = Vec::new();
     let mut notes = Vec::new();
     let mut mass_kg = None;
@@ -335,10 +337,15 @@ fn read(path: &Path) -> Result<Read, MeshError> {
 }
 
 /// Each child link's parent link and the joint's origin, from the URDF's `<joint>`s.
+///
+/// # Errors
+/// [`MeshError::Urdf`] naming the joint's line: no parent or child, a link that is not in the
+/// file, or a child that already has a parent (a link has one parent in a tree).
 fn joint_parents<'a>(
     path: &Path,
     doc: &roxmltree::Document,
     robot: roxmltree::Node<'a, '_>,
+    links: &std::collections::HashSet<&str>,
 ) -> Result<HashMap<&'a str, (&'a str, Isometry3<f64>)>, MeshError> {
     let mut parent: HashMap<&str, (&str, Isometry3<f64>)> = HashMap::new();
     for j in robot.children().filter(|c| c.has_tag_name("joint")) {
@@ -354,7 +361,21 @@ fn joint_parents<'a>(
                 format!("line {line}: <joint> without a parent or child link"),
             ));
         };
-        parent.insert(c, (p, origin(path, j)?));
+        let line = doc.text_pos_at(j.range().start).row;
+        if let Some(missing) = [p, c].into_iter().find(|l| !links.contains(l)) {
+            return Err(urdf_err(
+                path,
+                format!(
+                    "line {line}: <joint> names link `{missing}`, which the file does not have"
+                ),
+            ));
+        }
+        if let Some((first, _)) = parent.insert(c, (p, origin(path, j)?)) {
+            return Err(urdf_err(
+                path,
+                format!("line {line}: link `{c}` has two parents (`{first}` and `{p}`); a URDF is a tree"),
+            ));
+        }
     }
     Ok(parent)
 }

@@ -517,3 +517,38 @@ fn package_paths_resolve_above_a_relative_urdf() {
         assert_eq!(v["object"]["triangles"], 576, "{arg}");
     }
 }
+
+/// A URDF joint that names a link the file does not have, or a link with two parents, was
+/// accepted; each is refused with the joint's line.
+#[test]
+fn a_urdf_that_is_not_a_tree_of_its_links_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let link = |n: &str| {
+        format!("<link name=\"{n}\"><collision><geometry><box size=\"0.02 0.02 0.02\"/></geometry></collision></link>")
+    };
+    let joint = |p: &str, c: &str| {
+        format!("\n<joint name=\"{p}_{c}\" type=\"fixed\"><parent link=\"{p}\"/><child link=\"{c}\"/></joint>")
+    };
+    for (body, needle) in [
+        (
+            format!("{}{}", link("a"), joint("a", "ghost")),
+            "line 2: <joint> names link `ghost`, which the file does not have",
+        ),
+        (
+            format!(
+                "{}{}{}{}{}",
+                link("a"),
+                link("b"),
+                link("c"),
+                joint("a", "c"),
+                joint("b", "c")
+            ),
+            "line 3: link `c` has two parents (`a` and `b`)",
+        ),
+    ] {
+        let u = dir.path().join("t.urdf");
+        std::fs::write(&u, format!("<robot name=\"r\">{body}\n</robot>")).unwrap();
+        let out = grasp_sim().arg("--no-sim").arg(&u).output().unwrap();
+        refused(&out, &["t.urdf", needle]);
+    }
+}
