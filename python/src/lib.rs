@@ -406,8 +406,8 @@ fn outcome_message(input: &str, record: &Record) -> String {
         Some(_) => "error".to_string(),
         None => format!(
             "{} {}",
-            record.value["plan"]["status"].as_str().unwrap_or("?"),
-            record.value["sim"]["verdict"].as_str().unwrap_or("?")
+            record.view.plan.status.as_deref().unwrap_or("?"),
+            record.view.sim.verdict.as_deref().unwrap_or("?")
         ),
     };
     format!("{input}: {word}")
