@@ -254,8 +254,12 @@ def test_a_bad_batch_input_is_an_error_line_or_raises(tmp_path, monkeypatch):
     bad.write_bytes(b"not a mesh")
     (line,) = gs.batch([bad])
     assert "error" in line and str(bad) in line["error"]
-    with pytest.raises(gs.BadInputError, match="no such"):
-        gs.batch([tmp_path / "missing.toml"])
+    # A missing input named like one is an error line of its own, as in `grasp-sim batch`
+    # (issue 32); a name that is no input at all is refused.
+    (line,) = gs.batch([tmp_path / "missing.toml"])
+    assert "no such file" in line["error"]
+    with pytest.raises(gs.GraspSimError, match="no such file or folder"):
+        list(gs.batch([tmp_path / "missing"]))
 
 
 def test_a_panic_in_the_library_is_an_error_line_not_a_crash(monkeypatch):
