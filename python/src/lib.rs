@@ -366,31 +366,11 @@ fn run_file(
                 to_rounded_json(&report).map_err(|e| GraspSimError::new_err(e.to_string()))
             }
             Err(e) => {
-                let line = error_line(&item, &path, &e);
+                let line = pipeline::inputs::error_line(&item, &path, &e);
                 Err(pipeline_err_with(&e, line))
             }
         }
     })
-}
-
-/// The command line's one line for an input that could not run (`pipeline::inputs`): a
-/// scenario's mesh or hand file that cannot be read names the scenario too.
-fn error_line(item: &Item, path: &Path, e: &pipeline::Error) -> String {
-    let msg = one_line(e);
-    let scenario = path.display().to_string();
-    let hint = match item {
-        Item::Scenario(_)
-            if !path.is_dir()
-                && !path.extension().is_some_and(|e| e.eq_ignore_ascii_case("toml")) =>
-        {
-            " (read as a scenario: grasp-sim reads scenarios from .toml files and meshes from .stl, .obj, .ply and .urdf)"
-        }
-        _ => "",
-    };
-    match item {
-        Item::Scenario(_) if !msg.starts_with(&scenario) => format!("{scenario}: {msg}{hint}"),
-        _ => format!("{msg}{hint}"),
-    }
 }
 
 /// What the batch thread sends: a finished object's line, or the end (with an error that

@@ -189,11 +189,7 @@ pub fn run_one(item: &Item, key: &Key, template: &Scenario, options: &RunOptions
         Ok(Ok(report)) => Record::from_report(&report, info),
         Ok(Err(e)) => Record::from_error(&scenario, &format!("{e:#}"), info),
         Err(payload) => {
-            let message = payload
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| payload.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "(no message)".to_string());
+            let message = crate::pipeline::inputs::panic_message(payload.as_ref());
             Record::from_error(&scenario, &format!("{scenario}: panicked: {message}"), info)
         }
     }

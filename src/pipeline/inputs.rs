@@ -160,7 +160,7 @@ fn run_bounded(
 }
 
 /// A panic's message, where it has one.
-fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
+pub fn panic_message(payload: &(dyn std::any::Any + Send)) -> String {
     payload
         .downcast_ref::<&str>()
         .map(|s| s.to_string())
@@ -193,8 +193,9 @@ impl Names {
 }
 
 /// The one line for an input that could not run. A scenario's mesh or hand file that cannot be
-/// read names that file; the line names the scenario that asked for it too.
-fn error_line(item: &Item, path: &Path, e: &super::Error) -> String {
+/// read names that file; the line names the scenario that asked for it too. (The Python
+/// package words its errors with it as well.)
+pub fn error_line(item: &Item, path: &Path, e: &super::Error) -> String {
     let msg = format!("{e:#}").replace('\n', " ");
     let scenario = path.display().to_string();
     // A file that is neither a `.toml` scenario nor a mesh by its extension (a `.dae`, a
