@@ -44,4 +44,4 @@ pub mod summarize;
 pub mod tune;
 pub mod visual;
 
-pub use pipeline::{run, Error, RunFlags, RunOptions, DEFAULT_MAX_CHECKED};
+pub use pipeline::{run, Error, GivenGrasp, RunFlags, RunOptions, DEFAULT_MAX_CHECKED};

@@ -21,7 +21,7 @@ import json
 import os
 import sys
 import tempfile
-from typing import Any, Callable, Dict, Iterable, Iterator, List, Mapping, Optional, Union
+from typing import Any, Callable, Dict, Iterable, Iterator, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -253,6 +253,34 @@ def _pose_matrix(pose: Mapping[str, Any]) -> np.ndarray:
     return m
 
 
+def _pose_of_matrix(m: Any) -> Dict[str, Any]:
+    """``{position_mm, quaternion_wxyz}`` of a 4 × 4 rigid transform (refused otherwise)."""
+    try:
+        a = np.asarray(m, dtype=float)
+    except (TypeError, ValueError):
+        raise BadInputError("palm_pose: not a 4 × 4 array of numbers") from None
+    if a.shape != (4, 4) or not np.all(np.isfinite(a)):
+        raise BadInputError(f"palm_pose: a 4 × 4 array of finite numbers is needed, not shape {a.shape}")
+    r = a[:3, :3]
+    if np.abs(r.T @ r - np.eye(3)).max() > 1e-6 or np.linalg.det(r) < 0:
+        raise BadInputError("palm_pose: its 3 × 3 block is not a rotation (orthonormal, determinant +1)")
+    # Shepperd's method: divide by the largest of the four squared components.
+    t = np.trace(r)
+    k = int(np.argmax([t, r[0, 0], r[1, 1], r[2, 2]]))
+    if k == 0:
+        s = 2 * np.sqrt(1 + t)
+        q = [s / 4, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
+    else:
+        i, j, l = [(0, 1, 2), (1, 2, 0), (2, 0, 1)][k - 1]
+        s = 2 * np.sqrt(1 + r[i, i] - r[j, j] - r[l, l])
+        q = [0.0] * 4
+        q[0] = (r[l, j] - r[j, l]) / s
+        q[1 + i] = s / 4
+        q[1 + j] = (r[j, i] + r[i, j]) / s
+        q[1 + l] = (r[l, i] + r[i, l]) / s
+    return {"position_mm": a[:3, 3].tolist(), "quaternion_wxyz": [float(v) for v in q]}
+
+
 class Grasp:
     """One planned grasp (the report's ``plan.grasp`` or an entry of ``plan.grasps``)."""
 
@@ -292,6 +320,49 @@ class Grasp:
         self.palm_pitch_deg = raw["palm_pitch_deg"]
         self.elevation_index = raw["elevation_index"]
         self.elevation_mm = raw["elevation_mm"]
+
+    @classmethod
+    def from_pose(cls, palm_pose: Any, joint_angles_deg: Any, axis_name: Optional[str] = None) -> "Grasp":
+        """A grasp from outside the planner (a learned model's, a hand-made one), to give to
+        :func:`check`: the palm frame in the object's file frame (4 × 4, millimetres, as
+        :attr:`palm_pose`) and ``[θ1, θ2]`` per finger (interior angles, degrees).
+
+        Args:
+            axis_name: the principal axis whose aligned frame ``gravity="down"`` and the six
+                directions refer to (a plan's :attr:`axis_name`); default: the thesis axis.
+
+        Raises:
+            BadInputError: a palm pose that is not a rigid transform, or angles not of shape
+                (fingers, 2).
+        """
+        pose = _pose_of_matrix(palm_pose)
+        try:
+            angles = np.asarray(joint_angles_deg, dtype=float)
+        except (TypeError, ValueError):
+            raise BadInputError("joint_angles_deg: not an array of numbers") from None
+        if angles.ndim != 2 or angles.shape[1] != 2:
+            raise BadInputError(f"joint_angles_deg: shape (fingers, 2) is needed, not {angles.shape}")
+        raw: Dict[str, Any] = {
+            "palm_pose": pose,
+            "palm_pose_aligned": pose,
+            "fingers": [{"name": f"finger_{i + 1}", "theta1_deg": float(t1), "theta2_deg": float(t2)}
+                        for i, (t1, t2) in enumerate(angles)],
+            "axis_name": axis_name or "",
+            "approach_angle_deg": float("nan"),
+            "palm_pitch_deg": float("nan"),
+            "elevation_index": -1,
+            "elevation_mm": float("nan"),
+        }
+        g = cls(raw, index=-1)
+        g.palm_pose = np.asarray(palm_pose, dtype=float).copy()
+        g.palm_pose_aligned = np.full((4, 4), np.nan)
+        return g
+
+    def _given(self) -> Tuple[List[float], List[float], List[List[float]], Optional[str]]:
+        """The native check's ``given``: position, quaternion, angles, axis name."""
+        p = self.raw["palm_pose"]
+        return (list(p["position_mm"]), list(p["quaternion_wxyz"]),
+                self.joint_angles_deg.tolist(), self.axis_name or None)
 
     @property
     def finger_names(self) -> List[str]:
@@ -440,10 +511,11 @@ def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
     """Checks a grasp in the rapier3d physics scene (docs/SIM.md).
 
     Args:
-        obj: the object the grasp was planned on.
-        plan_or_grasp: a :class:`Plan` (its grasp is checked) or its first grasp; ``None``
-            plans and checks as the CLI does (candidates in search order until one holds), or
-            checks ``override_angles=[[θ1, θ2], ...]`` given in ``sim_params``.
+        obj: the object the grasp is on.
+        plan_or_grasp: a :class:`Plan` (its grasp is checked), any of its grasps
+            (``plan.candidates[k]``), or a :meth:`Grasp.from_pose` grasp from elsewhere;
+            ``None`` plans and checks as the CLI does (candidates in search order until one
+            holds), or checks ``override_angles=[[θ1, θ2], ...]`` given in ``sim_params``.
         hand: default: the plan's hand (else the thesis hand).
         gravity: ``"down"`` (−Z of the aligned frame) or ``"six"`` (±X, ±Y, ±Z in turn).
         samples: 1 (a robust verdict over perturbed samples is not in this version).
@@ -453,32 +525,43 @@ def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
         **sim_params: ``[sim]`` keys of a scenario, e.g. ``torque_limit_nm=0.5``,
             ``duration_s=2.0``, ``protocol="full"``.
 
+    A plan's first grasp is checked exactly as the CLI checks it. Any other grasp is checked
+    as given (``report["sim"]["grasp_source"] == "given"``): its palm pose in the object's
+    frame and its joint angles, with the planner's report beside it unchanged.
+
     Raises:
-        BadInputError: a grasp that is not a plan's first one, or ``samples`` other than 1.
+        BadInputError: ``samples`` other than 1; a given grasp that cannot be posed (wrong
+            finger count, a non-finite number, an axis the planner did not search).
         BadScenarioError, BadHandError: as :func:`plan`.
     """
     if samples != 1:
         raise BadInputError(f"samples: {samples}: only 1 is supported (no robust verdict in this version)")
     o = _to_object(obj)
     source: Optional[Plan] = None
+    given: Optional[Grasp] = None
     if isinstance(plan_or_grasp, Grasp):
-        if plan_or_grasp._plan is None or plan_or_grasp.index != 0:
-            raise BadInputError(
-                "check: only a plan's first grasp can be checked (candidates[0]); "
-                f"this is candidates[{plan_or_grasp.index}]"
-            )
-        source = plan_or_grasp._plan
+        if plan_or_grasp._plan is not None and plan_or_grasp.index == 0:
+            source = plan_or_grasp._plan
+        else:
+            given = plan_or_grasp
+            source = plan_or_grasp._plan
     elif isinstance(plan_or_grasp, Plan):
         source = plan_or_grasp
     elif plan_or_grasp is not None:
         raise BadInputError(f"check: not a Plan or Grasp: {type(plan_or_grasp).__name__}")
-    if source is not None and source.grasp is None:
+    if given is None and source is not None and source.grasp is None:
         raise BadInputError(f"check: the plan has no grasp ({source.reason})")
     h = _to_hand(hand if hand is not None else (source.hand if source else None))
     pp = dict(planner_params if planner_params is not None else (source.planner_params if source else {}))
     sim = dict(sim_params)
     sim["gravity"] = gravity
     flags: Dict[str, Any] = {"payload": payload, "quality": quality}
+    if given is not None:
+        flags["given"] = given._given()
+        report = _run("grasp_sim.check", _scenario(o, h, pp, sim), **flags)
+        result = Check(report)
+        result.grasp = given
+        return result
     if source is not None:
         # The planner is deterministic: the same object, hand and parameters give the same
         # first grasp, and checking only it (max_checked 1) checks the plan's grasp.

@@ -45,8 +45,10 @@ def run_table(
     quality: bool = False,
     candidates: int = 1,
     max_checked: Optional[int] = None,
+    given: Optional[Tuple[List[float], List[float], List[List[float]], Optional[str]]] = None,
 ) -> str:
-    """Runs a scenario given as JSON tables (parsed as its TOML); returns the ``--json`` line."""
+    """Runs a scenario given as JSON tables (parsed as its TOML); returns the ``--json`` line.
+    ``given`` (position, quaternion wxyz, angles per finger, axis name): check that grasp."""
 
 def run_file(
     path: str,

@@ -73,7 +73,7 @@ fn pipeline_err_with(e: &pipeline::Error, line: String) -> PyErr {
     match e {
         pipeline::Error::Scenario(ScenarioError::Hand(_)) => BadHandError::new_err(line),
         pipeline::Error::Scenario(_) => BadScenarioError::new_err(line),
-        pipeline::Error::Mesh(_) => BadInputError::new_err(line),
+        pipeline::Error::Mesh(_) | pipeline::Error::Given(_) => BadInputError::new_err(line),
         _ => GraspSimError::new_err(line),
     }
 }
@@ -269,6 +269,10 @@ fn mesh_from_arrays<'py>(
     ))
 }
 
+/// A grasp to check as given: palm position `[mm]` and quaternion (`w, x, y, z`) in the
+/// object's file frame, `[θ1, θ2]` per finger `[deg]`, and the axis name gravity refers to.
+type Given = ([f64; 3], [f64; 4], Vec<[f64; 2]>, Option<String>);
+
 /// Run flags as the command line's.
 fn options(
     no_sim: bool,
@@ -290,8 +294,11 @@ fn options(
 /// Runs a scenario given as JSON (a table per section, as its TOML would have it): converted
 /// to TOML and parsed by `Scenario::parse` with `label` as its path, then run. Returns the run's
 /// JSON line (`--json`).
+///
+/// `given` (position `[mm]`, quaternion `wxyz`, `[θ1, θ2]` per finger, axis name): check this
+/// grasp instead of the planner's (`RunOptions::given`).
 #[pyfunction]
-#[pyo3(signature = (scenario_json, label, no_sim=false, payload=false, quality=false, candidates=1, max_checked=None))]
+#[pyo3(signature = (scenario_json, label, no_sim=false, payload=false, quality=false, candidates=1, max_checked=None, given=None))]
 #[allow(clippy::too_many_arguments)]
 fn run_table(
     py: Python<'_>,
@@ -302,6 +309,7 @@ fn run_table(
     quality: bool,
     candidates: usize,
     max_checked: Option<usize>,
+    given: Option<Given>,
 ) -> PyResult<String> {
     let what = label.display().to_string();
     detached(py, &what, move || {
@@ -315,7 +323,15 @@ fn run_table(
             ))
         })?;
         let scenario = Scenario::parse(&text, &label).map_err(scenario_err)?;
-        let o = options(no_sim, payload, quality, candidates, max_checked);
+        let mut o = options(no_sim, payload, quality, candidates, max_checked);
+        o.given = given.map(|(position_mm, quaternion_wxyz, theta_deg, axis_name)| {
+            grasp_sim::GivenGrasp {
+                position_mm,
+                quaternion_wxyz,
+                theta_deg,
+                axis_name,
+            }
+        });
         let report = pipeline::run(&scenario, &o).map_err(pipeline_err)?;
         to_rounded_json(&report).map_err(|e| GraspSimError::new_err(e.to_string()))
     })

@@ -103,6 +103,51 @@ def test_plan_and_check_of_the_cup_equal_the_cli(cup, cup_plan):
     assert len(checked.directions) == 1
 
 
+# --- Any grasp can be checked as given: another candidate, or a pose from elsewhere.
+
+def test_a_grasp_from_a_pose_is_checked_as_given(cup, cup_plan):
+    g = cup_plan.grasp
+    planned = gs.check(cup, cup_plan)
+    # The plan's own grasp, given back as a pose: the same verdict, and a closing shift within
+    # half a millimetre of the planner's check of it.
+    same = gs.check(cup, gs.Grasp.from_pose(g.palm_pose, g.joint_angles_deg, g.axis_name))
+    assert same.sim["grasp_source"] == "given" and planned.sim["grasp_source"] == "planner"
+    assert same.verdict == planned.verdict == "hold"
+    assert abs(same.closing["shift_mm"] - planned.closing["shift_mm"]) < 0.5
+    np.testing.assert_allclose(same.grasp.palm_pose, g.palm_pose)
+    # The palm 60 mm back along its own x axis (away from the cup): the fingers close on
+    # nothing and the cup drops.
+    back = g.palm_pose.copy()
+    back[:3, 3] += 60.0 * back[:3, 0]
+    assert gs.check(cup, gs.Grasp.from_pose(back, g.joint_angles_deg, g.axis_name)).verdict == "drop"
+
+
+def test_a_later_candidate_is_checked_as_given(cup):
+    p = gs.plan(cup, candidates=3)
+    assert len(p.candidates) == 3
+    c = gs.check(cup, p.candidates[2])
+    assert c.sim["grasp_source"] == "given" and c.verdict in ("hold", "slip", "drop")
+    assert c.grasp is p.candidates[2]
+
+
+@pytest.mark.parametrize("pose, angles, message", [
+    (np.eye(4) * 2, [[150, 150]] * 3, "is not a rotation"),
+    (np.eye(3), [[150, 150]] * 3, "4 × 4"),
+    (np.eye(4), [[150, 150]] * 2, "2 fingers' joint angles for a hand of 3 fingers"),
+    (np.eye(4), [[150, float("nan")]] * 3, "not a finite number"),
+    (np.eye(4), [150, 150, 150], "shape (fingers, 2)"),
+])
+def test_a_bad_given_grasp_raises(cup, pose, angles, message):
+    with pytest.raises(gs.BadInputError, match=message.replace("(", r"\(").replace(")", r"\)")):
+        gs.check(cup, gs.Grasp.from_pose(pose, angles))
+
+
+def test_an_axis_the_planner_did_not_search_raises(cup, cup_plan):
+    g = cup_plan.grasp
+    with pytest.raises(gs.BadInputError, match='axis "sideways" is not one the planner searched'):
+        gs.check(cup, gs.Grasp.from_pose(g.palm_pose, g.joint_angles_deg, "sideways"))
+
+
 # --- Arrays in give the same plan as the file.
 
 def plan_section(p):

@@ -172,6 +172,8 @@ fn options_json<'a>(options: &'a RunOptions) -> Vec<u8> {
         ref export_urdf,
         ref report,
         folder: _,
+        // Batch never checks a given grasp (the library's and Python's `check` do).
+        given: _,
     } = *options;
     let bytes =
         |p: &'a Option<std::path::PathBuf>| p.as_ref().map(|p| p.as_os_str().as_encoded_bytes());

@@ -27,6 +27,66 @@ pub enum Error {
     /// An export could not be written.
     #[error(transparent)]
     Export(#[from] export::ExportError),
+    /// A grasp given to check ([`RunOptions::given`]) that cannot be posed.
+    #[error("given grasp: {0}")]
+    Given(String),
+}
+
+/// A grasp given from outside the planner, to check as it is: a learned model's, another
+/// candidate's, a hand-made one. The palm pose is in the object's file frame, as the JSON's
+/// `plan.grasp.palm_pose`; the angles are `[θ1, θ2]` per finger in the hand's order.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GivenGrasp {
+    /// Palm centre on its contact surface, object file frame `[mm]`.
+    pub position_mm: [f64; 3],
+    /// Palm orientation, object file frame (`w, x, y, z`; normalised here).
+    pub quaternion_wxyz: [f64; 4],
+    /// `[θ1, θ2]` per finger `[deg]`.
+    pub theta_deg: Vec<[f64; 2]>,
+    /// The principal axis whose aligned frame `gravity = "down"` and the six directions refer
+    /// to, by its JSON `axis_name` (`least`, `middle-`, …); `None`: the thesis axis.
+    pub axis_name: Option<String>,
+}
+
+impl GivenGrasp {
+    /// The pose in `aligned`'s frame, or why it cannot be posed for a hand of `fingers`.
+    fn pose_in(
+        &self,
+        aligned: &mesh::AlignedObject,
+        fingers: usize,
+    ) -> Result<sim::SimHand, String> {
+        let finite = self
+            .position_mm
+            .iter()
+            .chain(&self.quaternion_wxyz)
+            .all(|v| v.is_finite())
+            && self.theta_deg.iter().flatten().all(|v| v.is_finite());
+        if !finite {
+            return Err("a coordinate or angle is not a finite number".to_string());
+        }
+        if self.theta_deg.len() != fingers {
+            return Err(format!(
+                "{} fingers' joint angles for a hand of {fingers} fingers",
+                self.theta_deg.len()
+            ));
+        }
+        if let Some(a) = self.theta_deg.iter().flatten().find(|a| a.abs() > 360.0) {
+            return Err(format!("joint angle {a}° is outside [-360°, 360°]"));
+        }
+        let [w, x, y, z] = self.quaternion_wxyz;
+        let q = nalgebra::Quaternion::new(w, x, y, z);
+        if q.norm() < 1e-9 {
+            return Err("the palm quaternion is zero".to_string());
+        }
+        let r = aligned.to_aligned.rotation * nalgebra::UnitQuaternion::from_quaternion(q);
+        let m = r.to_rotation_matrix();
+        let p = nalgebra::Point3::from(self.position_mm);
+        Ok(sim::SimHand {
+            origin_mm: aligned.to_aligned * p,
+            axes: [0, 1, 2].map(|i| m.matrix().column(i).into_owned()),
+            theta_deg: self.theta_deg.clone(),
+        })
+    }
 }
 
 /// The flags that decide what is computed for each input, as the command line, `batch` and its
@@ -65,6 +125,9 @@ pub struct RunOptions {
     /// The name of the subfolder of `report`, `export_mjcf` and `export_urdf` (`None`: the
     /// scenario's name).
     pub folder: Option<String>,
+    /// Check this grasp instead of the planner's (the planner still runs and is reported, but
+    /// its candidates are not checked). Library and Python only.
+    pub given: Option<GivenGrasp>,
 }
 
 /// Candidates the physics check runs on at most before a run settles for the best it saw.
@@ -88,6 +151,7 @@ impl From<RunFlags> for RunOptions {
             export_urdf: None,
             report: None,
             folder: None,
+            given: None,
         }
     }
 }
@@ -114,14 +178,48 @@ pub struct Computed {
     posed: Option<sim::SimHand>,
     /// The bodies' poses at the end of the first hold and at the end of the closing.
     sim_poses: Option<(Vec<sim::BodyPose>, Vec<sim::BodyPose>)>,
+    /// The axis plan whose aligned object the check is on (`None`: the object's own).
+    checked_axis: Option<usize>,
 }
 
 impl Computed {
-    /// The aligned object the chosen grasp (or `override_angles`) is on.
+    /// The aligned object the checked grasp (or `override_angles`) is on.
     fn checked_on(&self) -> &mesh::AlignedObject {
-        self.selection.chosen().map_or(&self.object.aligned, |c| {
-            &self.selection.axes[c.axis_plan].aligned
-        })
+        self.checked_axis
+            .map_or(&self.object.aligned, |i| &self.selection.axes[i].aligned)
+    }
+}
+
+/// The axis plan the check is on: the given grasp's axis, else the chosen grasp's; `None`: the
+/// object's own aligned frame.
+fn checked_axis(
+    options: &RunOptions,
+    selection: &select::Selection,
+) -> Result<Option<usize>, Error> {
+    let Some(given) = &options.given else {
+        return Ok(selection.chosen().map(|c| c.axis_plan));
+    };
+    let Some(name) = &given.axis_name else {
+        return Ok(None);
+    };
+    match selection
+        .axes
+        .iter()
+        .position(|a| a.aligned.axis.name() == *name)
+    {
+        Some(i) => Ok(Some(i)),
+        None => {
+            let mut known: Vec<String> = selection
+                .axes
+                .iter()
+                .map(|a| a.aligned.axis.name())
+                .collect();
+            known.dedup();
+            Err(Error::Given(format!(
+                "axis \"{name}\" is not one the planner searched ({})",
+                known.join(", ")
+            )))
+        }
     }
 }
 
@@ -145,14 +243,23 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
     let selection = select_grasps(scenario, options, &object, &mut timings);
     let qualities = qualities(scenario, options, &selection);
     let plan = build::plan_report(scenario, &selection, &qualities, timings);
-    let chosen = selection.chosen();
-    let checked_on = chosen.map_or(&object.aligned, |c| &selection.axes[c.axis_plan].aligned);
-    let posed = sim_pose(
-        scenario,
-        checked_on,
-        &selection.axes[0].graded,
-        chosen.map(|c| (&c.grasp, c.check.clone())),
-    );
+    let checked_axis = checked_axis(options, &selection)?;
+    let checked_on = checked_axis.map_or(&object.aligned, |i| &selection.axes[i].aligned);
+    let posed = match &options.given {
+        Some(given) => Ok((
+            given
+                .pose_in(checked_on, scenario.hand.finger_list.len())
+                .map_err(Error::Given)?,
+            GraspSource::Given,
+            None,
+        )),
+        None => sim_pose(
+            scenario,
+            checked_on,
+            &selection.axes[0].graded,
+            selection.chosen().map(|c| (&c.grasp, c.check.clone())),
+        ),
+    };
     let (sim, sim_poses, ran) = run_sim(scenario, options, &object, checked_on, &posed);
     // A check that ran here (not in the candidate search: `override_angles`) closed its own
     // grip: the quality is that grip's, not the planned contacts'.
@@ -192,6 +299,7 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
         object,
         selection,
         sim_poses,
+        checked_axis,
     })
 }
 
@@ -267,7 +375,8 @@ fn select_grasps(
         check_grasp(scenario, object, a, g)
     };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
-    let checks_candidates = !options.no_sim && scenario.sim.input.override_angles.is_none();
+    let checks_candidates =
+        !options.no_sim && scenario.sim.input.override_angles.is_none() && options.given.is_none();
     let max_checked = options
         .max_checked
         .unwrap_or(scenario.sim.selection.max_checked);

@@ -403,6 +403,8 @@ pub enum GraspSource {
     Planner,
     /// The scenario's `[sim] override_angles`.
     OverrideAngles,
+    /// A grasp given to check from outside the planner (the library's and Python's `check`).
+    Given,
 }
 
 /// The `sim` part of the report.

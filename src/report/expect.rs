@@ -26,15 +26,20 @@ impl ExpectReport {
 
     /// Judges `[expect]`: the planning part (status and reference values), then, when the
     /// physics check ran, its verdict against the expected outcome. A scenario that fixes the
-    /// joint angles (`override_angles`) is judged on the verdict alone.
+    /// joint angles (`override_angles`) or checks a given grasp is judged on the verdict alone.
     pub fn judge(expect: &Expect, plan: &PlanReport, sim: &SimReport) -> ExpectReport {
         let outcome = Some(expect.outcome);
-        if sim.grasp_source == Some(GraspSource::OverrideAngles) {
+        let sim_only = match sim.grasp_source {
+            Some(GraspSource::OverrideAngles) => Some("override_angles"),
+            Some(GraspSource::Given) => Some("given grasp"),
+            _ => None,
+        };
+        if let Some(why) = sim_only {
             let verdict = sim.verdict.verdict();
             return ExpectReport {
                 outcome,
                 met: Some(verdict.is_some() && verdict == expect.outcome.verdict()),
-                details: format!("sim-only (override_angles): verdict {}", sim.verdict),
+                details: format!("sim-only ({why}): verdict {}", sim.verdict),
             };
         }
         let (met, details) = match (expect.outcome, &plan.grasp) {

@@ -729,3 +729,79 @@ fn friction_use_tells_a_sticking_grip_from_a_sliding_one() {
         assert!(sliding.sliding_share > 0.9, "{sliding:?}");
     });
 }
+
+/// The cup's planned grasp as a [`grasp_sim::GivenGrasp`]: its JSON palm pose (the object's file
+/// frame) and joint angles, with the palm moved `backoff_mm` away from the object.
+fn cup_given(r: &grasp_sim::report::RunReport, backoff_mm: f64) -> grasp_sim::GivenGrasp {
+    let g = r.plan.grasp.as_ref().expect("the cup has a grasp");
+    let [w, x, y, z] = g.palm_pose.quaternion_wxyz;
+    let q = nalgebra::UnitQuaternion::from_quaternion(nalgebra::Quaternion::new(w, x, y, z));
+    // The palm's x axis points away from the object.
+    let away = q * nalgebra::Vector3::x();
+    let p = g.palm_pose.position_mm;
+    grasp_sim::GivenGrasp {
+        position_mm: [0, 1, 2].map(|i| p[i] + away[i] * backoff_mm),
+        quaternion_wxyz: g.palm_pose.quaternion_wxyz,
+        theta_deg: g
+            .fingers
+            .iter()
+            .map(|f| [f.theta1_deg, f.theta2_deg])
+            .collect(),
+        axis_name: Some(g.axis_name.clone()),
+    }
+}
+
+#[test]
+fn a_given_grasp_is_checked_as_given() {
+    // The planner's own grasp, given back from its JSON pose: the same verdict, and the closing
+    // moves the cup as little as in the planner's check. The same grasp with the palm 60 mm off
+    // the cup closes on nothing and drops it: the given pose is what is checked.
+    let path = crate::root().join("scenarios/cup.toml");
+    let s = Scenario::load(&path).unwrap();
+    let planned = run(&s, &with_sim()).unwrap();
+    assert_eq!(
+        planned.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(Verdict::Hold)
+    );
+    let shift =
+        |r: &grasp_sim::report::RunReport| r.sim.closing.as_ref().map(|c| c.shift_mm).unwrap();
+    let mut o = with_sim();
+    o.given = Some(cup_given(&planned, 0.0));
+    let given = run(&s, &o).unwrap();
+    assert_eq!(
+        given.sim.grasp_source,
+        Some(grasp_sim::report::GraspSource::Given)
+    );
+    assert_eq!(given.sim.verdict, planned.sim.verdict, "{:?}", given.sim);
+    assert!(
+        (shift(&given) - shift(&planned)).abs() < 0.5,
+        "given {} mm against planned {} mm",
+        shift(&given),
+        shift(&planned)
+    );
+    o.given = Some(cup_given(&planned, 60.0));
+    let off = run(&s, &o).unwrap();
+    assert_eq!(
+        off.sim.verdict,
+        grasp_sim::report::SimVerdict::Ran(Verdict::Drop),
+        "{:?}",
+        off.sim
+    );
+    // A grasp for two fingers, or with a NaN, is refused with its reason.
+    let mut bad = cup_given(&planned, 0.0);
+    bad.theta_deg.pop();
+    o.given = Some(bad);
+    let e = run(&s, &o).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "given grasp: 2 fingers' joint angles for a hand of 3 fingers"
+    );
+    let mut bad = cup_given(&planned, 0.0);
+    bad.position_mm[1] = f64::NAN;
+    o.given = Some(bad);
+    let e = run(&s, &o).unwrap_err().to_string();
+    assert_eq!(
+        e,
+        "given grasp: a coordinate or angle is not a finite number"
+    );
+}
