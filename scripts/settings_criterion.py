@@ -34,8 +34,9 @@ def load(path):
 
 
 def changed(base, other):
-    keys = set(base) | set(other)
-    return {k for k in keys if base.get(k) != other.get(k)}
+    """The directions both runs checked whose verdicts differ (a run cut short, such as a
+    null stopped early, contributes the scenarios it reached)."""
+    return {k for k in set(base) & set(other) if base[k] != other[k]}
 
 
 def main():
@@ -56,8 +57,8 @@ def main():
     nulls = [c for _, c, _, _ in rows]
     mj = {}
     for path in a.mujoco:
-        for name, rows in json.load(open(path)).items():
-            mj[name] = {s: r["agree"] for s, r in rows.items()}
+        for name, by_scenario in json.load(open(path)).items():
+            mj[name] = {k: r["agree"] for k, r in by_scenario.items()}
 
     def agreement(name):
         m = mj.get(name)

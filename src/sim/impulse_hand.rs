@@ -139,7 +139,7 @@ mod tests {
                 let open = start(case).open_bend_rad;
                 let scene = build(case);
                 assert_eq!(
-                    scene.world.impulse_joints.len() > 0,
+                    !scene.world.impulse_joints.is_empty(),
                     kind == HandJoints::Impulse
                 );
                 for (f, [b1, b2]) in scene.fingers.iter().zip(open) {
