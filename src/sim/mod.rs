@@ -16,7 +16,8 @@
 //! box); joints are revolute on the finger joint axes with the hand's limits, as multibody
 //! (reduced-coordinate) joints: a 10 g phalanx pressing a 0.2 kg object is a mass ratio that
 //! makes impulse joints stretch and drift under load, while a multibody chain cannot come
-//! apart. Each joint has a force-based position motor (stiffness, damping) whose torque is capped
+//! apart (`[sim] hand_joints = "impulse"` builds them as impulse joints instead, [`impulse_hand`],
+//! measured and not adopted: docs/SIM.md). Each joint has a force-based position motor (stiffness, damping) whose torque is capped
 //! by the torque limit, driving towards the planned angle closed further by the squeeze
 //! overshoot, so the torque limit, not the target, bounds the grip. The object is a dynamic body
 //! with the scenario's mass and friction; its collider is the convex hull of the aligned mesh when
@@ -40,6 +41,7 @@ pub mod convert;
 pub mod early;
 pub mod flight;
 pub mod hold;
+pub mod impulse_hand;
 pub mod outcome;
 pub mod params;
 pub mod payload;

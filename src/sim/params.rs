@@ -33,6 +33,16 @@ pub enum Protocol {
     Full,
 }
 
+/// How the hand's phalanges are joined in rapier (docs/SIM.md, "The impulse-joint hand").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HandJoints {
+    /// One multibody (reduced-coordinate articulation) rooted at the fixed palm (the default).
+    Multibody,
+    /// Free rigid bodies held by revolute impulse joints, solved with the contacts.
+    Impulse,
+}
+
 /// The default of `[sim] max_closing_shift_mm` `[mm]` (docs/SIM.md, "What the closing does").
 pub const DEFAULT_MAX_CLOSING_SHIFT_MM: f64 = 5.0;
 
@@ -74,6 +84,8 @@ pub struct SolverParams {
     pub stabilization_iterations: usize,
     /// Natural frequency of contacts `[Hz]`: their stiffness relative to the bodies' masses.
     pub contact_stiffness_hz: f64,
+    /// The finger joints' kind: `multibody` (default) or `impulse`.
+    pub hand_joints: HandJoints,
 }
 
 impl Default for SolverParams {
@@ -84,6 +96,7 @@ impl Default for SolverParams {
             pgs_iterations: 8,
             stabilization_iterations: 2,
             contact_stiffness_hz: 10000.0,
+            hand_joints: HandJoints::Multibody,
         }
     }
 }
@@ -279,7 +292,7 @@ impl std::fmt::Debug for SimParams {
 
 /// The `[sim]` table as written: one field per key, in the order serde's messages list them.
 mod flat {
-    use super::{Approach, GravityMode, Protocol};
+    use super::{Approach, GravityMode, HandJoints, Protocol};
     use serde::Deserialize;
 
     /// The flat `[sim]` table (see the module docs of [`super`]).
@@ -308,6 +321,7 @@ mod flat {
         pub(super) motor_damping_nms_per_rad: f64,
         pub(super) finger_density_kg_m3: f64,
         pub(super) contact_stiffness_hz: f64,
+        pub(super) hand_joints: HandJoints,
         pub(super) open_margin_deg: f64,
         pub(super) override_angles: Option<Vec<[f64; 2]>>,
         pub(super) override_index: Option<usize>,
@@ -335,6 +349,7 @@ mod flat {
                     pgs_iterations: s.pgs_iterations,
                     stabilization_iterations: s.stabilization_iterations,
                     contact_stiffness_hz: s.contact_stiffness_hz,
+                    hand_joints: s.hand_joints,
                 },
                 fingers: super::FingerParams {
                     squeeze_deg: s.squeeze_deg,
@@ -400,6 +415,7 @@ mod flat {
                 motor_damping_nms_per_rad: s.fingers.motor_damping_nms_per_rad,
                 finger_density_kg_m3: s.fingers.finger_density_kg_m3,
                 contact_stiffness_hz: s.solver.contact_stiffness_hz,
+                hand_joints: s.solver.hand_joints,
                 open_margin_deg: s.closing.open_margin_deg,
                 override_angles: s.input.override_angles,
                 override_index: s.input.override_index,

@@ -5,7 +5,8 @@
 
 use super::collider::ObjectShape;
 use super::convert;
-use super::params::SimParams;
+use super::impulse_hand::{insert_joint, FingerJoint};
+use super::params::{HandJoints, SimParams};
 use crate::hand::{palm_rotation, BodyPose, Hand, HandBox};
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
@@ -71,9 +72,9 @@ pub struct SimFinger {
     /// The planned bend of joint 1 and joint 2 `[rad]`.
     pub planned_bend_rad: [f64; 2],
     /// Joint 1 (palm to phalanx 1).
-    pub joint1: MultibodyJointHandle,
+    pub joint1: FingerJoint,
     /// Joint 2 (phalanx 1 to phalanx 2), held open until released.
-    pub joint2: MultibodyJointHandle,
+    pub joint2: FingerJoint,
     /// Joint 2's motor target once released `[rad]`.
     pub joint2_target: f32,
     /// Joint 1's motor target while it closes `[rad]`.
@@ -123,20 +124,13 @@ impl Scene {
     /// Holds finger `k`'s joint 1 where it is now (`hold`) or sends it on to its closing target
     /// (the approach that waits for every finger to touch, `[sim] approach = "together"`).
     pub fn hold_joint1(&mut self, k: usize, hold: bool) {
-        let (stiffness, d) = self.motor_gains;
         let Some(f) = self.fingers.get(k) else { return };
-        if let Some((mb, id)) = self.world.multibody_joints.get_mut(f.joint1) {
-            if let Some(link) = mb.link_mut(id) {
-                let target = if hold {
-                    link.joint.coords()[3]
-                } else {
-                    f.joint1_target
-                };
-                link.joint
-                    .data
-                    .set_motor_position(JointAxis::AngX, target, stiffness, d);
-            }
-        }
+        let Some(angle) = f.joint1.angle(&self.world) else {
+            return;
+        };
+        let target = if hold { angle } else { f.joint1_target };
+        f.joint1
+            .set_motor(&mut self.world, target, self.motor_gains, None);
     }
 
     /// Locks joint 1 where it stopped and lets joint 2 close to its target: thesis 3.6.2 fixes
@@ -146,24 +140,15 @@ impl Scene {
     pub fn release_joint2(&mut self) {
         let (k, d) = self.motor_gains;
         for f in &self.fingers {
-            if let Some((mb, id)) = self.world.multibody_joints.get_mut(f.joint1) {
-                if let Some(link) = mb.link_mut(id) {
-                    let angle = link.joint.coords()[3];
-                    link.joint
-                        .data
-                        .set_motor_position(JointAxis::AngX, angle, k * 10.0, d)
-                        .set_motor_max_force(JointAxis::AngX, self.lock_torque);
-                }
+            if let Some(angle) = f.joint1.angle(&self.world) {
+                let lock = Some(self.lock_torque);
+                f.joint1
+                    .set_motor(&mut self.world, angle, (k * 10.0, d), lock);
             }
         }
         for f in &self.fingers {
-            if let Some((mb, id)) = self.world.multibody_joints.get_mut(f.joint2) {
-                if let Some(link) = mb.link_mut(id) {
-                    link.joint
-                        .data
-                        .set_motor_position(JointAxis::AngX, f.joint2_target, k, d);
-                }
-            }
+            f.joint2
+                .set_motor(&mut self.world, f.joint2_target, (k, d), None);
         }
     }
 }
@@ -427,8 +412,12 @@ pub fn build(case: &Case) -> Scene {
             insert_finger(&mut world, &mut hand_colliders, case, palm, &at)
         })
         .collect();
-    for (f, open) in fingers.iter().zip(&start.open_bend_rad) {
-        set_open(&mut world, f, *open);
+    // Impulse-joint phalanges are inserted where the open bends put them; a multibody's are
+    // placed from its coordinates.
+    if params.solver.hand_joints == HandJoints::Multibody {
+        for (f, open) in fingers.iter().zip(&start.open_bend_rad) {
+            set_open(&mut world, f, *open);
+        }
     }
 
     let object_body = world
@@ -566,17 +555,12 @@ fn insert_finger(
         limits1,
         motor(bend(t1) + squeeze, limits1),
     );
-    let joint1 = world
-        .multibody_joints
-        .insert(palm, b1, joint1, true)
-        .expect("joint 1 closes no loop");
+    let kind = params.solver.hand_joints;
+    let joint1 = insert_joint(world, kind, palm, b1, joint1);
     let b2 = phalanx(world, convert::pose(&j2, &r2), &p2);
     // Joint 2 is held at its open angle until released (see `Scene::release_joint2`).
     let joint2 = revolute(&hand.joint2_anchor_mm(f.side), limits2, open2 as f32);
-    let joint2 = world
-        .multibody_joints
-        .insert(b1, b2, joint2, true)
-        .expect("joint 2 closes no loop");
+    let joint2 = insert_joint(world, kind, b1, b2, joint2);
     SimFinger {
         phalanx1: b1,
         phalanx2: b2,

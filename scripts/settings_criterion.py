@@ -1,0 +1,101 @@
+#!/usr/bin/env python3
+"""The criterion for a cheaper physics setting (docs/SIM.md, "One criterion for a cheaper setting").
+
+    python3 scripts/settings_criterion.py --base BASE.jsonl --null N1.jsonl --null N2.jsonl ...
+        [--mujoco MJ.json] NAME=CANDIDATE.jsonl ...
+
+Each .jsonl is one run of `cargo run --release --example protocols -- --only fast --six
+--set max_checked=1 [--set KEY=VALUE] --jsonl FILE SCENARIO...` (one line per scenario, six
+directions each). The null set is the union of the directions whose verdict a null
+perturbation (a 1 ppm change of a constant) changes against BASE. A candidate passes the first
+half of the criterion when every direction whose verdict it changes is in the null set. The
+second half, agreement with MuJoCo not dropping, takes `--mujoco`: the file
+`scripts/engine_agreement.py --json` writes, whose variant `base` is the defaults and whose
+other variants are named as the candidates here. Prints a Markdown table: changed, changed outside the
+null set, steps and wall time against BASE, MuJoCo agreement, pass/fail.
+"""
+import argparse
+import json
+import sys
+
+
+def load(path):
+    """{(scenario, direction index): verdict}, total steps, total wall [ms]."""
+    verdicts, steps, wall = {}, 0, 0.0
+    with open(path) as f:
+        for line in f:
+            d = json.loads(line)
+            sim = d["sim"]
+            steps += sim.get("steps") or 0
+            wall += sim.get("wall_ms") or 0.0
+            for k, dr in enumerate(sim.get("directions") or []):
+                verdicts[(d["scenario"], k)] = dr["verdict"]
+    return verdicts, steps, wall
+
+
+def changed(base, other):
+    """The directions both runs checked whose verdicts differ (a run cut short, such as a
+    null stopped early, contributes the scenarios it reached)."""
+    return {k for k in set(base) & set(other) if base[k] != other[k]}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--base", required=True)
+    ap.add_argument("--null", action="append", default=[])
+    ap.add_argument("--mujoco", action="append", default=[], metavar="MJ.json")
+    ap.add_argument("candidates", nargs="*", metavar="NAME=FILE")
+    a = ap.parse_args()
+    base, bsteps, bwall = load(a.base)
+    null_set = set()
+    rows = []
+    for path in a.null:
+        v, s, w = load(path)
+        c = changed(base, v)
+        rows.append((f"null: {path}", c, s, w))
+        null_set |= c
+    nulls = [c for _, c, _, _ in rows]
+    mj = {}
+    for path in a.mujoco:
+        for name, by_scenario in json.load(open(path)).items():
+            mj[name] = {k: r["agree"] for k, r in by_scenario.items()}
+
+    def agreement(name):
+        m = mj.get(name)
+        if m is None:
+            return ""
+        return f"{sum(1 for x in m.values() if x)} of {len(m)}"
+
+    print(f"directions: {len(base)}; null set: {len(null_set)} directions of "
+          f"{len({k[0] for k in null_set})} objects from {len(a.null)} nulls")
+    print()
+    print("| run | verdicts changed | outside the null set | objects | steps / base | wall / base "
+          "| MuJoCo agrees (`down`) | passes |")
+    print("|---|---|---|---|---|---|---|---|")
+    print(f"| base: {a.base} | 0 | 0 | 0 | {bsteps:,} | {bwall / 1000:.1f} s | {agreement('base')} | |")
+    for i, (name, c, s, w) in enumerate(rows):
+        others = set().union(*[n for j, n in enumerate(nulls) if j != i])
+        print(f"| {name} | {len(c)} | {len(c - others)} outside the other nulls | "
+              f"{len({k[0] for k in c})} | {s / bsteps:.3f} | {w / bwall:.3f} | | |")
+    failed = False
+    for kv in a.candidates:
+        name, path = kv.split("=", 1)
+        v, s, w = load(path)
+        c = changed(base, v)
+        out = c - null_set
+        ok = not out
+        if name in mj and "base" in mj:
+            agree_c = sum(1 for x in mj[name].values() if x)
+            agree_b = sum(1 for x in mj["base"].values() if x)
+            ok = ok and agree_c >= agree_b
+        failed |= not ok
+        print(f"| {name} | {len(c)} | {len(out)} | {len({k[0] for k in c})} | {s / bsteps:.3f} "
+              f"| {w / bwall:.3f} | {agreement(name)} | {'yes' if ok else '**no**'} |")
+        if out:
+            objs = sorted({k[0] for k in out})
+            print(f"|  outside: {', '.join(objs)} | | | | | | | |")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
