@@ -252,7 +252,7 @@ pub fn check_grasp(
 ) -> sim::SimOutcome {
     let shape = object.shape(aligned);
     let pose = sim::SimHand::from_grasp(grasp);
-    sim::check(&object.case(scenario, &pose, &shape))
+    sim::check_candidate(&object.case(scenario, &pose, &shape))
 }
 
 /// Plans across axes and rule sets; with the physics check on the planner's grasps, checks
@@ -363,17 +363,25 @@ fn run_sim(
     let shape = object.shape(aligned);
     let case = object.case(scenario, pose, &shape);
     // The candidate search already checked the chosen grasp: the same case, the same outcome.
-    let (out, payload, ran) = match done {
+    let (mut out, payload, ran) = match done {
         Some(out) => {
             let payload = (options.payload && out.verdict == sim::Verdict::Hold)
                 .then(|| sim::payload_bracket(&case));
             (out.clone(), payload, false)
+        }
+        None if case.params.robust.replay_sample.is_some() => {
+            let out = sim::check_nominal(&case);
+            let payload = (options.payload && out.verdict == sim::Verdict::Hold)
+                .then(|| sim::payload_bracket(&case));
+            (out, payload, true)
         }
         None => {
             let (out, payload) = sim::check_with_payload(&case, options.payload);
             (out, payload, true)
         }
     };
+    // `[sim] samples`: the perturbed checks of the grasp chosen (issue 34).
+    sim::add_samples(&case, &mut out);
     let poses = (out.final_poses.clone(), out.closed_poses.clone());
     let ran = ran.then(|| out.clone());
     let report = build::checked_report(out, payload, &case, &shape, source, options);

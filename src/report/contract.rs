@@ -458,6 +458,13 @@ pub struct SimReport {
     /// `max_penetration_mm`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limits: Option<HoldLimits>,
+    /// The hold probability under `[sim] samples` perturbed checks (issue 34); absent with one
+    /// sample (the default: the main check only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub robust: Option<crate::sim::Robust>,
+    /// The perturbation the main check ran under (`[sim] replay_sample`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub replay: Option<crate::sim::Perturbation>,
 }
 
 /// The limits of a hold: how far the object may move and turn relative to the palm, and how
@@ -495,6 +502,8 @@ impl SimReport {
             closing: None,
             directions: Vec::new(),
             limits: None,
+            robust: None,
+            replay: None,
         }
     }
 }
