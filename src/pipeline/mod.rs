@@ -222,6 +222,7 @@ pub fn write_outputs(
         };
         let folder = dir.join(options.folder_for(scenario));
         export::write_mjcf(&folder, &input)?;
+        write_sample_scenes(&folder, &input)?;
         computed.report.mjcf_scene = Some(folder.join("scene.xml"));
     }
     if let Some(dir) = &options.report {
@@ -238,6 +239,27 @@ pub fn write_outputs(
                 .as_ref()
                 .map(|(end, closed)| visual::SimulatedPoses { end, closed }),
         )?;
+    }
+    Ok(())
+}
+
+/// With `[sim] samples` above 1 (issue 34): each perturbed sample's MJCF scene, into
+/// `folder/samples/<k>/`, for MuJoCo to replay the same samples
+/// (`scripts/compare_engines.py --robust`).
+fn write_sample_scenes(folder: &std::path::Path, input: &export::ExportInput) -> Result<(), Error> {
+    let rp = &input.case.params.robust;
+    if rp.samples < 2 {
+        return Ok(());
+    }
+    for k in 0..rp.samples {
+        let p = sim::Perturbation::draw(rp, k);
+        let perturbed = sim::robust::Perturbed::of(&input.case, &p);
+        let sample = export::ExportInput {
+            name: input.name,
+            object: input.object,
+            case: perturbed.case(&input.case),
+        };
+        export::write_mjcf(&folder.join("samples").join(k.to_string()), &sample)?;
     }
     Ok(())
 }

@@ -175,3 +175,32 @@ fn one_sample_reports_no_robust_part_and_bad_ranges_are_refused() {
         assert!(err.contains(key), "{sim}: {err}");
     }
 }
+
+#[test]
+fn the_samples_flag_overrides_the_scenario_and_the_summary_says_it() {
+    let out = crate::succeed(crate::grasp_sim().args([
+        "--json",
+        "--samples",
+        "2",
+        "scenarios/sim_open_fingers.toml",
+    ]));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["sim"]["robust"]["samples"], 2);
+    assert_eq!(v["sim"]["robust"]["counts"]["drop"], 2);
+    assert_eq!(v["sim"]["verdict"], "drop");
+    let out = crate::succeed(crate::grasp_sim().args([
+        "--samples",
+        "2",
+        "scenarios/sim_open_fingers.toml",
+    ]));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        text.contains("Robust      held in 0 of 2 perturbed checks (0 %, 95 % interval 0–66 %); first failure: sample 0 (drop under -Z; replay with [sim] replay_sample = 0)"),
+        "{text}"
+    );
+    let out = crate::grasp_sim()
+        .args(["--samples", "0", "scenarios/sim_open_fingers.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+}
