@@ -6,6 +6,15 @@
 Runs `GRASP_SIM_BINARY --json --export-mjcf OUT_DIR SCENARIO...`, replays every exported scene
 with scripts/mujoco_replay.py, and prints a Markdown table of both engines' verdicts and numbers.
 Exits 1 if a scenario named with --require gets different verdicts (CI requires D40 and the cup).
+
+    python3 scripts/compare_engines.py GRASP_SIM_BINARY OUT_DIR --robust N [--six] [--jsonl F] SCENARIO...
+
+Issue 34: runs the binary with `--samples N` (and `--gravity six`), replays each perturbed
+sample's exported scene (OUT_DIR/<scenario>/samples/<k>/) in MuJoCo, and prints per grasp both
+engines' hold probabilities, their difference, the per-sample agreement, and over all grasps
+the mean absolute difference, the Brier score of each engine's probability against the other's
+per-sample outcomes, and how often one says >= 0.9 while the other says < 0.5. `--jsonl F`
+writes one line per grasp with both engines' per-sample verdicts.
 """
 import json
 import pathlib
@@ -16,10 +25,82 @@ sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
 import mujoco_replay  # noqa: E402
 
 
+def robust(binary, out_dir, n, six, jsonl, scenarios):
+    """The `--robust N` study (see the module docs)."""
+    cmd = [binary, "--json", "--export-mjcf", str(out_dir), "--samples", str(n)]
+    if six:
+        cmd += ["--gravity", "six"]
+    run = subprocess.run([*cmd, *scenarios], capture_output=True, text=True)
+    if run.returncode == 2:
+        # A bad input is reported on stderr; the others' lines are still compared.
+        print(run.stderr, file=sys.stderr)
+        if not run.stdout.strip():
+            return 2
+    print("| scenario | main check | rapier p [95 % interval] | MuJoCo p | difference | samples agreeing "
+          "| rapier [ms] | MuJoCo [ms] |")
+    print("|---|---|---|---|---|---|---|---|")
+    rows = []
+    out = open(jsonl, "w") if jsonl else None
+    for line in run.stdout.splitlines():
+        d = json.loads(line)
+        name, sim = d["scenario"], d["sim"]
+        r = sim.get("robust")
+        if r is None:
+            print(f"| {name} | {sim['verdict']} | (not sampled) | | | | | |")
+            continue
+        verdicts, wall = [], 0.0
+        for k in range(r["samples"]):
+            m = mujoco_replay.replay(out_dir / name / "samples" / str(k),
+                                     mujoco_replay.SIX if six else None)
+            verdicts.append(m["verdict"])
+            wall += m["wall_ms"]
+        pm = sum(v == "hold" for v in verdicts) / len(verdicts)
+        pr = r["hold_probability"]
+        agree = sum(a == b for a, b in zip(verdicts, r["verdicts"]))
+        lo, hi = r["interval"]
+        print(f"| {name} | {sim['verdict']} | {pr:.3f} [{lo:.2f}, {hi:.2f}] | {pm:.3f} | {pr - pm:+.3f} "
+              f"| {agree} of {len(verdicts)} | {r['wall_ms']:.0f} | {wall:.0f} |")
+        row = {"scenario": name, "main": sim["verdict"], "rapier_p": pr, "rapier_interval": r["interval"],
+               "mujoco_p": pm, "rapier": r["verdicts"], "mujoco": verdicts,
+               "rapier_ms": r["wall_ms"], "mujoco_ms": wall}
+        rows.append(row)
+        if out:
+            out.write(json.dumps(row) + "\n")
+    if out:
+        out.close()
+    if rows:
+        def brier(p_key, outcomes_key):
+            terms = [(row[p_key] - (v == "hold")) ** 2 for row in rows for v in row[outcomes_key]]
+            return sum(terms) / len(terms)
+        diff = sum(abs(r["rapier_p"] - r["mujoco_p"]) for r in rows) / len(rows)
+        split = sum((r["rapier_p"] >= 0.9 and r["mujoco_p"] < 0.5) or
+                    (r["mujoco_p"] >= 0.9 and r["rapier_p"] < 0.5) for r in rows)
+        weak = sum(r["main"] == "hold" and r["rapier_interval"][0] < 0.9 for r in rows)
+        print()
+        print(f"{len(rows)} grasps, {n} samples each{', six directions' if six else ''}: mean |p_rapier - p_mujoco| "
+              f"{diff:.3f}; Brier score of rapier's p against MuJoCo's samples {brier('rapier_p', 'mujoco'):.3f}, "
+              f"of MuJoCo's p against rapier's {brier('mujoco_p', 'rapier'):.3f}; one engine >= 0.9 while the "
+              f"other < 0.5: {split}; main-check holds with a lower bound under 0.9: {weak}")
+    return 0
+
+
 def main(argv):
     if len(argv) < 4:
         print(__doc__, file=sys.stderr)
         return 2
+    if "--robust" in argv:
+        args = argv[3:]
+        i = args.index("--robust")
+        n = int(args[i + 1])
+        del args[i:i + 2]
+        six = "--six" in args
+        args = [a for a in args if a != "--six"]
+        jsonl = None
+        if "--jsonl" in args:
+            j = args.index("--jsonl")
+            jsonl = args[j + 1]
+            del args[j:j + 2]
+        return robust(argv[1], pathlib.Path(argv[2]), n, six, jsonl, args)
     binary, out_dir, rest = argv[1], pathlib.Path(argv[2]), argv[3:]
     required, scenarios = [], []
     i = 0

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Replay a grasp exported by `grasp-sim --export-mjcf DIR` in MuJoCo, with grasp-sim's protocol.
 
-    python3 scripts/mujoco_replay.py DIR/<scenario> [DIR/<scenario> ...]
+    python3 scripts/mujoco_replay.py [--six] DIR/<scenario> [DIR/<scenario> ...]
 
 Prints one JSON object per scene: the verdict (hold / slip / drop) with the same thresholds as
 grasp-sim's rapier check, the object's translation and rotation relative to the palm during the
@@ -11,6 +11,9 @@ bend plus squeeze) while joint 2 is held open; when the hand and the object have
 (`close_until_stalled`), or at the latest halfway through the closing time, joint 1 locks where
 it stopped (a TorqueSwitch) and joint 2 closes, again until they stop; then gravity on for the
 hold (its whole length: the replay is the full-length protocol).
+`--six`: the six gravity directions of `[sim] gravity = "six"`, each held from one closing.
+Perturbed samples (`[sim] samples`, issue 34) are exported as scenes of their own,
+DIR/<scenario>/samples/<k>/; scripts/compare_engines.py --robust replays them.
 Needs `pip install mujoco`.
 """
 import json
@@ -36,7 +39,15 @@ def relative_pose(m, d, palm, obj):
     return p * 1000.0, rp.T @ ro
 
 
-def replay(scene_dir):
+SIX = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
+
+
+def replay(scene_dir, directions=None):
+    """The replay of one exported scene. `directions`: None, the scene's gravity (the check as
+    it has always been replayed); or a list of unit vectors (aligned object frame, as `[sim]
+    gravity = "six"` gives them, e.g. `SIX`): the closing runs once and each direction holds
+    from a copy of the closed state, as grasp-sim's `fast` protocol does; the result then has
+    `directions` (one verdict each) and the worst verdict."""
     scene_dir = pathlib.Path(scene_dir)
     proto = json.loads((scene_dir / "protocol.json").read_text())
     m = mujoco.MjModel.from_xml_path(str(scene_dir / "scene.xml"))
@@ -149,6 +160,40 @@ def replay(scene_dir):
     closing_turn = quat_angle_deg(q0c, qcc)
     max_shift = proto.get("max_closing_shift_mm", math.inf)
     pushed = closing_shift > max_shift
+    closing = {
+        "closed": closed, "t0": t0, "pc": pc, "rc": rc, "pushed": pushed,
+        "closing_shift_mm": closing_shift, "closing_turn_deg": closing_turn,
+    }
+    if directions is None:
+        return hold(m, d, proto, gravity, hold_steps, closing)
+    g = float(np.linalg.norm(gravity))
+    closed_state = mujoco.MjData(m)
+    mujoco.mj_copyData(closed_state, m, d)
+    runs = []
+    for u in directions:
+        di = mujoco.MjData(m)
+        mujoco.mj_copyData(di, m, closed_state)
+        r = hold(m, di, proto, g * np.asarray(u, dtype=float), hold_steps, closing)
+        r["gravity"] = list(u)
+        runs.append(r)
+    order = {"hold": 0, "slip": 1, "drop": 2}
+    worst = max(runs, key=lambda r: (order[r["verdict"]], r["translation_mm"]))
+    out = dict(worst)
+    out.pop("gravity")
+    out["directions"] = [{"gravity": r["gravity"], "verdict": r["verdict"],
+                          "translation_mm": r["translation_mm"], "rotation_deg": r["rotation_deg"]}
+                         for r in runs]
+    out["wall_ms"] = (time.perf_counter() - t0) * 1000.0
+    out["steps"] = closed + sum(r["steps"] - closed for r in runs)
+    return out
+
+
+def hold(m, d, proto, gravity, hold_steps, closing):
+    """Gravity on along `gravity` (m/s²) for the whole hold from the closed state in `d`."""
+    closed, t0, pc, rc, pushed = (closing[k] for k in ("closed", "t0", "pc", "rc", "pushed"))
+    palm = m.body("palm").id
+    obj = m.body("object").id
+    dt = m.opt.timestep
     m.opt.gravity[:] = gravity
     for _ in range(hold_steps):
         mujoco.mj_step(m, d)
@@ -186,8 +231,8 @@ def replay(scene_dir):
         "wall_ms": wall_ms,
         "steps": closed + hold_steps,
         "closed_at_s": closed * dt,
-        "closing_shift_mm": closing_shift,
-        "closing_turn_deg": closing_turn,
+        "closing_shift_mm": closing["closing_shift_mm"],
+        "closing_turn_deg": closing["closing_turn_deg"],
         "closing_pushed": pushed,
     }
 
@@ -196,8 +241,9 @@ def main(argv):
     if len(argv) < 2:
         print(__doc__, file=sys.stderr)
         return 2
-    for scene_dir in argv[1:]:
-        print(json.dumps(replay(scene_dir)))
+    six = "--six" in argv
+    for scene_dir in [a for a in argv[1:] if a != "--six"]:
+        print(json.dumps(replay(scene_dir, SIX if six else None)))
     return 0
 
 

@@ -146,6 +146,12 @@ pub struct Cli {
     #[arg(long, value_name = "DIRECTIONS", value_enum)]
     pub gravity: Option<Gravity>,
 
+    /// Perturbed checks of the chosen grasp, for every input (`sim.robust`: the hold probability
+    /// with its 95 % interval; docs/SIM.md "Hold probability"); default: each scenario's
+    /// `[sim] samples`, 1 (the main check only).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub samples: Option<u32>,
+
     /// Stop waiting for an input after this many seconds: its line is an error and the next
     /// input runs (a backstop; no input the planner's budget admits comes near it).
     #[arg(long, value_name = "SECONDS", value_parser = positive_seconds,

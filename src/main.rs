@@ -96,6 +96,7 @@ fn run_inputs(cli: cli::Cli) -> anyhow::Result<u8> {
         options,
         units: cli.units.into(),
         gravity: cli.gravity.map(GravityMode::from),
+        samples: cli.samples.map(|n| n as usize),
         json: cli.json,
         time_limit: Some(std::time::Duration::from_secs_f64(cli.time_limit)),
     };

@@ -196,6 +196,10 @@ pub struct Expect {
     pub theta_tolerance_deg: f64,
     /// Tolerance on θ2 alone, when it must differ from `theta_tolerance_deg` `[deg]`.
     pub theta2_tolerance_deg: Option<f64>,
+    /// The least hold probability under `[sim] samples` perturbed checks, judged on its 95 %
+    /// Wilson interval's lower bound (issue 34): 8 of 8 held is a lower bound of 0.68.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_hold_probability: Option<f64>,
 }
 
 fn default_index_tolerance() -> i64 {
@@ -332,6 +336,14 @@ impl Scenario {
         raw.sim
             .validate(hand.finger_list.len())
             .map_err(|(key, problem)| invalid(key, problem))?;
+        if let Some(p) = raw.expect.as_ref().and_then(|e| e.min_hold_probability) {
+            if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
+                return Err(invalid(
+                    "expect.min_hold_probability",
+                    format!("must be in [0, 1], got {p}"),
+                ));
+            }
+        }
         if let Some(t) = raw.expect.as_ref().and_then(|e| e.theta_deg.as_ref()) {
             if t.len() != hand.finger_list.len() {
                 return Err(invalid(

@@ -310,14 +310,39 @@ fn wants_extended(sel: &Selection, p: &SelectParams) -> bool {
     }
 }
 
+/// Returns true if and only if a checked candidate succeeded ([`SimOutcome::succeeded`]: it
+/// held, or under `[sim] choose = "robust"` its hold probability's lower bound passed).
 fn has_hold(sel: &Selection) -> bool {
     sel.candidates
         .iter()
-        .any(|c| c.check.as_ref().is_some_and(|o| o.verdict == Verdict::Hold))
+        .any(|c| c.check.as_ref().is_some_and(SimOutcome::succeeded))
 }
 
-/// The first candidate that held, else the first that slipped, else the first found.
+/// The first candidate that succeeded; else, when candidates were sampled (`choose =
+/// "robust"`), the one with the highest lower bound of its hold probability (then the highest
+/// probability, then the first) if any sample of it held; else the first that held, else the
+/// first that slipped, else the first found.
 fn choose(candidates: &[Candidate]) -> Option<usize> {
+    if let Some(i) = candidates
+        .iter()
+        .position(|c| c.check.as_ref().is_some_and(SimOutcome::succeeded))
+    {
+        return Some(i);
+    }
+    let sampled = candidates
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| Some((i, c.check.as_ref()?.robust.as_ref()?)))
+        .filter(|(_, r)| r.counts.hold > 0);
+    let best = sampled.max_by(|(i, a), (j, b)| {
+        a.interval[0]
+            .total_cmp(&b.interval[0])
+            .then(a.hold_probability.total_cmp(&b.hold_probability))
+            .then(j.cmp(i))
+    });
+    if let Some((i, _)) = best {
+        return Some(i);
+    }
     let first_with = |v: Verdict| {
         candidates
             .iter()

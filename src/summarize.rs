@@ -43,6 +43,10 @@ pub struct Row {
     pub wall_ms: f64,
     /// The error, for an object that could not be run.
     pub error: String,
+    /// `sim.robust.hold_probability`, when the line has one (`[sim] samples` above 1).
+    pub hold_probability: Option<f64>,
+    /// `sim.robust.interval`'s lower bound, when the line has one.
+    pub hold_lower_bound: Option<f64>,
 }
 
 /// Per gravity direction: how many grasps were checked under it and their verdicts.
@@ -186,6 +190,7 @@ impl Summary {
                 );
             }
         }
+        self.write_probabilities(&mut t);
         let _ = writeln!(
             t,
             "  expectations  {} met, {} not met, {} not judged",
@@ -201,6 +206,37 @@ impl Summary {
         self.write_slowest(&mut t, slowest);
         self.write_errors(&mut t);
         t
+    }
+
+    /// The hold probabilities of the lines that have one (`[sim] samples` above 1): their
+    /// mean and spread, and how many main-check holds have a lower bound under 0.9.
+    fn write_probabilities(&self, t: &mut String) {
+        let sampled: Vec<&Row> = self
+            .rows
+            .iter()
+            .filter(|r| r.hold_probability.is_some())
+            .collect();
+        if sampled.is_empty() {
+            return;
+        }
+        let p: Vec<f64> = sampled.iter().filter_map(|r| r.hold_probability).collect();
+        let mean = p.iter().sum::<f64>() / p.len() as f64;
+        let count = |f: &dyn Fn(f64) -> bool| p.iter().filter(|x| f(**x)).count();
+        let held = sampled.iter().filter(|r| r.verdict == "hold");
+        let weak = held
+            .clone()
+            .filter(|r| r.hold_lower_bound.is_some_and(|lo| lo < 0.9))
+            .count();
+        let _ = writeln!(
+            t,
+            "  hold probability {} sampled: mean {mean:.3}; p = 1 {}, 0.5 <= p < 1 {}, 0 < p < 0.5 {}, p = 0 {}; {weak} of {} held in the main check have a 95 % lower bound under 0.9",
+            sampled.len(),
+            count(&|x| x == 1.0),
+            count(&|x| (0.5..1.0).contains(&x)),
+            count(&|x| x > 0.0 && x < 0.5),
+            count(&|x| x == 0.0),
+            held.count()
+        );
     }
 
     /// The `slowest` slowest objects, slowest first, each with its outcome.
@@ -241,13 +277,22 @@ impl Summary {
     }
 
     /// One row per object, in file order, with a header.
+    ///
+    /// With hold probabilities on any line, two columns more at the end:
+    /// `hold_probability,hold_lower_bound`.
     pub fn to_csv(&self) -> String {
+        let sampled = self.rows.iter().any(|r| r.hold_probability.is_some());
         let mut t = String::from(
-            "input,scenario,status,verdict,translation_mm,rotation_deg,payload_margin,directions,expected,met,wall_ms,error\n",
+            "input,scenario,status,verdict,translation_mm,rotation_deg,payload_margin,directions,expected,met,wall_ms,error",
         );
+        t.push_str(if sampled {
+            ",hold_probability,hold_lower_bound\n"
+        } else {
+            "\n"
+        });
         let num = |x: Option<f64>| x.map_or(String::new(), |v| format!("{v}"));
         for r in &self.rows {
-            let fields = [
+            let mut fields = vec![
                 csv_field(&r.input),
                 csv_field(&r.scenario),
                 csv_field(&r.status),
@@ -261,6 +306,10 @@ impl Summary {
                 format!("{:.3}", r.wall_ms),
                 csv_field(&r.error),
             ];
+            if sampled {
+                fields.push(num(r.hold_probability));
+                fields.push(num(r.hold_lower_bound));
+            }
             t.push_str(&fields.join(","));
             t.push('\n');
         }
@@ -314,6 +363,8 @@ fn row_of(v: &RecordView) -> Result<Row, String> {
             met: None,
             wall_ms: v.batch.wall_ms.unwrap_or(0.0),
             error: e.text().to_string(),
+            hold_probability: None,
+            hold_lower_bound: None,
         });
     }
     let status = v
@@ -348,6 +399,8 @@ fn row_of(v: &RecordView) -> Result<Row, String> {
         met: v.expect.met,
         wall_ms,
         error: String::new(),
+        hold_probability: sim.robust.hold_probability,
+        hold_lower_bound: sim.robust.lower_bound(),
     })
 }
 
@@ -403,6 +456,38 @@ mod tests {
             "{}",
             lines[3]
         );
+    }
+
+    #[test]
+    fn hold_probabilities_are_summed_up_and_written_when_present() {
+        let sampled = HOLD.replace(
+            r#""directions":"#,
+            r#""robust":{"samples":16,"hold_probability":0.875,"interval":[0.64,0.965]},"directions":"#,
+        );
+        let text = format!("{sampled}\n{UNGRASPABLE}\n");
+        let s = Summary::parse(Path::new("r.jsonl"), text.as_bytes()).unwrap();
+        assert_eq!(s.rows[0].hold_probability, Some(0.875));
+        assert_eq!(s.rows[0].hold_lower_bound, Some(0.64));
+        let t = s.to_text("r.jsonl", 0);
+        assert!(
+            t.contains("hold probability 1 sampled: mean 0.875; p = 1 0, 0.5 <= p < 1 1")
+                && t.contains("1 of 1 held in the main check have a 95 % lower bound under 0.9"),
+            "{t}"
+        );
+        let csv = s.to_csv();
+        let lines: Vec<&str> = csv.lines().collect();
+        assert!(lines[0].ends_with(",error,hold_probability,hold_lower_bound"));
+        assert!(lines[1].ends_with(",1500.000,,0.875,0.64"), "{}", lines[1]);
+        assert!(lines[2].ends_with(",,"), "{}", lines[2]);
+        // Without probabilities the CSV keeps its columns.
+        let plain = Summary::parse(Path::new("r.jsonl"), HOLD.as_bytes()).unwrap();
+        assert!(plain
+            .to_csv()
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with(",wall_ms,error"));
+        assert!(!plain.to_text("r", 0).contains("hold probability"));
     }
 
     #[test]

@@ -242,9 +242,17 @@ fn outcome_word(r: &ItemResult) -> String {
         Ok(rec) => match rec.error() {
             Some(_) => "error".to_string(),
             None => format!(
-                "{} {}",
+                "{} {}{}",
                 rec.view.plan.status.as_deref().unwrap_or("?"),
-                rec.view.sim.verdict.as_deref().unwrap_or("?")
+                rec.view.sim.verdict.as_deref().unwrap_or("?"),
+                // With `[sim] samples` (issue 34): the hold probability and its lower bound.
+                match (
+                    rec.view.sim.robust.hold_probability,
+                    rec.view.sim.robust.lower_bound()
+                ) {
+                    (Some(p), Some(lo)) => format!(" (hold probability {p:.2}, >= {lo:.2})"),
+                    _ => String::new(),
+                }
             ),
         },
         Err(_) => "interrupted".to_string(),

@@ -183,6 +183,8 @@ pub(super) fn checked_report(
         payload_fails_at: payload.and_then(|(_, failed)| failed),
         closing: Some(out.closing),
         directions: out.directions,
+        robust: out.robust,
+        replay: out.replay,
         limits: Some(report::HoldLimits {
             translation_mm: case.params.hold.hold_translation_mm,
             rotation_deg: case.params.hold.hold_rotation_deg,

@@ -21,6 +21,8 @@ pub struct CommandLine {
     pub units: LengthUnit,
     /// Gravity directions for every input (`None`: each scenario's own).
     pub gravity: Option<GravityMode>,
+    /// Perturbed checks for every input (`None`: each scenario's `[sim] samples`).
+    pub samples: Option<usize>,
     /// JSON Lines instead of the summary.
     pub json: bool,
     /// The longest one input may run (`None`: no bound).
@@ -80,6 +82,9 @@ pub fn run_inputs(
         let ran = input::scenario_for(&item, &template).map(|mut s| {
             if let Some(g) = cl.gravity {
                 s.sim.gravity = g;
+            }
+            if let Some(n) = cl.samples {
+                s.sim.robust.samples = n;
             }
             let options = names.options_for(&s, path, &cl.options);
             let finish = spinner(&s, &options);

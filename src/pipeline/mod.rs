@@ -330,6 +330,7 @@ pub fn write_outputs(
         };
         let folder = dir.join(options.folder_for(scenario));
         export::write_mjcf(&folder, &input)?;
+        write_sample_scenes(&folder, &input)?;
         computed.report.mjcf_scene = Some(folder.join("scene.xml"));
     }
     if let Some(dir) = &options.report {
@@ -350,6 +351,27 @@ pub fn write_outputs(
     Ok(())
 }
 
+/// With `[sim] samples` above 1 (issue 34): each perturbed sample's MJCF scene, into
+/// `folder/samples/<k>/`, for MuJoCo to replay the same samples
+/// (`scripts/compare_engines.py --robust`).
+fn write_sample_scenes(folder: &std::path::Path, input: &export::ExportInput) -> Result<(), Error> {
+    let rp = &input.case.params.robust;
+    if rp.samples < 2 {
+        return Ok(());
+    }
+    for k in 0..rp.samples {
+        let p = sim::Perturbation::draw(rp, k);
+        let perturbed = sim::robust::Perturbed::of(&input.case, &p);
+        let sample = export::ExportInput {
+            name: input.name,
+            object: input.object,
+            case: perturbed.case(&input.case),
+        };
+        export::write_mjcf(&folder.join("samples").join(k.to_string()), &sample)?;
+    }
+    Ok(())
+}
+
 /// The physics check of one planned grasp on `aligned`, as a run does it: the one place that
 /// turns a grasp into a check (the candidate search and `tune` call it).
 pub fn check_grasp(
@@ -360,7 +382,7 @@ pub fn check_grasp(
 ) -> sim::SimOutcome {
     let shape = object.shape(aligned);
     let pose = sim::SimHand::from_grasp(grasp);
-    sim::check(&object.case(scenario, &pose, &shape))
+    sim::check_candidate(&object.case(scenario, &pose, &shape))
 }
 
 /// Plans across axes and rule sets; with the physics check on the planner's grasps, checks
@@ -472,17 +494,25 @@ fn run_sim(
     let shape = object.shape(aligned);
     let case = object.case(scenario, pose, &shape);
     // The candidate search already checked the chosen grasp: the same case, the same outcome.
-    let (out, payload, ran) = match done {
+    let (mut out, payload, ran) = match done {
         Some(out) => {
             let payload = (options.payload && out.verdict == sim::Verdict::Hold)
                 .then(|| sim::payload_bracket(&case));
             (out.clone(), payload, false)
+        }
+        None if case.params.robust.replay_sample.is_some() => {
+            let out = sim::check_nominal(&case);
+            let payload = (options.payload && out.verdict == sim::Verdict::Hold)
+                .then(|| sim::payload_bracket(&case));
+            (out, payload, true)
         }
         None => {
             let (out, payload) = sim::check_with_payload(&case, options.payload);
             (out, payload, true)
         }
     };
+    // `[sim] samples`: the perturbed checks of the grasp chosen (issue 34).
+    sim::add_samples(&case, &mut out);
     let poses = (out.final_poses.clone(), out.closed_poses.clone());
     let ran = ran.then(|| out.clone());
     let report = build::checked_report(out, payload, &case, &shape, source, options);

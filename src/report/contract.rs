@@ -460,6 +460,13 @@ pub struct SimReport {
     /// `max_penetration_mm`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limits: Option<HoldLimits>,
+    /// The hold probability under `[sim] samples` perturbed checks (issue 34); absent with one
+    /// sample (the default: the main check only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub robust: Option<crate::sim::Robust>,
+    /// The perturbation the main check ran under (`[sim] replay_sample`); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub replay: Option<crate::sim::Perturbation>,
 }
 
 /// The limits of a hold: how far the object may move and turn relative to the palm, and how
@@ -497,6 +504,8 @@ impl SimReport {
             closing: None,
             directions: Vec::new(),
             limits: None,
+            robust: None,
+            replay: None,
         }
     }
 }
@@ -615,6 +624,31 @@ pub struct SimView {
     /// `sim.directions` (empty when absent or not a list).
     #[serde(deserialize_with = "lenient_list")]
     pub directions: Vec<DirectionView>,
+    /// `sim.robust` (all absent when the line has none).
+    #[serde(deserialize_with = "lenient_object")]
+    pub robust: RobustView,
+}
+
+/// The `sim.robust` fields a reader uses (issue 34).
+#[derive(Debug, Clone, Default, PartialEq, Deserialize)]
+#[serde(default)]
+pub struct RobustView {
+    /// `samples`.
+    #[serde(deserialize_with = "lenient")]
+    pub samples: Option<usize>,
+    /// `hold_probability`.
+    #[serde(deserialize_with = "lenient")]
+    pub hold_probability: Option<f64>,
+    /// `interval`, the numbers of the list (empty when it is not a list).
+    #[serde(deserialize_with = "numbers_of_list")]
+    pub interval: Vec<f64>,
+}
+
+impl RobustView {
+    /// The interval's lower bound, when the line gives one.
+    pub fn lower_bound(&self) -> Option<f64> {
+        self.interval.first().copied()
+    }
 }
 
 impl SimView {

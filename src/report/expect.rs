@@ -28,6 +28,22 @@ impl ExpectReport {
     /// physics check ran, its verdict against the expected outcome. A scenario that fixes the
     /// joint angles (`override_angles`) or checks a given grasp is judged on the verdict alone.
     pub fn judge(expect: &Expect, plan: &PlanReport, sim: &SimReport) -> ExpectReport {
+        let report = Self::judge_verdict(expect, plan, sim);
+        match (expect.min_hold_probability, report.met) {
+            (Some(p), Some(true)) if expect.outcome != Outcome::Ungraspable => {
+                let (met, words) = judge_probability(p, sim);
+                ExpectReport {
+                    met: Some(met),
+                    details: format!("{}; {words}", report.details),
+                    ..report
+                }
+            }
+            _ => report,
+        }
+    }
+
+    /// [`ExpectReport::judge`] without `min_hold_probability`.
+    fn judge_verdict(expect: &Expect, plan: &PlanReport, sim: &SimReport) -> ExpectReport {
         let outcome = Some(expect.outcome);
         let sim_only = match sim.grasp_source {
             Some(GraspSource::OverrideAngles) => Some("override_angles"),
@@ -65,6 +81,29 @@ impl ExpectReport {
             details,
         }
     }
+}
+
+/// `[expect] min_hold_probability = p` against the check: the 95 % Wilson lower bound of the
+/// hold probability must reach `p`. With one sample (no `sim.robust`) the main check is the one
+/// sample; a check that did not run cannot meet it.
+fn judge_probability(p: f64, sim: &SimReport) -> (bool, String) {
+    let (held, n, lo) = match (&sim.robust, sim.verdict.verdict()) {
+        (Some(r), _) => (r.counts.hold, r.samples, r.interval[0]),
+        (None, Some(v)) => {
+            let held = usize::from(v == crate::sim::Verdict::Hold);
+            (held, 1, crate::sim::robust::wilson(held, 1)[0])
+        }
+        (None, None) => {
+            return (
+                false,
+                format!("hold probability not measured (physics check not run); expected a lower bound of at least {p}"),
+            )
+        }
+    };
+    let words = format!(
+        "held in {held} of {n} perturbed checks, 95 % lower bound {lo:.3} (expected at least {p})"
+    );
+    (lo >= p, words)
 }
 
 /// Once the planning part is met: the physics check's verdict against the expected outcome.

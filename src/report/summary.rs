@@ -204,6 +204,12 @@ impl RunReport {
     /// The physics check's line and, when it closed the hand, the closing's lines.
     fn write_sim(&self, s: &mut String) {
         let _ = writeln!(s, "  Sim         {}", self.sim_line());
+        if let Some(p) = &self.sim.replay {
+            let _ = writeln!(s, "  Replay      {}", replay_line(p));
+        }
+        if let Some(r) = &self.sim.robust {
+            let _ = writeln!(s, "  Robust      {}", robust_line(r));
+        }
         if let Some(c) = &self.sim.closing {
             let _ = writeln!(s, "  Closing     {}", closing_line(c));
             let set = |f: &crate::sim::FingerClosing,
@@ -401,6 +407,57 @@ pub fn closing_line(c: &crate::sim::ClosingOutcome) -> String {
         None => s += "; nothing touched the object",
     }
     s
+}
+
+/// The hold probability in words, per direction, and the first failing sample with how to
+/// replay it.
+pub fn robust_line(r: &crate::sim::Robust) -> String {
+    let dirs: Vec<String> = r
+        .directions
+        .iter()
+        .map(|d| {
+            format!(
+                "{} {}/{}",
+                direction_name(d.gravity),
+                d.counts.hold,
+                r.samples
+            )
+        })
+        .collect();
+    let mut line = r.in_words();
+    if r.directions.len() > 1 {
+        line.push_str(&format!("; per direction {}", dirs.join(", ")));
+    }
+    if let Some(f) = &r.first_failure {
+        line.push_str(&format!(
+            "; first failure: sample {} ({} under {}; replay with [sim] replay_sample = {})",
+            f.sample,
+            f.verdict,
+            direction_name(f.gravity),
+            f.sample
+        ));
+    }
+    line
+}
+
+/// A perturbation in words.
+fn replay_line(p: &crate::sim::Perturbation) -> String {
+    let [x, y, z] = p.offset_mm;
+    let [a, b, c] = p.rotation_deg;
+    format!(
+        "sample {}: object offset ({x:.2}, {y:.2}, {z:.2}) mm and turned ({a:.2}, {b:.2}, {c:.2}) deg relative to the hand; friction x{:.3}, mass x{:.3}, motor torque x{:.3}",
+        p.sample, p.friction_scale, p.mass_scale, p.torque_scale
+    )
+}
+
+/// `+X`, `-Z`, ... for an axis direction; the vector otherwise.
+fn direction_name(g: [f64; 3]) -> String {
+    for (i, axis) in ["X", "Y", "Z"].iter().enumerate() {
+        if g[i].abs() == 1.0 {
+            return format!("{}{axis}", if g[i] > 0.0 { "+" } else { "-" });
+        }
+    }
+    format!("({:.2}, {:.2}, {:.2})", g[0], g[1], g[2])
 }
 
 /// The summary's quality line: epsilon and volume, what they were computed from, and why

@@ -8,7 +8,8 @@
 //! Files: [`params`] (the `[sim]` table), [`scene`] (the rapier scene and where it starts),
 //! [`collider`] (the object's collision shape), [`protocol`] (the two protocols' drivers),
 //! [`closing`], [`hold`] with [`early`] (the rest rule) and [`flight`] (drop detection),
-//! [`payload`], [`outcome`] (what is reported), [`contacts`] (the grip's contacts) and
+//! [`payload`], [`robust`] (the hold probability under perturbation), [`outcome`] (what is
+//! reported), [`contacts`] (the grip's contacts) and
 //! [`convert`] (nalgebra to glam, millimetres to metres).
 //!
 //! Scene ([`scene`]): the palm is a fixed box at the planned pose; each phalanx is a
@@ -46,6 +47,7 @@ pub mod outcome;
 pub mod params;
 pub mod payload;
 pub mod protocol;
+pub mod robust;
 pub mod scene;
 
 pub use closing::{Stall, STALL};
@@ -56,6 +58,7 @@ pub use outcome::{
 };
 pub use payload::{check_with_payload, payload_bracket, payload_margin};
 pub use protocol::{check, check_closed, Closed};
+pub use robust::{add_samples, check_candidate, check_nominal, Perturbation, Robust};
 pub use scene::{Case, SimHand};
 
 /// A body's pose: position `[m]` and orientation, aligned object frame.

@@ -157,6 +157,23 @@ pub struct SimOutcome {
     /// Where the closing left the bodies, gravity still off (aligned frame, metres): the
     /// palm, phalanx 1 and 2 of each finger, then the object.
     pub closed_poses: Vec<super::BodyPose>,
+    /// The hold probability under `[sim] samples` perturbations, when they ran.
+    pub robust: Option<super::robust::Robust>,
+    /// The perturbation this check ran under (`[sim] replay_sample`); `None`: the scenario's
+    /// case as given.
+    pub replay: Option<super::robust::Perturbation>,
+}
+
+impl SimOutcome {
+    /// Returns true if and only if the check counts as a success for the candidate search: the
+    /// hold probability's lower bound reaches `[sim] choose_min_lower_bound` when the samples
+    /// ran for it (`choose = "robust"`), else the main check's verdict is `hold`.
+    pub fn succeeded(&self) -> bool {
+        match &self.robust {
+            Some(r) => r.passes,
+            None => self.verdict == Verdict::Hold,
+        }
+    }
 }
 
 /// What the closing did to the planned grasp (issue 33, docs/SIM.md "What the closing does"):

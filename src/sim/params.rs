@@ -69,6 +69,76 @@ pub struct SimParams {
     pub selection: SelectionParams,
     /// Where the grasp comes from: the planner, or joint angles fixed by the scenario.
     pub input: InputParams,
+    /// The hold probability under perturbation (issue 34, docs/SIM.md "Hold probability"):
+    /// how many perturbed checks, drawn how. Left out of the serialised parameters when all at
+    /// their defaults, so a scenario that does not use it keeps its batch input hash.
+    #[serde(skip_serializing_if = "RobustParams::is_default")]
+    pub robust: RobustParams,
+}
+
+/// How the candidate search picks among the candidates it checked (`[sim] choose`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Choose {
+    /// The first candidate that holds in the main check (the check before issue 34).
+    First,
+    /// The first candidate whose hold probability's lower bound reaches
+    /// `choose_min_lower_bound`; if none of the `max_checked` does, the one with the highest
+    /// lower bound. Needs `samples` of at least 2.
+    Robust,
+}
+
+/// The hold probability under perturbation (`[sim]` keys of the same names; docs/SIM.md,
+/// "Hold probability").
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct RobustParams {
+    /// Perturbed checks of the chosen grasp (1: none, the main check only).
+    pub samples: usize,
+    /// The seed the perturbations are drawn from.
+    pub seed: u64,
+    /// Each coordinate of the object's offset relative to the hand before closing is uniform
+    /// within ± this `[mm]`.
+    pub pose_offset_mm: f64,
+    /// The object's rotation relative to the hand before closing: about an axis uniform on the
+    /// sphere, by an angle uniform up to this `[deg]`.
+    pub pose_rotation_deg: f64,
+    /// Friction is multiplied by a factor uniform within 1 ± this `[%]`.
+    pub friction_range_pct: f64,
+    /// The object's mass is multiplied by a factor uniform within 1 ± this `[%]`.
+    pub mass_range_pct: f64,
+    /// The finger motors' torque limit is multiplied by a factor uniform within 1 ± this `[%]`.
+    pub torque_range_pct: f64,
+    /// Run the main check under this sample's perturbation (to replay a failure reported in
+    /// `sim.robust.first_failure`).
+    pub replay_sample: Option<usize>,
+    /// How the candidate search picks (`first` or `robust`).
+    pub choose: Choose,
+    /// `choose = "robust"`: the lower bound a candidate's hold probability must reach.
+    pub choose_min_lower_bound: f64,
+}
+
+impl Default for RobustParams {
+    fn default() -> Self {
+        RobustParams {
+            samples: 1,
+            seed: 0,
+            pose_offset_mm: 2.0,
+            pose_rotation_deg: 3.0,
+            friction_range_pct: 15.0,
+            mass_range_pct: 15.0,
+            torque_range_pct: 10.0,
+            replay_sample: None,
+            choose: Choose::First,
+            choose_min_lower_bound: 0.8,
+        }
+    }
+}
+
+impl RobustParams {
+    /// Returns true if and only if every value is its default.
+    pub fn is_default(&self) -> bool {
+        *self == RobustParams::default()
+    }
 }
 
 /// The rapier solver: timestep, iterations and contact stiffness.
@@ -278,6 +348,7 @@ impl Default for SimParams {
             early: EarlyParams::default(),
             selection: SelectionParams::default(),
             input: InputParams::default(),
+            robust: RobustParams::default(),
         }
     }
 }
@@ -292,7 +363,7 @@ impl std::fmt::Debug for SimParams {
 
 /// The `[sim]` table as written: one field per key, in the order serde's messages list them.
 mod flat {
-    use super::{Approach, GravityMode, HandJoints, Protocol};
+    use super::{Approach, Choose, GravityMode, HandJoints, Protocol};
     use serde::Deserialize;
 
     /// The flat `[sim]` table (see the module docs of [`super`]).
@@ -330,6 +401,16 @@ mod flat {
         pub(super) max_closing_shift_mm: f64,
         pub(super) balanced_squeeze: bool,
         pub(super) approach: Approach,
+        pub(super) samples: usize,
+        pub(super) seed: u64,
+        pub(super) pose_offset_mm: f64,
+        pub(super) pose_rotation_deg: f64,
+        pub(super) friction_range_pct: f64,
+        pub(super) mass_range_pct: f64,
+        pub(super) torque_range_pct: f64,
+        pub(super) replay_sample: Option<usize>,
+        pub(super) choose: Choose,
+        pub(super) choose_min_lower_bound: f64,
     }
 
     impl Default for SimParams {
@@ -386,6 +467,18 @@ mod flat {
                     override_angles: s.override_angles,
                     override_index: s.override_index,
                 },
+                robust: super::RobustParams {
+                    samples: s.samples,
+                    seed: s.seed,
+                    pose_offset_mm: s.pose_offset_mm,
+                    pose_rotation_deg: s.pose_rotation_deg,
+                    friction_range_pct: s.friction_range_pct,
+                    mass_range_pct: s.mass_range_pct,
+                    torque_range_pct: s.torque_range_pct,
+                    replay_sample: s.replay_sample,
+                    choose: s.choose,
+                    choose_min_lower_bound: s.choose_min_lower_bound,
+                },
             }
         }
     }
@@ -424,6 +517,16 @@ mod flat {
                 max_closing_shift_mm: s.hold.max_closing_shift_mm,
                 balanced_squeeze: s.fingers.balanced_squeeze,
                 approach: s.closing.approach,
+                samples: s.robust.samples,
+                seed: s.robust.seed,
+                pose_offset_mm: s.robust.pose_offset_mm,
+                pose_rotation_deg: s.robust.pose_rotation_deg,
+                friction_range_pct: s.robust.friction_range_pct,
+                mass_range_pct: s.robust.mass_range_pct,
+                torque_range_pct: s.robust.torque_range_pct,
+                replay_sample: s.robust.replay_sample,
+                choose: s.robust.choose,
+                choose_min_lower_bound: s.robust.choose_min_lower_bound,
             }
         }
     }
@@ -451,7 +554,8 @@ impl SimParams {
         self.validate_bounds()?;
         self.validate_work()?;
         self.input.validate(fingers)?;
-        self.fingers.validate_squeeze()
+        self.fingers.validate_squeeze()?;
+        self.robust.validate()
     }
 
     /// The values that must be finite and positive.
@@ -585,6 +689,56 @@ impl InputParams {
     }
 }
 
+/// The most perturbed checks a run may ask for.
+pub const MAX_SAMPLES: usize = 1000;
+
+impl RobustParams {
+    /// The sample count, the ranges (zero allowed; the multipliers' below 100 %), the replayed
+    /// sample and the choice's lower bound.
+    fn validate(&self) -> Result<(), Invalid> {
+        if !(1..=MAX_SAMPLES).contains(&self.samples) {
+            return Err((
+                "sim.samples",
+                format!("must be in 1..={MAX_SAMPLES}, got {}", self.samples),
+            ));
+        }
+        for (key, v, max) in [
+            ("sim.pose_offset_mm", self.pose_offset_mm, 50.0),
+            ("sim.pose_rotation_deg", self.pose_rotation_deg, 45.0),
+            ("sim.friction_range_pct", self.friction_range_pct, 90.0),
+            ("sim.mass_range_pct", self.mass_range_pct, 90.0),
+            ("sim.torque_range_pct", self.torque_range_pct, 90.0),
+        ] {
+            if !(v.is_finite() && (0.0..=max).contains(&v)) {
+                return Err((key, format!("must be in [0, {max}], got {v}")));
+            }
+        }
+        if let Some(k) = self.replay_sample {
+            if k >= MAX_SAMPLES {
+                return Err((
+                    "sim.replay_sample",
+                    format!("must be below {MAX_SAMPLES}, got {k}"),
+                ));
+            }
+        }
+        let lb = self.choose_min_lower_bound;
+        if !(lb.is_finite() && (0.0..=1.0).contains(&lb)) {
+            return Err((
+                "sim.choose_min_lower_bound",
+                format!("must be in [0, 1], got {lb}"),
+            ));
+        }
+        if self.choose == Choose::Robust && self.samples < 2 {
+            return Err((
+                "sim.choose",
+                "\"robust\" needs samples of at least 2 (the hold probability it chooses by)"
+                    .to_string(),
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl FingerParams {
     /// The squeeze overshoots: zero or positive.
     fn validate_squeeze(&self) -> Result<(), Invalid> {
@@ -648,7 +802,7 @@ mod tests {
             "{debug}"
         );
         assert!(
-            debug.ends_with("balanced_squeeze: true, approach: Squeeze }"),
+            debug.contains("balanced_squeeze: true, approach: Squeeze, samples: 1, seed: 0,"),
             "{debug}"
         );
     }

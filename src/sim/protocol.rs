@@ -191,5 +191,7 @@ fn summarise(
             phalanges_on_plan: 0,
         },
         closed_poses: Vec::new(),
+        robust: None,
+        replay: None,
     }
 }

@@ -3,7 +3,10 @@
 //!
 //! Score of a setting, compared in this order: hold rate (objects held / objects), then the
 //! mean payload margin (0 for an object not held), then the mean translation of the held objects
-//! during the hold (smaller is better).
+//! during the hold (smaller is better). With `[sim] samples` above 1 (issue 34) the chosen grasp
+//! of each object is checked under that many perturbations, and the mean hold probability
+//! (0 for an object without a grasp) comes first: a setting is ranked by how reliably its
+//! grasps hold, not by one deterministic sample of each.
 //!
 //! Work that does not depend on a swept parameter is done once: each object is loaded and
 //! aligned once; its stage-1 domain (the vertical slices, which depend only on the AngularStep
@@ -257,6 +260,10 @@ pub struct ObjectResult {
     pub translation_mm: Option<f64>,
     /// Payload margin (held objects only).
     pub payload_margin: Option<f64>,
+    /// The chosen grasp's hold probability under `[sim] samples` perturbations (absent with
+    /// one sample).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub hold_probability: Option<f64>,
     /// Why the setting is `invalid` for this object's hand.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
@@ -273,6 +280,10 @@ pub struct SettingResult {
     pub mean_payload_margin: f64,
     /// Mean translation of the held objects `[mm]` (`null` when none is held).
     pub mean_translation_mm: Option<f64>,
+    /// Mean hold probability over all objects (0 for one without a probability), when any
+    /// object was sampled (`[sim] samples` above 1); absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_hold_probability: Option<f64>,
     /// Per object.
     pub objects: Vec<ObjectResult>,
     /// Why the setting is invalid (it breaks a rule for an object's hand, e.g. a HeightStep
@@ -344,7 +355,7 @@ fn simulate(
         return o.clone();
     }
     let case = p.object.case(&p.scenario, pose, shape);
-    let out = sim::check(&case);
+    let out = sim::check_candidate(&case);
     counters.sim_runs += 1;
     let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
     let o = Simulated {
@@ -352,6 +363,23 @@ fn simulate(
         payload_margin: margin,
     };
     sims.insert(key, o.clone());
+    o
+}
+
+/// `o` with the chosen grasp's perturbed checks (`[sim] samples` above 1), run once per grasp
+/// and kept in the cache.
+fn sampled(
+    p: &Prepared,
+    pose: &SimHand,
+    shape: &ObjectShape,
+    key: (crate::mesh::GraspAxis, Vec<u64>),
+    mut o: Simulated,
+    sims: &mut SimCache,
+) -> Simulated {
+    if p.scenario.sim.robust.samples > 1 && o.outcome.robust.is_none() {
+        sim::add_samples(&p.object.case(&p.scenario, pose, shape), &mut o.outcome);
+        sims.insert(key, o.clone());
+    }
     o
 }
 
@@ -470,8 +498,9 @@ pub fn tune_with_progress(
 
 /// Orders settings best first.
 pub fn rank(a: &SettingResult, b: &SettingResult) -> std::cmp::Ordering {
-    b.hold_rate
-        .total_cmp(&a.hold_rate)
+    let p = |s: &SettingResult| s.mean_hold_probability.unwrap_or(0.0);
+    p(b).total_cmp(&p(a))
+        .then(b.hold_rate.total_cmp(&a.hold_rate))
         .then(b.mean_payload_margin.total_cmp(&a.mean_payload_margin))
         .then(
             a.mean_translation_mm
@@ -491,9 +520,18 @@ fn score(values: Vec<f64>, objects: Vec<ObjectResult>) -> SettingResult {
         .collect();
     let mean_translation_mm = (!held.is_empty())
         .then(|| held.iter().filter_map(|o| o.translation_mm).sum::<f64>() / held.len() as f64);
+    let sampled = objects.iter().any(|o| o.hold_probability.is_some());
+    let mean_hold_probability = sampled.then(|| {
+        objects
+            .iter()
+            .filter_map(|o| o.hold_probability)
+            .fold(0.0, |a, p| a + p)
+            / n
+    });
     SettingResult {
         values,
         hold_rate: held.len() as f64 / n,
+        mean_hold_probability,
         // Folded from +0.0: an empty f64 sum is -0.0, printed "-0.00".
         mean_payload_margin: objects
             .iter()
@@ -566,6 +604,8 @@ fn object_result(
         verdict: outcome.map(|o| o.outcome.verdict),
         translation_mm: outcome.map(|o| o.outcome.translation_mm),
         payload_margin: outcome.and_then(|o| o.payload_margin),
+        hold_probability: outcome
+            .and_then(|o| o.outcome.robust.as_ref().map(|r| r.hold_probability)),
         reason,
     }
 }
@@ -604,14 +644,15 @@ fn run_override(
     let outcome = pose.ok().map(|pose| {
         let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
         let shape = p.object.shape(aligned);
-        simulate(
+        let o = simulate(
             p,
             &pose,
             &shape,
-            key,
+            key.clone(),
             &mut shared.sims,
             &mut shared.counters,
-        )
+        );
+        sampled(p, &pose, &shape, key, o, &mut shared.sims)
     });
     object_result(p, ObjectStatus::OverrideAngles, outcome.as_ref(), None)
 }
@@ -659,7 +700,16 @@ fn run_planned(
     let best = selection.chosen().and_then(|c| {
         let a = &selection.axes[c.axis_plan].aligned;
         let pose = SimHand::from_grasp(&c.grasp);
-        shared.sims.get(&(a.axis, fingerprint(&pose))).cloned()
+        let key = (a.axis, fingerprint(&pose));
+        let o = shared.sims.get(&key).cloned()?;
+        Some(sampled(
+            p,
+            &pose,
+            &p.object.shape(a),
+            key,
+            o,
+            &mut shared.sims,
+        ))
     });
     let status = match selection.chosen {
         Some(_) => ObjectStatus::Feasible,
@@ -675,7 +725,13 @@ pub fn to_csv(r: &TuneResult) -> String {
         s.push_str(sw.name.as_str());
         s.push(',');
     }
-    s.push_str("hold_rate,mean_payload_margin,mean_translation_mm,held,feasible,objects,invalid\n");
+    let sampled = r.settings.iter().any(|s| s.mean_hold_probability.is_some());
+    s.push_str("hold_rate,mean_payload_margin,mean_translation_mm,held,feasible,objects,invalid");
+    s.push_str(if sampled {
+        ",mean_hold_probability\n"
+    } else {
+        "\n"
+    });
     for set in &r.settings {
         for v in &set.values {
             s.push_str(&format!("{v},"));
@@ -683,9 +739,10 @@ pub fn to_csv(r: &TuneResult) -> String {
         if let Some(why) = &set.invalid {
             // Not run: no scores, only the reason (quoted, doubled quotes inside).
             s.push_str(&format!(
-                ",,,,,{},\"{}\"\n",
+                ",,,,,{},\"{}\"{}\n",
                 set.objects.len(),
-                why.replace('"', "\"\"")
+                why.replace('"', "\"\""),
+                if sampled { "," } else { "" }
             ));
             continue;
         }
@@ -700,13 +757,18 @@ pub fn to_csv(r: &TuneResult) -> String {
             .filter(|o| o.status == ObjectStatus::Feasible)
             .count();
         s.push_str(&format!(
-            "{:.6},{:.6},{},{held},{feasible},{},\n",
+            "{:.6},{:.6},{},{held},{feasible},{},",
             set.hold_rate,
             set.mean_payload_margin,
             set.mean_translation_mm
                 .map_or(String::new(), |t| format!("{t:.6}")),
             set.objects.len()
         ));
+        if sampled {
+            let p = set.mean_hold_probability.unwrap_or(0.0);
+            s.push_str(&format!(",{p:.6}"));
+        }
+        s.push('\n');
     }
     s
 }
@@ -734,6 +796,11 @@ pub fn to_table(r: &TuneResult) -> String {
                 .map_or("-".to_string(), |t| format!("{t:.2}")),
             if k == r.best { "  <- best" } else { "" }
         ));
+        if let Some(p) = set.mean_hold_probability {
+            // At the end of the line, before its newline.
+            let at = s.len() - 1;
+            s.insert_str(at, &format!("  (mean hold probability {p:.3})"));
+        }
     }
     s
 }

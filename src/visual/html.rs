@@ -193,6 +193,13 @@ fn headline(report: &RunReport) -> String {
         "<p class=\"verdict\">{}</p>",
         esc(&verdict_sentence(report))
     ));
+    if let Some(r) = &report.sim.robust {
+        s.push_str(&format!(
+            "<p class=\"verdict\">Hold probability {:.2}: {}</p>",
+            r.hold_probability,
+            esc(&crate::report::summary::robust_line(r))
+        ));
+    }
     s.push_str(&format!(
         "<p>Plan: {}; {}</p>",
         esc(report.plan.status.as_str()),

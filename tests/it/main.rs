@@ -15,6 +15,7 @@ mod planner;
 mod quality;
 mod real_meshes;
 mod resume;
+mod robust;
 mod sim;
 mod summarize;
 mod thesis_table;
