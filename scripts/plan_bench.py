@@ -10,6 +10,12 @@ loading included), both cores free for it.
 
 The default inputs are assets/real/scenarios/*.toml and out/hard/*.stl. An object that runs past
 `--timeout` seconds is killed and counted at the timeout (marked `>`).
+
+    python3 scripts/plan_bench.py --against /tmp/old-grasp-sim --out out/bench.json
+
+times a second binary on each object just before the first (both under the same load, which on a
+shared machine drifts), prints both tables and the results that differ, and writes its rows to
+OUT with `.against` before the suffix.
 """
 
 import argparse
@@ -67,13 +73,17 @@ def main():
     ap.add_argument("--bin", default=str(ROOT / "target/release/grasp-sim"))
     ap.add_argument("--timeout", type=float, default=300.0)
     ap.add_argument("--out", type=pathlib.Path, help="write the rows as JSON here")
+    ap.add_argument("--against", help="a second binary, run on each object just before --bin")
     a = ap.parse_args()
     inputs = a.inputs or (
         sorted((ROOT / "assets/real/scenarios").glob("*.toml"))
         + sorted((ROOT / "out/hard").glob("*.stl"))
     )
     rows = []
+    against = []
     for path in inputs:
+        if a.against:
+            against.append(run_one(a.against, path, a.timeout))
         row = run_one(a.bin, path, a.timeout)
         rows.append(row)
         mark = ">" if row["timed_out"] else " "
@@ -84,17 +94,34 @@ def main():
             f'{row.get("status", "timeout" if row["timed_out"] else "error"):12} {what}',
             flush=True,
         )
+    if a.against:
+        print(f"\n{a.against}:")
+        summary(against)
+        for old, new in zip(against, rows):
+            key = ("status", "candidates_tried", "grasp")
+            if [old.get(k) for k in key] != [new.get(k) for k in key]:
+                name = pathlib.Path(new["input"]).stem
+                print(f"differs: {name}: {[old.get(k) for k in key]} -> {[new.get(k) for k in key]}")
+        print(f"\n{a.bin}:")
+    summary(rows)
+    if a.out:
+        a.out.parent.mkdir(parents=True, exist_ok=True)
+        a.out.write_text(json.dumps(rows, indent=1))
+        if a.against:
+            other = a.out.with_suffix(".against" + a.out.suffix)
+            other.write_text(json.dumps(against, indent=1))
+    return 0
+
+
+def summary(rows):
+    """Prints the median, the 95th percentile, the max and the counts within 0.5 s and 5 s."""
     walls = [r["wall_s"] for r in rows]
     print(
-        f"\n{len(rows)} objects: median {statistics.median(walls):.3f} s, "
+        f"{len(rows)} objects: median {statistics.median(walls):.3f} s, "
         f"95th percentile {percentile(walls, 0.95):.3f} s, max {max(walls):.3f} s, "
         f"within 0.5 s {sum(w <= 0.5 for w in walls)}, within 5 s {sum(w <= 5 for w in walls)}, "
         f"timed out {sum(r['timed_out'] for r in rows)}"
     )
-    if a.out:
-        a.out.parent.mkdir(parents=True, exist_ok=True)
-        a.out.write_text(json.dumps(rows, indent=1))
-    return 0
 
 
 if __name__ == "__main__":

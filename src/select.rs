@@ -213,11 +213,26 @@ fn graded_for(
         .find(|a| a.rules == RuleSet::Extended && a.aligned.axis == axis)
         .filter(|_| rules == RuleSet::Pinch)
         .map(|a| a.graded.clone());
+    // Another rule set's domain of this axis: its vertical slices are this one's.
+    let sliced = sel
+        .axes
+        .iter()
+        .find(|a| a.aligned.axis == axis)
+        .map(|a| &a.graded.domain);
     match (extended, p.domains) {
         (Some(graded), _) => graded,
-        (None, None) => {
-            plan::grade_domain_with(&aligned.mesh, p.hand, p.planner, p.friction, rules, t)
-        }
+        (None, None) => match sliced {
+            Some(other) => plan::grade_domain_reusing(
+                other,
+                &aligned.mesh,
+                p.hand,
+                p.planner,
+                p.friction,
+                rules,
+                t,
+            ),
+            None => plan::grade_domain_with(&aligned.mesh, p.hand, p.planner, p.friction, rules, t),
+        },
         (None, Some(cache)) => {
             let key = (
                 axis,

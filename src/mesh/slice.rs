@@ -227,6 +227,162 @@ pub fn slice_indexed_within(mesh: &Mesh, index: &SliceIndex, plane: &Plane, tol_
     )
 }
 
+/// The contours `plane` cuts from `mesh` (through `index`) as they come: not joined, united,
+/// simplified nor bridged (open chains stay open, overlapping shells overlap). Its points are
+/// the exact cut's, at the cost of the triangles cut: what a test of how far the object reaches
+/// needs, where the repairs would only cost (they add no point beyond the cut's but where a
+/// joint or a bridge spans a gap).
+pub fn slice_indexed_raw(mesh: &Mesh, index: &SliceIndex, plane: &Plane) -> Slice {
+    let tris = index.candidates(plane);
+    let dist = |i: u32| plane.distance(&mesh.vertices[i as usize]);
+    finish(*plane, raw_contours(mesh, plane, tris.into_iter(), &dist))
+}
+
+/// [`slice_indexed_within`]`(mesh, index, plane, tol_mm)`, then [`Slice::bridged_within`]`(gap_mm,
+/// tol_mm)`: what a finger of width `gap_mm` meets in `plane`. A search cuts the same plane in
+/// many frames (a level palm's finger planes are the horizontal planes at the candidates'
+/// heights, whatever the approach angle), so a slice that needs repairing or bridging (a
+/// many-shell or open mesh: the costly ones) is made once per plane, in the plane's canonical
+/// frame ([`canonical_plane`]: the normal rounded to 1e-9, the offset to 1e-6 mm), and
+/// re-expressed in `plane`'s frame ([`Slice::in_frame_of`]). A plane whose cut is one closed
+/// piece is cut in `plane` itself, as by the two calls. A re-expressed slice differs from the
+/// two calls' by what they differ between frames themselves (i_overlay's rings start where its
+/// grid puts them, the one-sided simplification splits a contour at its first point, and the
+/// closing's bevels move with the vertices kept: 1.4 mm in the tests). Either way the slice
+/// depends only on the
+/// mesh, the plane and the two lengths, never on which planes were cut before nor on threads.
+pub fn slice_indexed_bridged(
+    mesh: &Mesh,
+    index: &SliceIndex,
+    plane: &Plane,
+    gap_mm: f64,
+    tol_mm: f64,
+) -> Slice {
+    let direct = || slice_indexed_within(mesh, index, plane, tol_mm).bridged_within(gap_mm, tol_mm);
+    let Some(key) = plane_key(plane, gap_mm, tol_mm) else {
+        return direct();
+    };
+    let canonical = || {
+        let c = canonical_plane(&key);
+        let tris = index.candidates(&c);
+        let dist = |i: u32| c.distance(&mesh.vertices[i as usize]);
+        let raw = raw_contours(mesh, &c, tris.into_iter(), &dist);
+        (!is_simple_cut(&raw)).then(|| repair(c, raw, tol_mm).bridged_within(gap_mm, tol_mm))
+    };
+    let entry = {
+        let mut guard = index
+            .planes
+            .entries
+            .lock()
+            .unwrap_or_else(|e| e.into_inner());
+        let (map, points) = &mut *guard;
+        match map.get(&key) {
+            Some(e) => Some(e.clone()),
+            None if *points < PLANE_CACHE_POINTS => {
+                let e = PlaneEntry::default();
+                map.insert(key, e.clone());
+                Some(e)
+            }
+            None => None,
+        }
+    };
+    let found = match &entry {
+        Some(e) => {
+            let mut fresh = false;
+            let v = e.get_or_init(|| {
+                fresh = true;
+                canonical()
+            });
+            if fresh {
+                let n: usize = v
+                    .iter()
+                    .flat_map(|s| &s.contours)
+                    .map(|c| c.points.len())
+                    .sum();
+                index
+                    .planes
+                    .entries
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .1 += n;
+            }
+            v.as_ref().map(|s| s.in_frame_of(plane))
+        }
+        None => canonical().map(|s| s.in_frame_of(plane)),
+    };
+    found.unwrap_or_else(direct)
+}
+
+/// The key of `plane` in a [`SliceIndex`]'s plane cache; `None` for a plane too far out to key.
+fn plane_key(plane: &Plane, gap_mm: f64, tol_mm: f64) -> Option<PlaneKey> {
+    let n = plane.normal();
+    let q = |x: f64, unit: f64| {
+        let k = (x / unit).round();
+        (k.abs() < 4e18).then_some(k as i64)
+    };
+    let offset = n.dot(&plane.origin.coords);
+    Some((
+        [
+            q(n.x, PLANE_KEY_NORMAL)?,
+            q(n.y, PLANE_KEY_NORMAL)?,
+            q(n.z, PLANE_KEY_NORMAL)?,
+        ],
+        q(offset, PLANE_KEY_OFFSET_MM)?,
+        gap_mm.to_bits(),
+        tol_mm.to_bits(),
+    ))
+}
+
+/// The plane a [`PlaneKey`] stands for, in its canonical frame: the rounded normal (made unit)
+/// `n`, origin `n × offset`, `u` the unit part of +X (or +Y, for a normal within 26° of ±X)
+/// normal to `n`, `v = n × u`, so `u × v = n`.
+fn canonical_plane(key: &PlaneKey) -> Plane {
+    let ([nx, ny, nz], off, _, _) = *key;
+    let n = Vector3::new(nx as f64, ny as f64, nz as f64).normalize();
+    let a = if n.x.abs() < 0.9 {
+        Vector3::x()
+    } else {
+        Vector3::y()
+    };
+    let u = (a - n * n.dot(&a)).normalize();
+    Plane {
+        origin: Point3::from(n * (off as f64 * PLANE_KEY_OFFSET_MM)),
+        u,
+        v: n.cross(&u),
+    }
+}
+
+impl Slice {
+    /// The slice re-expressed in the 2D frame of `plane`, a plane through the same points (up to
+    /// the rounding of [`slice_indexed_bridged`]'s key) with the same normal: every point and
+    /// normal mapped through 3D, the contours sorted again ([`finish`]).
+    pub fn in_frame_of(&self, plane: &Plane) -> Slice {
+        let from = &self.plane;
+        let d = from.origin - plane.origin;
+        let (uu, vu) = (from.u.dot(&plane.u), from.v.dot(&plane.u));
+        let (uv, vv) = (from.u.dot(&plane.v), from.v.dot(&plane.v));
+        let (du, dv) = (d.dot(&plane.u), d.dot(&plane.v));
+        let contours = self
+            .contours
+            .iter()
+            .map(|c| Contour {
+                points: c
+                    .points
+                    .iter()
+                    .map(|p| Point2::new(p.x * uu + p.y * vu + du, p.x * uv + p.y * vv + dv))
+                    .collect(),
+                normals: c
+                    .normals
+                    .iter()
+                    .map(|m| Vector2::new(m.x * uu + m.y * vu, m.x * uv + m.y * vv).normalize())
+                    .collect(),
+                is_closed: c.is_closed,
+            })
+            .collect();
+        finish(*plane, contours)
+    }
+}
+
 /// A multiplicative hash for the slicer's edge tables (FxHash's mixing): SipHash's protection
 /// against chosen keys is not needed for mesh edges, and it was a fifth of the search's time.
 /// Only lookups use these tables, never their iteration order, so results do not depend on it.
@@ -260,12 +416,55 @@ type EdgeBuild = std::hash::BuildHasherDefault<EdgeHasher>;
 /// Built once per mesh (O(n log n)); a query visits the boxes the plane crosses, about the
 /// square root of the triangle count for a plane through a closed surface. Deterministic: the
 /// split is a median by centroid with ties broken by triangle index.
-#[derive(Debug, Clone)]
+#[derive(Debug)]
 pub struct SliceIndex {
     nodes: Vec<BvhNode>,
     order: Vec<u32>,
     triangles: usize,
+    /// Bridged slices of the planes [`slice_indexed_bridged`] has cut, by [`PlaneKey`].
+    planes: PlaneCache,
 }
+
+impl Clone for SliceIndex {
+    /// The same index, with an empty plane cache (the cache changes only the time taken).
+    fn clone(&self) -> SliceIndex {
+        SliceIndex {
+            nodes: self.nodes.clone(),
+            order: self.order.clone(),
+            triangles: self.triangles,
+            planes: PlaneCache::default(),
+        }
+    }
+}
+
+/// A plane as a set of points, whatever its in-plane frame: its unit normal's components in
+/// units of [`PLANE_KEY_NORMAL`] and its offset along the normal in units of
+/// [`PLANE_KEY_OFFSET_MM`], with the bridging gap and the simplification tolerance it was asked
+/// with (their bits).
+type PlaneKey = ([i64; 3], i64, u64, u64);
+
+/// What a plane's cut is, once known: `None` when the cut in the plane's canonical frame is one
+/// closed piece (with its holes), cut afresh in each frame asked for; else the bridged slice in
+/// the canonical frame ([`canonical_plane`]), re-expressed in each frame asked for.
+type PlaneEntry = std::sync::Arc<std::sync::OnceLock<Option<Slice>>>;
+
+/// The plane cache of a [`SliceIndex`]: entries and the contour points they hold.
+#[derive(Debug, Default)]
+struct PlaneCache {
+    entries: std::sync::Mutex<(HashMap<PlaneKey, PlaneEntry>, usize)>,
+}
+
+/// The unit of a [`PlaneKey`]'s normal components: planes whose normals differ by less (the
+/// finger planes of palms whose pitch differs by round-off) are cut as one, at most 1e-9 rad
+/// apart, some 1e-7 mm over a 100 mm object.
+const PLANE_KEY_NORMAL: f64 = 1e-9;
+
+/// The unit of a [`PlaneKey`]'s offset `[mm]`.
+const PLANE_KEY_OFFSET_MM: f64 = 1e-6;
+
+/// The cache stops taking slices once it holds this many contour points (some 100 MB): beyond
+/// it, slices are cut afresh. Only the time taken depends on it, never a slice.
+const PLANE_CACHE_POINTS: usize = 3_000_000;
 
 #[derive(Debug, Clone)]
 struct BvhNode {
@@ -353,6 +552,7 @@ impl SliceIndex {
             nodes,
             order,
             triangles: mesh.triangles.len(),
+            planes: PlaneCache::default(),
         }
     }
 
@@ -410,6 +610,18 @@ fn cut_within(
     dist: impl Fn(u32) -> f64,
     tol_mm: f64,
 ) -> Slice {
+    let contours = raw_contours(mesh, plane, tris, &dist);
+    repair(*plane, contours, tol_mm)
+}
+
+/// The contours `plane` cuts from the triangles `tris`, chained but not repaired: open chains
+/// stay open and overlapping shells overlap ([`repair`] joins and unites them).
+fn raw_contours(
+    mesh: &Mesh,
+    plane: &Plane,
+    tris: impl Iterator<Item = usize>,
+    dist: &impl Fn(u32) -> f64,
+) -> Vec<Contour> {
     let n = plane.normal();
     let above = |i: u32| dist(i) >= 0.0;
 
@@ -437,6 +649,19 @@ fn cut_within(
         })
         .collect();
     contours.retain(|c| c.points.len() >= 2 && !c.normals.is_empty());
+    contours
+}
+
+/// Returns true if and only if raw contours need no repair and no bridging: every one closed,
+/// fewer than two outer pieces (so none overlap).
+fn is_simple_cut(contours: &[Contour]) -> bool {
+    contours.iter().all(|c| c.is_closed)
+        && contours.iter().filter(|c| c.signed_area() > 0.0).count() < 2
+}
+
+/// Raw contours made a slice: simplified within `tol_mm` first where they need joining or
+/// uniting, their open ends joined, overlapping shells united.
+fn repair(plane: Plane, mut contours: Vec<Contour>, tol_mm: f64) -> Slice {
     if tol_mm > 0.0 && (contours.iter().any(|c| !c.is_closed) || has_overlapping_outers(&contours))
     {
         contours = contours.iter().map(|c| c.simplified(tol_mm)).collect();
@@ -450,7 +675,7 @@ fn cut_within(
     if repaired || has_overlapping_outers(&contours) {
         contours = union_closed(contours);
     }
-    finish(*plane, contours)
+    finish(plane, contours)
 }
 
 /// The segments the plane cuts from the triangles `tris`, each oriented by its triangle's
@@ -1108,6 +1333,133 @@ mod tests {
             }
             assert_eq!(planes, 125);
         }
+    }
+
+    /// Two boxes overlapping in a cross and a cylinder beside them, 10 mm apart: three shells,
+    /// so every finger-height plane needs uniting and bridging.
+    fn three_shells() -> Mesh {
+        let mut soup = Vec::new();
+        let mut add = |m: Mesh, dx: f64| {
+            for t in &m.triangles {
+                soup.push(t.map(|i| m.vertices[i as usize] + Vector3::new(dx, 0.0, 0.0)));
+            }
+        };
+        add(prism(60.0, 20.0, 80.0), 0.0);
+        // A quarter millimetre off the first, so that no vertex of one is welded to the other's.
+        add(prism(20.0, 60.0, 80.0), 0.25);
+        add(cylinder(16.0, 80.0), 48.0);
+        Mesh::from_triangles(&soup).0
+    }
+
+    /// `plane`'s points in another in-plane frame: `u` and `v` turned by `turn` about the
+    /// normal and the origin moved by `(du, dv)` within the plane.
+    fn reframed(plane: &Plane, turn: f64, du: f64, dv: f64) -> Plane {
+        let (s, c) = turn.sin_cos();
+        Plane {
+            origin: plane.origin + plane.u * du + plane.v * dv,
+            u: plane.u * c + plane.v * s,
+            v: plane.v * c - plane.u * s,
+        }
+    }
+
+    /// The largest distance of a point of `a` from the nearest segment of `b` `[mm]`.
+    fn farthest_from(a: &Slice, b: &Slice) -> f64 {
+        let to_segment = |p: Point2<f64>, (s, t): (Point2<f64>, Point2<f64>)| {
+            let d = t - s;
+            let k = ((p - s).dot(&d) / d.norm_squared().max(1e-300)).clamp(0.0, 1.0);
+            (p - (s + d * k)).norm()
+        };
+        let near = |p: Point2<f64>| {
+            b.contours
+                .iter()
+                .flat_map(|c| (0..c.segment_count()).map(move |i| c.segment(i)))
+                .map(|seg| to_segment(p, seg))
+                .fold(f64::INFINITY, f64::min)
+        };
+        a.contours
+            .iter()
+            .flat_map(|c| c.points.iter())
+            .map(|&p| near(p))
+            .fold(0.0, f64::max)
+    }
+
+    #[test]
+    fn a_bridged_plane_is_the_same_whatever_its_frame_and_the_cache() {
+        // Finger planes through three shells at five pitches and four heights, each asked for
+        // in three frames of the same plane: the cached slice, re-expressed, is the direct one
+        // (slice, then bridge) within 2 mm, outline to outline; and a fresh index (a cold cache)
+        // gives the same bits as one that cut the plane in another frame before.
+        let (gap, tol) = (14.0, 0.5);
+        let mesh = three_shells();
+        assert_eq!(mesh.shell_count(), 3);
+        let warm = SliceIndex::new(&mesh);
+        let mut united = 0;
+        for z in [5.0, 31.0, 40.0, 77.5] {
+            for pitch_deg in [-12.0f64, -0.2, 0.0, 3.0, 20.0] {
+                let base = Plane::finger(Point3::new(40.0, 3.0, z), pitch_deg.to_radians());
+                for (turn, du, dv) in [(0.0, 0.0, 0.0), (0.7, -12.5, 4.0), (2.9, 30.0, -8.0)] {
+                    let plane = reframed(&base, turn, du, dv);
+                    let direct =
+                        slice_indexed_within(&mesh, &warm, &plane, tol).bridged_within(gap, tol);
+                    let cached = slice_indexed_bridged(&mesh, &warm, &plane, gap, tol);
+                    let cold =
+                        slice_indexed_bridged(&mesh, &SliceIndex::new(&mesh), &plane, gap, tol);
+                    assert_eq!(cached, cold, "z {z}, pitch {pitch_deg}, turn {turn}");
+                    // The direct slice itself moves with the frame: i_overlay's rings start
+                    // where its grid puts them, the one-sided simplification splits a contour at
+                    // its first point, so which dents under the relief are filled depends on the
+                    // frame, and the closing's bevels in concave corners move with the vertices
+                    // kept (1.4 mm measured). A wrong mapping would be tens of millimetres off.
+                    assert_eq!(cached.contours.len(), direct.contours.len(), "z {z}");
+                    let off = farthest_from(&cached, &direct).max(farthest_from(&direct, &cached));
+                    assert!(
+                        off < 2.0,
+                        "{off} mm apart, z {z}, pitch {pitch_deg}, turn {turn}"
+                    );
+                    // The three shells are one piece, bridged.
+                    united += usize::from(cached.contours.len() == 1);
+                }
+            }
+        }
+        assert!(united >= 20, "{united} of 60 planes one piece");
+    }
+
+    #[test]
+    fn a_plane_cut_in_one_piece_is_the_direct_cut_bit_for_bit() {
+        // One closed shell: the cache keeps nothing, every frame is cut afresh, bits and all.
+        let mesh = crate::objects::frustum(56.0, 80.0, 110.0);
+        let index = SliceIndex::new(&mesh);
+        for z in [0.0, 20.0, 55.5, 109.0] {
+            for pitch_deg in [-7.0f64, 0.0, 6.5] {
+                let base = Plane::finger(Point3::new(30.0, 0.0, z), pitch_deg.to_radians());
+                for (turn, du, dv) in [(0.0, 0.0, 0.0), (1.1, 5.0, -3.0)] {
+                    let plane = reframed(&base, turn, du, dv);
+                    assert_eq!(
+                        slice_indexed_bridged(&mesh, &index, &plane, 14.0, 0.5),
+                        slice_indexed_within(&mesh, &index, &plane, 0.5).bridged_within(14.0, 0.5)
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_raw_slice_is_the_cut_unrepaired() {
+        // Through the three shells at mid-height: the boxes' two rectangles and the cylinder's
+        // circle, overlapping and apart as cut; the repaired slice unites the cross.
+        let mesh = three_shells();
+        let index = SliceIndex::new(&mesh);
+        let plane = Plane::horizontal(40.0);
+        let raw = slice_indexed_raw(&mesh, &index, &plane);
+        assert_eq!(raw.contours.len(), 3);
+        assert!(raw.contours.iter().all(|c| c.is_closed));
+        let areas: Vec<f64> = raw.contours.iter().map(|c| c.signed_area()).collect();
+        assert!((areas[0] - 1200.0).abs() < 1e-6 && (areas[1] - 1200.0).abs() < 1e-6);
+        let circle = std::f64::consts::PI * 64.0;
+        assert!(areas[2] < circle && areas[2] > 0.98 * circle, "{areas:?}");
+        let repaired = slice_indexed(&mesh, &index, &plane);
+        assert_eq!(repaired.contours.len(), 2);
+        assert!((repaired.contours[0].signed_area() - 2000.0).abs() < 1e-3);
     }
 
     #[test]

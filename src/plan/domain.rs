@@ -74,6 +74,25 @@ impl Domain {
                     .bridged_prepared(hand.finger_width_mm(), hand.relief_mm())
             })
             .collect();
+        Domain::from_slices(mesh, params, slices, angles_deg, shrink_mm)
+    }
+
+    /// Stage 1 shrunk by `shrink_mm` on the vertical slices of `other`, a domain of the same
+    /// mesh, AngularStep and hand (the slices do not depend on the shrink): what another rule
+    /// set's domain of the same axis costs without cutting and bridging them again (issue 30).
+    pub fn reshrunk(other: &Domain, mesh: &Mesh, params: &PlannerParams, shrink_mm: f64) -> Domain {
+        let (slices, angles) = (other.slices.clone(), other.angles_deg.clone());
+        Domain::from_slices(mesh, params, slices, angles, shrink_mm)
+    }
+
+    /// Stage 1 from its vertical slices at `angles_deg`.
+    fn from_slices(
+        mesh: &Mesh,
+        params: &PlannerParams,
+        slices: Vec<Slice>,
+        angles_deg: Vec<f64>,
+        shrink_mm: f64,
+    ) -> Domain {
         let slice_z_range_mm: Vec<[f64; 2]> = slices.iter().map(|s| z_range(&s.contours)).collect();
         let mut lo = f64::NEG_INFINITY;
         let mut hi = f64::INFINITY;

@@ -24,7 +24,7 @@ use super::palm::{PalmPlacement, PENETRATION_TOL_MM};
 use super::{Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice_indexed_within, Slice, SliceIndex};
+use crate::slice::{slice_indexed_bridged, Slice, SliceIndex};
 use nalgebra::{Point2, Rotation2, Vector2};
 use std::f64::consts::PI;
 
@@ -107,8 +107,8 @@ pub fn place_finger(
     let mirror = f.side.sign();
     let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
         let tol = hand.relief_mm();
-        let s = slice_indexed_within(mesh, index, &palm.finger_plane(f.height_mm + dz), tol)
-            .bridged_within(2.0 * o, tol);
+        let plane = palm.finger_plane(f.height_mm + dz);
+        let s = slice_indexed_bridged(mesh, index, &plane, 2.0 * o, tol);
         match place_als(&s, hand, mirror) {
             Err(e) if rules == RuleSet::Pinch && e != FingerRejection::PalmPenetration => {
                 place_als_distal(&s, hand, mirror).map_err(|_| e)

@@ -137,13 +137,36 @@ pub fn grade_domain_with(
 /// Stage 1 under a rule set: the thesis's Effective Elevation, or under the extended rules the
 /// whole object widened so that an outer finger may overhang its ends.
 pub fn stage1_with(mesh: &Mesh, hand: &Hand, params: &PlannerParams, rules: RuleSet) -> Domain {
-    let shrink = match rules {
+    Domain::build_with(mesh, params, hand, stage1_shrink(hand, rules))
+}
+
+/// [`grade_domain_with`] on the vertical slices of `other`, a stage-1 domain of the same
+/// aligned mesh under another rule set (the slices depend only on the mesh, the AngularStep
+/// and the hand, not on the rules' Effective Elevation): the same graded domain, without
+/// cutting and bridging the slices again (issue 30).
+pub fn grade_domain_reusing(
+    other: &Domain,
+    mesh: &Mesh,
+    hand: &Hand,
+    params: &PlannerParams,
+    friction: f64,
+    rules: RuleSet,
+    timings: &mut StageTimings,
+) -> GradedDomain {
+    let t = Instant::now();
+    let domain = Domain::reshrunk(other, mesh, params, stage1_shrink(hand, rules));
+    timings.stage1_domain = ms(t);
+    grade_built_with(domain, hand, params, friction, rules, timings)
+}
+
+/// How far stage 1 shrinks the Effective Elevation at both ends under `rules` `[mm]`.
+fn stage1_shrink(hand: &Hand, rules: RuleSet) -> f64 {
+    match rules {
         RuleSet::Thesis => hand.fingers.offset_mm,
         // An outer finger's centreline may lie beyond the object's end by up to the finger
         // offset less EXTENDED_MIN_OVERLAP_MM: its inner edge still overlaps the object.
         RuleSet::Extended | RuleSet::Pinch => EXTENDED_MIN_OVERLAP_MM - hand.fingers.offset_mm,
-    };
-    Domain::build_with(mesh, params, hand, shrink)
+    }
 }
 
 /// Stages 2–3 on an already built stage-1 domain (which depends only on the mesh, the

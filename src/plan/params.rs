@@ -73,45 +73,7 @@ impl PlannerParams {
     /// `(key, problem)`.
     pub fn validate(&self, hand: &Hand, friction: f64) -> Result<(), (&'static str, String)> {
         let p = self;
-        let step = p.height_step_mm;
-        if !(step.is_finite() && step > 0.0) {
-            return Err((
-                "planner.height_step_mm",
-                format!("must be positive, got {step}"),
-            ));
-        }
-        // The work the steps imply: elevations x approach angles grow as their inverse product.
-        if step < MIN_HEIGHT_STEP_MM {
-            return Err((
-                "planner.height_step_mm",
-                format!("must be at least {MIN_HEIGHT_STEP_MM} mm (a finer index is more work than any finger can use), got {step}"),
-            ));
-        }
-        let ratio = hand.fingers.gap_mm / step;
-        if (ratio - ratio.round()).abs() > 1e-9 * ratio.max(1.0) {
-            return Err((
-                "planner.height_step_mm",
-                format!(
-                    "must divide the finger gap of {} mm evenly (thesis 3.4.2), got {step}",
-                    hand.fingers.gap_mm
-                ),
-            ));
-        }
-        // Every finger must sit on an indexed elevation when Finger_1 does (thesis 3.4.4.2).
-        let top = hand.finger_list[0].height_mm;
-        for f in &hand.finger_list[1..] {
-            let k = (top - f.height_mm) / step;
-            if (k - k.round()).abs() > 1e-9 * k.abs().max(1.0) {
-                return Err((
-                    "planner.height_step_mm",
-                    format!(
-                        "must divide the height difference of finger_1 and {} ({} mm), got {step}",
-                        f.name,
-                        top - f.height_mm
-                    ),
-                ));
-            }
-        }
+        p.validate_height_step(hand)?;
         let a = p.angular_step_deg;
         if a.is_finite() && a > 0.0 && a < MIN_ANGULAR_STEP_DEG {
             return Err((
@@ -153,6 +115,51 @@ impl PlannerParams {
         ) {
             if !(v.is_finite() && v >= 0.0) {
                 return Err((key, format!("must be zero or positive, got {v}")));
+            }
+        }
+        Ok(())
+    }
+
+    /// The HeightStep's part of [`Self::validate`]: positive, not finer than
+    /// [`MIN_HEIGHT_STEP_MM`], dividing the finger gap and every finger's height below Finger_1.
+    fn validate_height_step(&self, hand: &Hand) -> Result<(), (&'static str, String)> {
+        let step = self.height_step_mm;
+        if !(step.is_finite() && step > 0.0) {
+            return Err((
+                "planner.height_step_mm",
+                format!("must be positive, got {step}"),
+            ));
+        }
+        // The work the steps imply: elevations x approach angles grow as their inverse product.
+        if step < MIN_HEIGHT_STEP_MM {
+            return Err((
+                "planner.height_step_mm",
+                format!("must be at least {MIN_HEIGHT_STEP_MM} mm (a finer index is more work than any finger can use), got {step}"),
+            ));
+        }
+        let ratio = hand.fingers.gap_mm / step;
+        if (ratio - ratio.round()).abs() > 1e-9 * ratio.max(1.0) {
+            return Err((
+                "planner.height_step_mm",
+                format!(
+                    "must divide the finger gap of {} mm evenly (thesis 3.4.2), got {step}",
+                    hand.fingers.gap_mm
+                ),
+            ));
+        }
+        // Every finger must sit on an indexed elevation when Finger_1 does (thesis 3.4.4.2).
+        let top = hand.finger_list[0].height_mm;
+        for f in &hand.finger_list[1..] {
+            let k = (top - f.height_mm) / step;
+            if (k - k.round()).abs() > 1e-9 * k.abs().max(1.0) {
+                return Err((
+                    "planner.height_step_mm",
+                    format!(
+                        "must divide the height difference of finger_1 and {} ({} mm), got {step}",
+                        f.name,
+                        top - f.height_mm
+                    ),
+                ));
             }
         }
         Ok(())

@@ -12,7 +12,7 @@ use super::PlannerParams;
 use super::{GradedDomain, Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice_indexed_within, Slice, SliceIndex};
+use crate::slice::{slice_indexed_raw, Slice, SliceIndex};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
@@ -189,9 +189,11 @@ fn search_scheduled(
     // the search first needs it (by whichever thread gets there first).
     let vslices: Vec<OnceLock<Slice>> = angles.iter().map(|_| OnceLock::new()).collect();
     let candidates = candidate_order(graded, angles.len(), budget);
-    // Every finger plane of every candidate is cut through one index of the mesh's triangles.
-    let index = SliceIndex::new(mesh);
+    // Every finger plane of every candidate is cut through one index of the mesh's triangles,
+    // built when the first candidate needs it (an axis with no candidates costs none).
+    let index = OnceLock::new();
     let evaluate = |&(index_z, a): &(usize, usize)| {
+        let index = index.get_or_init(|| SliceIndex::new(mesh));
         let approach_deg = angles[a];
         let vslice =
             vslices[a].get_or_init(|| vertical_slice(mesh, hand, approach_deg.to_radians()));
@@ -200,7 +202,7 @@ fn search_scheduled(
             approach_deg,
             vslice,
         };
-        try_candidate(mesh, &index, hand, &candidate, params, deviation, rules)
+        try_candidate(mesh, index, hand, &candidate, params, deviation, rules)
     };
     // Candidates are tried in blocks on rayon's threads, each block's results then taken in
     // search order: the grasps, the count tried and the rejections are the sequential search's
@@ -362,6 +364,13 @@ fn finger_indices(graded: &GradedDomain, index: usize) -> impl Iterator<Item = u
 
 /// How far the palm must move back along its normal so that its outline touches but does not
 /// take in the object in any finger slice plane (the three ALS planes of every finger) `[mm]`.
+///
+/// Measured on the planes' exact cuts ([`slice_indexed_raw`]), not on the bridged slices the
+/// fingers are then placed on (issue 30): the bridging of a many-shell or open mesh was most of
+/// an extended candidate's cost, and it reaches no further towards the palm than the cut except
+/// where a bridge or a joint crosses the edge of the palm's band. A candidate whose palm then
+/// still takes in a bridge in a finger's plane is rejected when that finger is placed
+/// ("palm penetrates the object in its plane").
 fn palm_backoff_in_finger_planes(
     mesh: &Mesh,
     index: &SliceIndex,
@@ -373,9 +382,7 @@ fn palm_backoff_in_finger_planes(
     let mut depth = f64::NEG_INFINITY;
     for f in &hand.finger_list {
         for dz in [-o, 0.0, o] {
-            let tol = hand.relief_mm();
-            let s = slice_indexed_within(mesh, index, &palm.finger_plane(f.height_mm + dz), tol)
-                .bridged_within(hand.finger_width_mm(), tol);
+            let s = slice_indexed_raw(mesh, index, &palm.finger_plane(f.height_mm + dz));
             // Finger-plane coordinates: x away from the object (contact surface at 0), y sideways.
             depth = depth.max(penetration_depth(
                 &s,
