@@ -430,6 +430,11 @@ class Check:
     """With ``payload=True``: the largest payload multiplier that still holds."""
     closing: Optional[Dict[str, Any]]
     """What the closing did to the planned grasp (docs/SIM.md)."""
+    robust: Optional[Dict[str, Any]]
+    """With ``samples`` above 1: the report's ``sim.robust`` (``hold_probability``, ``interval``
+    [lo, hi], ``counts``, per direction, the first failing sample's perturbation)."""
+    hold_probability: Optional[float]
+    """``robust["hold_probability"]`` (``None`` with one sample)."""
     grasp: Optional[Grasp]
     """The grasp checked."""
     sim: Dict[str, Any]
@@ -447,6 +452,8 @@ class Check:
         self.directions = list(s.get("directions", []))
         self.payload_margin = s.get("payload_margin")
         self.closing = s.get("closing")
+        self.robust = s.get("robust")
+        self.hold_probability = self.robust["hold_probability"] if self.robust else None
         g = report["plan"].get("grasp")
         self.grasp = Grasp(g) if g else None
 
@@ -518,7 +525,9 @@ def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
             holds), or checks ``override_angles=[[θ1, θ2], ...]`` given in ``sim_params``.
         hand: default: the plan's hand (else the thesis hand).
         gravity: ``"down"`` (−Z of the aligned frame) or ``"six"`` (±X, ±Y, ±Z in turn).
-        samples: 1 (a robust verdict over perturbed samples is not in this version).
+        samples: perturbed checks of the grasp (``[sim] samples``, docs/SIM.md "Hold
+            probability"): above 1, :attr:`Check.robust` gives the hold probability and its
+            95 % interval; the ranges and ``seed`` are ``sim_params``.
         payload: also find the payload margin (several more physics runs).
         quality: also compute the grasp's Ferrari–Canny quality (``report["quality"]``).
         planner_params: default: the plan's.
@@ -530,12 +539,10 @@ def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
     frame and its joint angles, with the planner's report beside it unchanged.
 
     Raises:
-        BadInputError: ``samples`` other than 1; a given grasp that cannot be posed (wrong
+        BadInputError: a given grasp that cannot be posed (wrong
             finger count, a non-finite number, an axis the planner did not search).
         BadScenarioError, BadHandError: as :func:`plan`.
     """
-    if samples != 1:
-        raise BadInputError(f"samples: {samples}: only 1 is supported (no robust verdict in this version)")
     o = _to_object(obj)
     source: Optional[Plan] = None
     given: Optional[Grasp] = None
@@ -555,6 +562,8 @@ def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
     pp = dict(planner_params if planner_params is not None else (source.planner_params if source else {}))
     sim = dict(sim_params)
     sim["gravity"] = gravity
+    if samples != 1:
+        sim["samples"] = samples
     flags: Dict[str, Any] = {"payload": payload, "quality": quality}
     if given is not None:
         flags["given"] = given._given()

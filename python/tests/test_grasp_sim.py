@@ -130,6 +130,20 @@ def test_a_later_candidate_is_checked_as_given(cup):
     assert c.grasp is p.candidates[2]
 
 
+def test_samples_give_the_hold_probability_as_the_cli(cup, cup_plan):
+    status, out, err = cli("--json", "--samples", "4", "scenarios/cup.toml")
+    assert status == 0, err
+    from_cli = json.loads(out)["sim"]["robust"]
+    c = gs.check(cup, cup_plan, samples=4)
+    assert c.robust is not None and c.robust["samples"] == 4
+    assert without_timings(c.robust) == without_timings(from_cli)
+    lo, hi = c.robust["interval"]
+    assert 0.0 <= lo <= c.hold_probability <= hi <= 1.0
+    assert gs.check(cup, cup_plan).robust is None
+    with pytest.raises(gs.BadScenarioError, match="samples"):
+        gs.check(cup, cup_plan, samples=0)
+
+
 @pytest.mark.parametrize("pose, angles, message", [
     (np.eye(4) * 2, [[150, 150]] * 3, "is not a rotation"),
     (np.eye(3), [[150, 150]] * 3, "4 × 4"),
