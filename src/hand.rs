@@ -259,6 +259,26 @@ impl Hand {
             .collect()
     }
 
+    /// [`Hand::coupling_checks`] as one line each for a run's warnings: which coupling, by how
+    /// much the plan breaks or keeps it, and that it is checked, not refused.
+    pub fn coupling_lines(&self, theta_deg: &[[f64; 2]]) -> Vec<String> {
+        self.coupling_checks(theta_deg)
+            .into_iter()
+            .map(|c| {
+                let verdict = if c.error_deg.abs() <= COUPLING_TOLERANCE_DEG {
+                    "keeps it".to_string()
+                } else {
+                    format!("breaks it by {:+.1}°", c.error_deg)
+                };
+                format!(
+                    "hand `{}`: coupling {}: the plan {verdict} (checked, not refused: the \
+                     planner and the physics check drive each joint on its own)",
+                    self.name, c.coupling
+                )
+            })
+            .collect()
+    }
+
     /// A finger's width `[mm]`: its centreline to each side wall is the finger offset (thesis
     /// 3.3.2), so no gap narrower than this lets a finger in.
     pub fn finger_width_mm(&self) -> f64 {
