@@ -16,7 +16,6 @@ pub mod import;
 mod import_frame;
 pub mod kinematics;
 pub mod mjcf_hand;
-pub mod show;
 pub mod urdf_hand;
 pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
 
@@ -462,6 +461,23 @@ impl Hand {
         }
         if self.finger_list.is_empty() {
             return Err(("finger", "the hand has no fingers".to_string()));
+        }
+        let n = self.finger_list.len();
+        let joint_ok = |r: [usize; 2]| (1..=n).contains(&r[0]) && (1..=2).contains(&r[1]);
+        for c in &self.coupling {
+            if !(joint_ok(c.follower)
+                && joint_ok(c.leader)
+                && c.multiplier.is_finite()
+                && c.offset_deg.is_finite())
+            {
+                return Err((
+                    "coupling",
+                    format!(
+                        "must name [finger 1-{n}, joint 1-2] twice with a finite multiplier \
+                         and offset, got {c:?}"
+                    ),
+                ));
+            }
         }
         for (i, f) in self.finger_list.iter().enumerate() {
             if self.finger_list[..i].iter().any(|g| g.name == f.name) {

@@ -70,7 +70,7 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
         }
         Some(Command::Hand {
             action: cli::HandCommand::Show { file, svg },
-        }) => grasp_sim::hand::show::run(&file, svg.as_deref()),
+        }) => grasp_sim::hand_show::run(&file, svg.as_deref()),
         Some(Command::Tune(args)) => grasp_sim::tune::command::run(&args.request(), &Bar::tune()),
         None => run_inputs(cli),
     }

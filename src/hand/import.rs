@@ -337,6 +337,8 @@ struct Chain {
     flex: [usize; 2],
     /// The spread joint at its base, if any.
     spread: Option<usize>,
+    /// The mapping's slot that names it (0 finger_1, 1 the thumb, 2 finger_3), if one does.
+    slot: Option<usize>,
 }
 
 /// True if and only if the axes of joints `a` and `b` are parallel (either sense) within 1°, at
@@ -466,10 +468,12 @@ fn classify_chain(
         [a, b] => Ok(Chain {
             flex: [a, b],
             spread: None,
+            slot: None,
         }),
         [s, a, b] if !parallel(tree, pose, s, a) => Ok(Chain {
             flex: [a, b],
             spread: Some(s),
+            slot: None,
         }),
         [_, _, _] => Err(err(
             &tree.file,
@@ -521,19 +525,6 @@ fn chains(
         .map(|&s| follow_chain(tree, s))
         .collect::<Result<_, _>>()?;
     let named = [&mapping.finger_1, &mapping.thumb, &mapping.finger_3];
-    let mut out = Vec::new();
-    for chain in &raw {
-        // A mapping that names this chain's joints decides; else the chain's shape does.
-        let given = named.iter().flat_map(|n| n.iter()).find(|pair| {
-            pair.iter()
-                .any(|name| tree.joint_named(name).is_some_and(|j| chain.contains(&j)))
-        });
-        let c = match given {
-            Some(pair) => mapped_chain(tree, mapping, chain, pair)?,
-            None => classify_chain(tree, pose, chain)?,
-        };
-        out.push(c);
-    }
     for pair in named.iter().flat_map(|n| n.iter()) {
         for name in pair {
             if tree.joint_named(name).is_none() {
@@ -544,11 +535,31 @@ fn chains(
             }
         }
     }
+    let mut out = Vec::new();
+    for chain in &raw {
+        // A mapping that names this chain's joints decides; else the chain's shape does.
+        let given = named.iter().enumerate().find_map(|(slot, n)| {
+            n.as_ref()
+                .filter(|pair| {
+                    pair.iter()
+                        .any(|name| tree.joint_named(name).is_some_and(|j| chain.contains(&j)))
+                })
+                .map(|pair| (slot, pair))
+        });
+        let c = match given {
+            Some((slot, pair)) => Chain {
+                slot: Some(slot),
+                ..mapped_chain(tree, mapping, chain, pair)?
+            },
+            None => classify_chain(tree, pose, chain)?,
+        };
+        out.push(c);
+    }
     Ok(out)
 }
 
-/// A chain whose flexion joints the mapping names: both in it, in order, every other joint of
-/// it a spread joint the mapping holds.
+/// A chain whose flexion joints the mapping names: both in it, in order, and at most one other
+/// joint, before joint 1 (its spread joint).
 fn mapped_chain(
     tree: &Tree,
     mapping: &Mapping,
@@ -583,12 +594,15 @@ fn mapped_chain(
     for (k, &j) in chain.iter().enumerate() {
         if k != a && k != b {
             let name = &tree.joints[j].name;
-            if !mapping.spread.contains_key(name) || spread.is_some() {
+            // The one joint before joint 1 is the finger's spread joint (held at the
+            // mapping's value, 0 by default); any other is a joint the model has no place for.
+            if (k > a && !mapping.spread.contains_key(name)) || spread.is_some() {
                 return Err(err(
                     &tree.file,
                     format!(
                         "line {}: joint `{name}` of the finger of `{}` is neither one of its two \
-                         flexion joints nor a spread joint [hand.mapping] spread holds",
+                         flexion joints nor its spread joint: expected one spread joint before \
+                         joint 1",
                         tree.joints[j].line, pair[0]
                     ),
                 ));
@@ -599,6 +613,7 @@ fn mapped_chain(
     Ok(Chain {
         flex: [chain[a], chain[b]],
         spread,
+        slot: None,
     })
 }
 
@@ -700,11 +715,11 @@ pub fn derive(
     )
 }
 
-/// The chains as index triples `(joint 1, joint 2, spread)`.
-fn chains_info(chains: &[Chain]) -> Vec<(usize, usize, Option<usize>)> {
+/// The chains as `(joint 1, joint 2, spread, mapping slot)`.
+fn chains_info(chains: &[Chain]) -> Vec<(usize, usize, Option<usize>, Option<usize>)> {
     chains
         .iter()
-        .map(|c| (c.flex[0], c.flex[1], c.spread))
+        .map(|c| (c.flex[0], c.flex[1], c.spread, c.slot))
         .collect()
 }
 

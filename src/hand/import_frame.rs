@@ -9,8 +9,9 @@ use super::import::{axes_of, err, model_coupling, points_of_body, Derived, Tree}
 use super::{Coupling, Hand, HandError};
 use nalgebra::{Isometry3, Point3, UnitQuaternion, Vector2, Vector3};
 
-/// One finger: its joints 1 and 2 and its spread joint (tree indices).
-type ChainInfo = (usize, usize, Option<usize>);
+/// One finger: its joints 1 and 2 and its spread joint (tree indices), and the mapping's slot
+/// that names it (0 finger_1, 1 the thumb, 2 finger_3).
+type ChainInfo = (usize, usize, Option<usize>, Option<usize>);
 
 /// The model's palm frame in the palm link's frame.
 pub(super) struct Frame {
@@ -149,7 +150,22 @@ pub(super) fn palm_frame(
     let origin = Point3::from(x * x0 + y * y0 + z * (0.5 * (zl + zh)));
     // finger_1 above finger_3 along z (by their joint 1's height).
     let h = |k: usize| z.dot(&axes[k][0].0.coords);
-    let (f1, f3) = if h(others[0]) >= h(others[1]) {
+    if let Some(k) = (0..3).find(|&k| chains[k].3 == Some(1) && k != thumb) {
+        return Err(err(
+            &tree.file,
+            format!(
+                "[hand.mapping] thumb names joint `{}`, but the finger closing against the other \
+                 two is that of joint `{}`: expected the opposing finger",
+                tree.joints[chains[k].0].name, tree.joints[chains[thumb].0].name
+            ),
+        ));
+    }
+    let named_first = |k: usize, slot: usize| chains[others[k]].3 == Some(slot);
+    let (f1, f3) = if named_first(0, 0) || named_first(1, 2) {
+        (others[0], others[1])
+    } else if named_first(1, 0) || named_first(0, 2) {
+        (others[1], others[0])
+    } else if h(others[0]) >= h(others[1]) {
         (others[0], others[1])
     } else {
         (others[1], others[0])
@@ -184,6 +200,32 @@ fn extent(points: &[Vector2<f64>], from: Vector2<f64>, dir: Vector2<f64>) -> (f6
         let t = (p - from).dot(&dir);
         (lo.min(t), hi.max(t))
     })
+}
+
+/// Phalanx 2's direction from joint 2 (towards its geometry's centroid) and its length (the
+/// geometry's farthest extent along it), in the flexion plane.
+fn tip(
+    tree: &Tree,
+    joint: usize,
+    points: &[Point3<f64>],
+    at: Vector2<f64>,
+) -> Result<(Vector2<f64>, f64), HandError> {
+    let flat2: Vec<Vector2<f64>> = points.iter().map(|p| Vector2::new(p.x, p.y)).collect();
+    let centroid = flat2.iter().sum::<Vector2<f64>>() / flat2.len() as f64;
+    let toward = centroid - at;
+    if toward.norm() < 1.0 {
+        let link = &tree.links[tree.joints[joint].child];
+        return Err(err(
+            &tree.file,
+            format!(
+                "line {}: link `{}`'s geometry does not reach out from joint `{}`: expected the \
+                 fingertip link to extend from its joint",
+                link.line, link.name, tree.joints[joint].name
+            ),
+        ));
+    }
+    let u2 = toward.normalize();
+    Ok((u2, extent(&flat2, at, u2).1))
 }
 
 fn measure(
@@ -225,23 +267,7 @@ fn measure(
     if b2.is_empty() {
         return Err(no_geometry(chain.1));
     }
-    let flat2: Vec<Vector2<f64>> = b2.iter().map(xy).collect();
-    let centroid = flat2.iter().sum::<Vector2<f64>>() / flat2.len() as f64;
-    let toward = centroid - xy(&p2);
-    if toward.norm() < 1.0 {
-        return Err(err(
-            &tree.file,
-            format!(
-                "line {}: link `{}`'s geometry does not reach out from joint `{}`: expected the \
-                 fingertip link to extend from its joint",
-                tree.links[tree.joints[chain.1].child].line,
-                tree.links[tree.joints[chain.1].child].name,
-                tree.joints[chain.1].name
-            ),
-        ));
-    }
-    let u2 = toward.normalize();
-    let l2 = extent(&flat2, xy(&p2), u2).1;
+    let (u2, l2) = tip(tree, chain.1, &b2, xy(&p2))?;
     let n1 = Vector2::new(-u1.y, u1.x);
     let flat1: Vec<Vector2<f64>> = b1.iter().map(xy).collect();
     let offset = extent(&flat1, xy(&p1), n1).1;
@@ -258,13 +284,7 @@ fn measure(
         (frame.axes[2].dot(&axes[0].1)).signum() * side,
         (frame.axes[2].dot(&axes[1].1)).signum() * side,
     ];
-    let mut ranges = [[0.0; 2]; 2];
-    for (k, j) in [chain.0, chain.1].into_iter().enumerate() {
-        let (lo, hi) = limits(tree, j)?;
-        let a = theta0[k] - sense[k] * lo.to_degrees();
-        let b = theta0[k] - sense[k] * hi.to_degrees();
-        ranges[k] = [a.min(b), a.max(b)];
-    }
+    let ranges = interior_ranges(tree, chain, theta0, sense)?;
     Ok(Measured {
         setback: p1.x,
         lateral: p1.y,
@@ -277,6 +297,23 @@ fn measure(
         sense,
         ranges,
     })
+}
+
+/// The joints' limits as interior-angle ranges `[deg]`: θ = θ0 − sense × q.
+fn interior_ranges(
+    tree: &Tree,
+    chain: ChainInfo,
+    theta0: [f64; 2],
+    sense: [f64; 2],
+) -> Result<[[f64; 2]; 2], HandError> {
+    let mut ranges = [[0.0; 2]; 2];
+    for (k, j) in [chain.0, chain.1].into_iter().enumerate() {
+        let (lo, hi) = limits(tree, j)?;
+        let a = theta0[k] - sense[k] * lo.to_degrees();
+        let b = theta0[k] - sense[k] * hi.to_degrees();
+        ranges[k] = [a.min(b), a.max(b)];
+    }
+    Ok(ranges)
 }
 
 /// The palm's extents in the model frame: x (depth), y, z ranges.
@@ -355,7 +392,6 @@ pub(super) fn build(
     frame: Frame,
     overrides: &[(String, f64)],
 ) -> Result<Derived, HandError> {
-    let names = ["finger_1", "finger_2", "finger_3"];
     let sides = [1.0, -1.0, 1.0];
     let mut m = Vec::new();
     for (k, &c) in frame.order.iter().enumerate() {
@@ -399,13 +435,34 @@ pub(super) fn build(
     let r2 = shared_range(&m, 1, &mut notes);
     let ext = palm_extents(tree, pose, palm, &frame);
     let heights: Vec<f64> = m.iter().map(|f| f.height).collect();
+    let hand = model(
+        tree,
+        &ext,
+        &heights,
+        (setback, lateral, l1, l2, offset),
+        [r1, r2],
+    );
+    finish(tree, pose, palm, chains, &frame, &m, hand, notes, overrides)
+}
+
+/// The model's numbers as a [`Hand`] (unvalidated), with the thesis hand's proportions for
+/// what no file gives.
+fn model(
+    tree: &Tree,
+    ext: &[(f64, f64); 3],
+    heights: &[f64],
+    (setback, lateral, l1, l2, offset): (f64, f64, f64, f64, f64),
+    [r1, r2]: [[f64; 2]; 2],
+) -> Hand {
+    let names = ["finger_1", "finger_2", "finger_3"];
+    let sides = [1.0, -1.0, 1.0];
     let (h_lo, h_hi) = heights
         .iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
             (l.min(*v), h.max(*v))
         });
     let margin = 0.5 * ((ext[2].1 - h_hi) + (h_lo - ext[2].0));
-    let hand = Hand {
+    Hand {
         name: tree.name.clone(),
         palm: super::Palm {
             offset_mm: ext[0].1 - ext[0].0,
@@ -436,7 +493,7 @@ pub(super) fn build(
         },
         finger_list: names
             .iter()
-            .zip(&heights)
+            .zip(heights)
             .zip(sides)
             .map(|((n, h), s)| super::Finger {
                 name: n.to_string(),
@@ -449,8 +506,7 @@ pub(super) fn build(
             })
             .collect(),
         coupling: Vec::new(),
-    };
-    finish(tree, pose, palm, chains, &frame, &m, hand, notes, overrides)
+    }
 }
 
 /// Couplings, the bodies for the figure, validation.
@@ -469,7 +525,7 @@ fn finish(
     // Which finger and joint (model order) each flexion joint is, with its zero and sense.
     let place = |j: usize| -> Option<((usize, usize), f64, f64)> {
         frame.order.iter().enumerate().find_map(|(k, &c)| {
-            let (a, b, _) = chains[c];
+            let (a, b, _, _) = chains[c];
             [a, b]
                 .iter()
                 .position(|&x| x == j)
@@ -502,7 +558,7 @@ fn finish(
     )];
     let mut joints = Vec::new();
     for (k, &c) in frame.order.iter().enumerate() {
-        let (a, b, s) = chains[c];
+        let (a, b, s, _) = chains[c];
         let name = &hand.finger_list[k].name;
         for (n, j) in [(1, a), (2, b)] {
             let pts = points_of_body(tree, pose, tree.joints[j].child);

@@ -9,7 +9,7 @@
 
 use super::import::{err, FileCoupling, Geom, GeomShape, Joint, JointKind, Link, Tree};
 use super::HandError;
-use crate::mesh::urdf::{geometry, nesting_deeper_than, numbers, origin, Shape, MAX_DEPTH};
+use crate::mesh::urdf::{element_geometry, nesting_deeper_than, numbers, origin, Shape, MAX_DEPTH};
 use crate::mesh::MeshError;
 use nalgebra::{Isometry3, Point3, Translation3, Unit, Vector3};
 use std::path::Path;
@@ -63,7 +63,7 @@ fn link_geoms(path: &Path, link: roxmltree::Node) -> Result<Vec<Geom>, HandError
     for tag in ["collision", "visual"] {
         let mut out = Vec::new();
         for e in link.children().filter(|c| c.has_tag_name(tag)) {
-            match geometry(path, e).map_err(|e| from_mesh(path, e))? {
+            match element_geometry(path, e).map_err(|e| from_mesh(path, e))? {
                 Ok(placed) => out.push(Geom {
                     shape: shape_mm(path, &placed.shape)?,
                     pose: to_mm(placed.pose),
@@ -77,6 +77,31 @@ fn link_geoms(path: &Path, link: roxmltree::Node) -> Result<Vec<Geom>, HandError
         }
     }
     Ok(Vec::new())
+}
+
+/// A `<limit>`'s `(lower, upper)` `[rad]`, `None` when they leave no range.
+fn limit(path: &Path, l: roxmltree::Node) -> Result<Option<(f64, f64)>, HandError> {
+    let get = |a: &str| numbers(path, l, a, 1).map_err(|e| from_mesh(path, e));
+    let lo = get("lower")?.map_or(0.0, |v| v[0]);
+    let hi = get("upper")?.map_or(0.0, |v| v[0]);
+    Ok((lo < hi).then_some((lo, hi)))
+}
+
+/// A `<mimic>` of joint `name`.
+fn mimic(path: &Path, m: roxmltree::Node, name: &str) -> Result<FileCoupling, HandError> {
+    let get = |a: &str, d: f64| -> Result<f64, HandError> {
+        Ok(numbers(path, m, a, 1)
+            .map_err(|e| from_mesh(path, e))?
+            .map_or(d, |v| v[0]))
+    };
+    Ok(FileCoupling {
+        follower: name.to_string(),
+        leader: m.attribute("joint").unwrap_or("").to_string(),
+        multiplier: get("multiplier", 1.0)?,
+        offset: get("offset", 0.0)?,
+        line: line_of(m),
+        kind: "mimic",
+    })
 }
 
 /// One `<joint>`.
@@ -129,28 +154,11 @@ fn joint(
         ));
     }
     let limits = match (child("limit"), j.attribute("type")) {
-        (Some(l), Some("revolute")) => {
-            let get = |a: &str| numbers(path, l, a, 1).map_err(|e| from_mesh(path, e));
-            let lo = get("lower")?.map_or(0.0, |v| v[0]);
-            let hi = get("upper")?.map_or(0.0, |v| v[0]);
-            (lo < hi).then_some((lo, hi))
-        }
+        (Some(l), Some("revolute")) => limit(path, l)?,
         _ => None,
     };
     if let Some(m) = child("mimic") {
-        let get = |a: &str, d: f64| -> Result<f64, HandError> {
-            Ok(numbers(path, m, a, 1)
-                .map_err(|e| from_mesh(path, e))?
-                .map_or(d, |v| v[0]))
-        };
-        couplings.push(FileCoupling {
-            follower: name.clone(),
-            leader: m.attribute("joint").unwrap_or("").to_string(),
-            multiplier: get("multiplier", 1.0)?,
-            offset: get("offset", 0.0)?,
-            line: line_of(m),
-            kind: "mimic",
-        });
+        couplings.push(mimic(path, m, &name)?);
     }
     let (parent, child) = (index(p)?, index(c)?);
     Ok(Joint {

@@ -130,10 +130,7 @@ pub(crate) fn resolve(path: &Path, filename: &str) -> Option<PathBuf> {
 }
 
 /// The geometry of one `<visual>` or `<collision>` element, or why it cannot be read.
-pub(crate) fn geometry(
-    path: &Path,
-    element: roxmltree::Node,
-) -> Result<Result<Placed, String>, MeshError> {
+fn geometry(path: &Path, element: roxmltree::Node) -> Result<Result<Placed, String>, MeshError> {
     let pose = origin(path, element)?;
     let Some(g) = element
         .children()
@@ -211,6 +208,15 @@ pub(crate) fn geometry(
         other => return Ok(Err(format!("<{other}> is not a geometry grasp-sim reads"))),
     };
     Ok(Ok(Placed { shape, pose }))
+}
+
+/// What one `<visual>` or `<collision>` element gives: its placed shape, or why it cannot be
+/// read (a note), or the URDF's error.
+pub(crate) type ElementGeometry = Result<Result<Placed, String>, MeshError>;
+
+/// [`geometry`], for the hand reader (`crate::hand::urdf_hand`).
+pub(crate) fn element_geometry(path: &Path, element: roxmltree::Node) -> ElementGeometry {
+    geometry(path, element)
 }
 
 /// What a URDF gives: its geometry in the root link's frame, notes on what was read instead of

@@ -253,3 +253,62 @@ fn malformed_hand_files_are_refused_with_one_line() {
         }
     }
 }
+
+/// `[hand.mapping]`: the BarrettHand's own finger names put F1 first (`hand show SCENARIO`
+/// shows it, and the plan is the same hand's); a thumb that is not the opposing finger, a
+/// joint the file does not have, and a spread held where the fingers no longer flex in
+/// parallel planes are refused with one line.
+#[test]
+fn a_mapping_names_the_fingers_or_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let urdf = asset("assets/hands/bh8.urdf");
+    let hand = |mapping: &str| format!("urdf = \"{}\"\n[hand.mapping]\n{mapping}", urdf.display());
+    let named = cup_scenario(
+        dir.path(),
+        "named",
+        &hand(
+            "finger_1 = [\"f1_joint_1\", \"f1_joint_2\"]\nthumb = [\"f3_joint_1\", \"f3_joint_2\"]\n\
+             spread = { f1_spread = 0.0 }",
+        ),
+    );
+    let out = crate::succeed(
+        crate::grasp_sim()
+            .args(["hand", "show"])
+            .arg(&named)
+            .args(["--svg", dir.path().join("n.svg").to_str().unwrap()]),
+    );
+    let table = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        table.contains("finger_1  f1_joint_1") && table.contains("finger_3  f2_joint_1"),
+        "{table}"
+    );
+    let v = run_json(&["--no-sim"], &named);
+    assert_eq!(v["plan"]["status"], "feasible");
+    for (name, mapping, expected) in [
+        (
+            "thumb",
+            "thumb = [\"f1_joint_1\", \"f1_joint_2\"]",
+            "expected the opposing finger",
+        ),
+        (
+            "missing",
+            "finger_1 = [\"f1_joint_1\", \"no_such_joint\"]",
+            "which the file does not have",
+        ),
+        (
+            "spread",
+            "spread = { f1_spread = 30.0 }",
+            "expected every finger to flex in parallel planes",
+        ),
+    ] {
+        let s = cup_scenario(dir.path(), name, &hand(mapping));
+        let out = crate::grasp_sim().arg("--no-sim").arg(&s).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{name}: {err}");
+        assert_eq!(err.trim_end().lines().count(), 1, "{name}: {err}");
+        assert!(
+            err.contains("bh8.urdf") && err.contains(expected),
+            "{name}: {err}"
+        );
+    }
+}

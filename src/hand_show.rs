@@ -7,8 +7,8 @@
 //! links filled grey (their outlines' convex hulls), the model's palm and phalanx boxes drawn
 //! over them in blue at the file's zero pose, the joint axes as dots.
 
-use super::import::Derived;
-use super::{bend, HandBox};
+use crate::hand::import::Derived;
+use crate::hand::{bend, HandBox};
 use crate::visual::svg::Plot;
 use nalgebra::{Point3, UnitQuaternion, Vector3};
 use std::fmt::Write;
@@ -36,7 +36,7 @@ pub fn table(d: &Derived, file: &str) -> String {
             format!("{:.1}/{:.1}", t[0], t[1])
         );
     }
-    let range = super::kinematics::graspable_range(h);
+    let range = crate::hand::kinematics::graspable_range(h);
     let rows = [
         ("palm.offset_mm", h.palm.offset_mm),
         ("palm.margin_mm", h.palm.margin_mm),
@@ -157,6 +157,9 @@ fn model_boxes(d: &Derived) -> (Vec<Vec<Point3<f64>>>, Vec<Point3<f64>>) {
     (boxes, joints)
 }
 
+/// A projection of the palm frame onto the figure's plane.
+type View = Box<dyn Fn(&Point3<f64>) -> (f64, f64)>;
+
 /// The figure: the flexion plane and the side view, the file's links under the model's boxes.
 pub fn figure(d: &Derived) -> String {
     let (boxes, joints) = model_boxes(d);
@@ -170,7 +173,7 @@ pub fn figure(d: &Derived) -> String {
     let hi = |k: usize| all.iter().map(|p| p[k]).fold(f64::NEG_INFINITY, f64::max);
     // The side view sits right of the flexion plane, 20 mm clear of it.
     let shift = hi(1) - lo(2) + 20.0;
-    let views: [Box<dyn Fn(&Point3<f64>) -> (f64, f64)>; 2] = [
+    let views: [View; 2] = [
         Box::new(|p: &Point3<f64>| (p.y, -p.x)),
         Box::new(move |p: &Point3<f64>| (p.z + shift, -p.x)),
     ];
@@ -206,13 +209,13 @@ pub fn figure(d: &Derived) -> String {
     plot.finish()
 }
 
-/// A hand file to show: a URDF or MJCF itself, or a scenario whose `[hand]` names one (then
-/// with its mapping and overrides).
+/// A hand file to show: a URDF or MJCF itself, a scenario whose `[hand]` names one (then with
+/// its mapping and overrides), or a hand TOML (its model alone).
 ///
 /// # Errors
 /// The hand file's or the scenario's error, naming the file.
-pub fn derive_for_show(file: &std::path::Path) -> Result<Derived, super::HandError> {
-    use super::import::{err, load, Mapping};
+pub fn derive_for_show(file: &std::path::Path) -> Result<Derived, crate::hand::HandError> {
+    use crate::hand::import::{err, load, Mapping};
     let is_toml = file
         .extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
@@ -221,7 +224,7 @@ pub fn derive_for_show(file: &std::path::Path) -> Result<Derived, super::HandErr
     }
     let text =
         crate::files::read_regular_string(file, crate::files::MAX_TEXT_BYTES).map_err(|e| {
-            super::HandError::Io {
+            crate::hand::HandError::Io {
                 path: file.to_path_buf(),
                 error: e,
             }
@@ -237,6 +240,20 @@ pub fn derive_for_show(file: &std::path::Path) -> Result<Derived, super::HandErr
     }
     let table: toml::Table =
         toml::from_str(&text).map_err(|e| err(file, e.message().replace('\n', " ")))?;
+    if table.contains_key("palm") && !table.contains_key("hand") {
+        // A hand TOML itself: its model, without a file's links to draw under it.
+        let hand = crate::hand::Hand::parse(&text, file, &[])?;
+        let n = hand.finger_list.len();
+        return Ok(Derived {
+            palm: "-".to_string(),
+            joints: vec![(["-".to_string(), "-".to_string()], None); n],
+            couplings: hand.coupling.iter().map(|c| c.describe()).collect(),
+            notes: Vec::new(),
+            bodies: Vec::new(),
+            zero_theta_deg: vec![[180.0, 180.0]; n],
+            hand,
+        });
+    }
     let section: Section = table
         .get("hand")
         .cloned()
