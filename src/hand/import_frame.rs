@@ -148,8 +148,27 @@ pub(super) fn palm_frame(
     let y0 = 0.5 * (y.dot(&mean_others) + y.dot(&axes[thumb][0].0.coords));
     let (zl, zh) = range(&z);
     let origin = Point3::from(x * x0 + y * y0 + z * (0.5 * (zl + zh)));
-    // finger_1 above finger_3 along z (by their joint 1's height).
-    let h = |k: usize| z.dot(&axes[k][0].0.coords);
+    let heights: Vec<f64> = axes.iter().map(|a| z.dot(&a[0].0.coords)).collect();
+    let order = finger_order(tree, chains, thumb, [others[0], others[1]], &heights)?;
+    Ok(Frame {
+        axes: [x, y, z],
+        origin,
+        order,
+    })
+}
+
+/// The fingers in model order (finger_1, the thumb, finger_3): as the mapping names them, else
+/// finger_1 the higher of the two along z (by joint 1's height).
+///
+/// # Errors
+/// A mapping whose thumb is not the finger closing against the other two.
+fn finger_order(
+    tree: &Tree,
+    chains: &[ChainInfo],
+    thumb: usize,
+    others: [usize; 2],
+    heights: &[f64],
+) -> Result<[usize; 3], HandError> {
     if let Some(k) = (0..3).find(|&k| chains[k].3 == Some(1) && k != thumb) {
         return Err(err(
             &tree.file,
@@ -160,20 +179,18 @@ pub(super) fn palm_frame(
             ),
         ));
     }
-    let named_first = |k: usize, slot: usize| chains[others[k]].3 == Some(slot);
-    let (f1, f3) = if named_first(0, 0) || named_first(1, 2) {
-        (others[0], others[1])
-    } else if named_first(1, 0) || named_first(0, 2) {
-        (others[1], others[0])
-    } else if h(others[0]) >= h(others[1]) {
-        (others[0], others[1])
+    let named = |k: usize, slot: usize| chains[others[k]].3 == Some(slot);
+    let first = if named(0, 0) || named(1, 2) {
+        true
+    } else if named(1, 0) || named(0, 2) {
+        false
     } else {
-        (others[1], others[0])
+        heights[others[0]] >= heights[others[1]]
     };
-    Ok(Frame {
-        axes: [x, y, z],
-        origin,
-        order: [f1, thumb, f3],
+    Ok(if first {
+        [others[0], thumb, others[1]]
+    } else {
+        [others[1], thumb, others[0]]
     })
 }
 
