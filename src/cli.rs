@@ -212,6 +212,14 @@ pub enum Command {
     /// rate, then mean payload margin, then mean translation); writes tune.csv, tune.json and
     /// score_<param>.svg into --out.
     Tune(TuneArgs),
+    /// Hand files (issue 37): `hand show FILE` prints the model grasp-sim derives from a hand's
+    /// URDF or MJCF (or from the one a scenario's `[hand]` names, with its mapping) and writes
+    /// a figure of it over the file's link geometry.
+    Hand {
+        /// What to do.
+        #[command(subcommand)]
+        action: HandCommand,
+    },
     /// Write the thesis objects as binary STL (deterministic: the same bytes every time).
     GenAssets {
         /// Output folder.
@@ -222,6 +230,19 @@ pub enum Command {
         /// 40 MB in all), into `--out` (give one: they are not committed).
         #[arg(long)]
         hard: bool,
+    },
+}
+
+/// `grasp-sim hand` subcommands.
+#[derive(Debug, Subcommand)]
+pub enum HandCommand {
+    /// Print the derived hand model as a table and write its figure (SVG).
+    Show {
+        /// A hand's URDF (.urdf) or MJCF (.xml), or a scenario whose `[hand]` names one.
+        file: PathBuf,
+        /// Where to write the figure (default: `<FILE's stem>.hand.svg` here).
+        #[arg(long, value_name = "FILE")]
+        svg: Option<PathBuf>,
     },
 }
 

@@ -12,7 +12,11 @@ use serde::Deserialize;
 use std::path::{Path, PathBuf};
 
 mod geometry;
+pub mod import;
+mod import_frame;
 pub mod kinematics;
+pub mod mjcf_hand;
+pub mod urdf_hand;
 pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
 
 /// The largest length a hand file may give `[mm]`: a hand is hand-sized (issue 32).
@@ -97,8 +101,63 @@ pub struct Hand {
     /// The fingers, in the thesis's order (finger_1 top, finger_2 the opposing thumb, finger_3).
     #[serde(rename = "finger")]
     pub finger_list: Vec<Finger>,
+    /// Joints the hand couples (issue 37: a URDF's `mimic`, an MJCF's `<equality><joint>`),
+    /// as relations between interior angles. The planner treats the joints as independent; a
+    /// plan is checked against each coupling ([`Hand::coupling_checks`]), not refused.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub coupling: Vec<Coupling>,
 }
 
+/// A coupling between two joints of the model: θ(follower) = multiplier × θ(leader) +
+/// offset_deg, interior angles in degrees.
+#[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Coupling {
+    /// The following joint: `[finger number (1-3, model order), joint (1 or 2)]`.
+    pub follower: [usize; 2],
+    /// The joint it follows, likewise.
+    pub leader: [usize; 2],
+    /// The multiplier (between interior angles).
+    pub multiplier: f64,
+    /// The offset `[deg]`.
+    pub offset_deg: f64,
+    /// Where the file states it, in words.
+    #[serde(default)]
+    pub source: String,
+}
+
+/// How far a plan is from holding a coupling.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CouplingCheck {
+    /// The coupling, in words.
+    pub coupling: String,
+    /// The follower's planned angle minus the angle the coupling gives it `[deg]`.
+    pub error_deg: f64,
+}
+
+/// How closely a plan must keep a coupling to keep it `[deg]`: the thesis's Joint Angular
+/// Deviation.
+pub const COUPLING_TOLERANCE_DEG: f64 = 5.0;
+
+impl Coupling {
+    /// The coupling in words, with the model's joint names.
+    pub fn describe(&self) -> String {
+        let j = |r: [usize; 2]| format!("finger_{} θ{}", r[0], r[1]);
+        let what = format!(
+            "{} = {:.4} × {} {} {:.2}°",
+            j(self.follower),
+            self.multiplier,
+            j(self.leader),
+            if self.offset_deg < 0.0 { "−" } else { "+" },
+            self.offset_deg.abs()
+        );
+        if self.source.is_empty() {
+            what
+        } else {
+            format!("{what} ({})", self.source)
+        }
+    }
+}
 /// Palm dimensions.
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
@@ -178,6 +237,47 @@ pub struct Finger {
 }
 
 impl Hand {
+    /// Checks planned joint angles `[θ1, θ2]` per finger (model order, degrees) against every
+    /// coupling: the planner does not refuse a plan that breaks one, the check says by how much.
+    pub fn coupling_checks(&self, theta_deg: &[[f64; 2]]) -> Vec<CouplingCheck> {
+        let angle = |r: [usize; 2]| {
+            theta_deg
+                .get(r[0].wrapping_sub(1))
+                .and_then(|t| t.get(r[1].wrapping_sub(1)))
+                .copied()
+        };
+        self.coupling
+            .iter()
+            .filter_map(|c| {
+                let (f, l) = (angle(c.follower)?, angle(c.leader)?);
+                Some(CouplingCheck {
+                    coupling: c.describe(),
+                    error_deg: f - (c.multiplier * l + c.offset_deg),
+                })
+            })
+            .collect()
+    }
+
+    /// [`Hand::coupling_checks`] as one line each for a run's warnings: which coupling, by how
+    /// much the plan breaks or keeps it, and that it is checked, not refused.
+    pub fn coupling_lines(&self, theta_deg: &[[f64; 2]]) -> Vec<String> {
+        self.coupling_checks(theta_deg)
+            .into_iter()
+            .map(|c| {
+                let verdict = if c.error_deg.abs() <= COUPLING_TOLERANCE_DEG {
+                    "keeps it".to_string()
+                } else {
+                    format!("breaks it by {:+.1}°", c.error_deg)
+                };
+                format!(
+                    "hand `{}`: coupling {}: the plan {verdict} (checked, not refused: the \
+                     planner and the physics check drive each joint on its own)",
+                    self.name, c.coupling
+                )
+            })
+            .collect()
+    }
+
     /// A finger's width `[mm]`: its centreline to each side wall is the finger offset (thesis
     /// 3.3.2), so no gap narrower than this lets a finger in.
     pub fn finger_width_mm(&self) -> f64 {
@@ -361,6 +461,23 @@ impl Hand {
         }
         if self.finger_list.is_empty() {
             return Err(("finger", "the hand has no fingers".to_string()));
+        }
+        let n = self.finger_list.len();
+        let joint_ok = |r: [usize; 2]| (1..=n).contains(&r[0]) && (1..=2).contains(&r[1]);
+        for c in &self.coupling {
+            if !(joint_ok(c.follower)
+                && joint_ok(c.leader)
+                && c.multiplier.is_finite()
+                && c.offset_deg.is_finite())
+            {
+                return Err((
+                    "coupling",
+                    format!(
+                        "must name [finger 1-{n}, joint 1-2] twice with a finite multiplier \
+                         and offset, got {c:?}"
+                    ),
+                ));
+            }
         }
         for (i, f) in self.finger_list.iter().enumerate() {
             if self.finger_list[..i].iter().any(|g| g.name == f.name) {

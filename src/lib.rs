@@ -28,6 +28,7 @@ pub mod batch;
 pub mod export;
 pub mod files;
 pub mod hand;
+pub mod hand_show;
 pub mod mesh;
 mod messages;
 pub mod objects;

@@ -68,6 +68,9 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
         Some(Command::Summarize { file, csv, slowest }) => {
             summarize(&file, csv.as_deref(), slowest)
         }
+        Some(Command::Hand {
+            action: cli::HandCommand::Show { file, svg },
+        }) => grasp_sim::hand_show::run(&file, svg.as_deref()),
         Some(Command::Tune(args)) => grasp_sim::tune::command::run(&args.request(), &Bar::tune()),
         None => run_inputs(cli),
     }

@@ -252,6 +252,12 @@ pub const DEFAULT_FRICTION: f64 = 0.3;
 struct RawHand {
     /// A hand file relative to the scenario, or the name of a bundled hand; default `thesis`.
     file: Option<PathBuf>,
+    /// A hand's URDF relative to the scenario (issue 37), instead of `file`.
+    urdf: Option<PathBuf>,
+    /// A hand's MJCF relative to the scenario (issue 37), instead of `file`.
+    mjcf: Option<PathBuf>,
+    /// Which links and joints of the URDF or MJCF are the palm and the fingers.
+    mapping: Option<crate::hand::import::Mapping>,
     #[serde(default)]
     overrides: BTreeMap<String, f64>,
 }
@@ -456,6 +462,35 @@ fn validate_object(o: &RawObject) -> Result<MassSpec, (&'static str, String)> {
 /// [`ScenarioError`]: the hand file's own, or [`ScenarioError::Invalid`] for an override.
 fn load_hand(raw: RawHand, dir: &Path, path: &Path) -> Result<(PathBuf, Hand), ScenarioError> {
     let overrides: Vec<(String, f64)> = raw.overrides.into_iter().collect();
+    let invalid = |key: &str, problem: &str| ScenarioError::Invalid {
+        path: path.to_path_buf(),
+        key: key.to_string(),
+        problem: problem.to_string(),
+    };
+    let robot = match (&raw.file, raw.urdf, raw.mjcf) {
+        (None, Some(f), None) | (None, None, Some(f)) => Some(f),
+        (_, None, None) => None,
+        _ => {
+            return Err(invalid(
+                "hand",
+                "gives more than one of `file`, `urdf` and `mjcf`: give one",
+            ))
+        }
+    };
+    if let Some(f) = robot {
+        let f = dir.join(f);
+        let mapping = raw.mapping.unwrap_or_default();
+        let derived = crate::hand::import::load(&f, &mapping, &overrides);
+        return derived
+            .map(|d| (f, d.hand))
+            .map_err(|e| hand_error(e, &overrides, path));
+    }
+    if raw.mapping.is_some() {
+        return Err(invalid(
+            "hand.mapping",
+            "maps the joints of a URDF or MJCF: give `urdf` or `mjcf` with it",
+        ));
+    }
     let file = raw.file.unwrap_or_else(|| PathBuf::from("thesis"));
     let bundled = file
         .to_str()
@@ -473,7 +508,13 @@ fn load_hand(raw: RawHand, dir: &Path, path: &Path) -> Result<(PathBuf, Hand), S
             (f, hand)
         }
     };
-    let hand = loaded.map_err(|e| match e {
+    let hand = loaded.map_err(|e| hand_error(e, &overrides, path))?;
+    Ok((hand_file, hand))
+}
+
+/// A hand file's error, or the scenario's when its override caused it.
+fn hand_error(e: HandError, overrides: &[(String, f64)], path: &Path) -> ScenarioError {
+    match e {
         // The override was written in the scenario: name the scenario.
         HandError::BadOverride {
             path: hand,
@@ -495,8 +536,7 @@ fn load_hand(raw: RawHand, dir: &Path, path: &Path) -> Result<(PathBuf, Hand), S
             problem: format!("{problem} ({} with this override)", hand.display()),
         },
         other => other.into(),
-    })?;
-    Ok((hand_file, hand))
+    }
 }
 
 /// Checks planner parameters against the hand and the friction (see

@@ -21,7 +21,7 @@ use std::path::{Path, PathBuf};
 
 /// One piece of geometry: what it is, and where in the URDF it sits (for messages).
 #[derive(Debug, Clone)]
-enum Shape {
+pub(crate) enum Shape {
     /// A mesh file (resolved) and its per-axis scale.
     Mesh(PathBuf, Vector3<f64>),
     /// A box of these edge lengths `[m]`, centred.
@@ -34,12 +34,12 @@ enum Shape {
 
 /// A piece of geometry placed in the root link's frame.
 #[derive(Debug, Clone)]
-struct Placed {
-    shape: Shape,
-    pose: Isometry3<f64>,
+pub(crate) struct Placed {
+    pub(crate) shape: Shape,
+    pub(crate) pose: Isometry3<f64>,
 }
 
-fn urdf_err(path: &Path, detail: impl Into<String>) -> MeshError {
+pub(crate) fn urdf_err(path: &Path, detail: impl Into<String>) -> MeshError {
     MeshError::Urdf {
         path: path.to_path_buf(),
         detail: detail.into(),
@@ -47,7 +47,7 @@ fn urdf_err(path: &Path, detail: impl Into<String>) -> MeshError {
 }
 
 /// Numbers in an attribute: `n` of them, finite.
-fn numbers(
+pub(crate) fn numbers(
     path: &Path,
     node: roxmltree::Node,
     attr: &str,
@@ -79,7 +79,7 @@ fn numbers(
 }
 
 /// The pose an `<origin>` child of `node` gives (identity without one).
-fn origin(path: &Path, node: roxmltree::Node) -> Result<Isometry3<f64>, MeshError> {
+pub(crate) fn origin(path: &Path, node: roxmltree::Node) -> Result<Isometry3<f64>, MeshError> {
     let Some(o) = node.children().find(|c| c.has_tag_name("origin")) else {
         return Ok(Isometry3::identity());
     };
@@ -92,7 +92,7 @@ fn origin(path: &Path, node: roxmltree::Node) -> Result<Isometry3<f64>, MeshErro
 }
 
 /// Where a mesh `filename` points, relative to the URDF at `path`.
-fn resolve(path: &Path, filename: &str) -> Option<PathBuf> {
+pub(crate) fn resolve(path: &Path, filename: &str) -> Option<PathBuf> {
     let dir = path.parent().unwrap_or(Path::new("."));
     if let Some(rest) = filename.strip_prefix("file://") {
         let p = PathBuf::from(rest);
@@ -210,6 +210,15 @@ fn geometry(path: &Path, element: roxmltree::Node) -> Result<Result<Placed, Stri
     Ok(Ok(Placed { shape, pose }))
 }
 
+/// What one `<visual>` or `<collision>` element gives: its placed shape, or why it cannot be
+/// read (a note), or the URDF's error.
+pub(crate) type ElementGeometry = Result<Result<Placed, String>, MeshError>;
+
+/// [`geometry`], for the hand reader (`crate::hand::urdf_hand`).
+pub(crate) fn element_geometry(path: &Path, element: roxmltree::Node) -> ElementGeometry {
+    geometry(path, element)
+}
+
 /// What a URDF gives: its geometry in the root link's frame, notes on what was read instead of
 /// what, and its links' inertial masses summed `[kg]` (`None` when no link gives one).
 struct Read {
@@ -226,7 +235,7 @@ pub const MAX_DEPTH: usize = 256;
 /// The nesting depth of `text`'s elements where it first exceeds `limit`, found by a scan of its
 /// tags that does not recurse (comments, processing instructions, declarations and CDATA
 /// skipped); `None` when it stays within.
-fn nesting_deeper_than(text: &str, limit: usize) -> Option<usize> {
+pub(crate) fn nesting_deeper_than(text: &str, limit: usize) -> Option<usize> {
     let b = text.as_bytes();
     let (mut i, mut depth) = (0usize, 0usize);
     let skip_to = |from: usize, end: &[u8]| {

@@ -277,7 +277,7 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
         None => ExpectReport::none(),
     };
     let shown = selection.reported_axis();
-    let report = RunReport {
+    let mut report = RunReport {
         scenario: scenario.name.clone(),
         object: build::object_report(scenario, &object),
         warnings: build::warnings(
@@ -293,6 +293,15 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
         quality,
         mjcf_scene: None,
     };
+    // Issue 37: a hand file's coupled joints, checked against the plan.
+    if let Some(g) = &report.plan.grasp {
+        let theta: Vec<[f64; 2]> = g
+            .fingers
+            .iter()
+            .map(|f| [f.theta1_deg, f.theta2_deg])
+            .collect();
+        report.warnings.extend(scenario.hand.coupling_lines(&theta));
+    }
     Ok(Computed {
         report,
         posed: posed.ok().map(|p| p.0),

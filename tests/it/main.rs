@@ -8,6 +8,7 @@ mod export;
 mod formats;
 mod frames;
 mod geometry;
+mod hand_files;
 mod hostile;
 mod isolation;
 mod issue16;
