@@ -258,8 +258,6 @@ def test_keyword_parameters_are_validated_as_scenario_keys(cup):
         gs.plan(cup, sf_c=object())
     with pytest.raises(gs.BadScenarioError, match="sim.override_angles"):
         gs.check(cup, None, override_angles=np.array([[90.0, 90.0]]))
-    with pytest.raises(gs.BadInputError, match="samples"):
-        gs.check(cup, None, samples=8)
 
 
 # --- Hands.
