@@ -44,6 +44,7 @@ pub mod outcome;
 pub mod params;
 pub mod payload;
 pub mod protocol;
+pub mod refine;
 pub mod scene;
 
 pub use closing::{Stall, STALL};
