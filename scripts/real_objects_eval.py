@@ -280,6 +280,18 @@ def stats_line(name, st):
             f"{within}.")
 
 
+def share_line(results, before=None):
+    """The summary line of the phalanges on their plan (issue 33's target: 90 %), this run's and
+    the earlier run's."""
+    def share(r):
+        st = closing_stats(r)
+        return (f"{st['on_plan']} of {st['phalanges']} "
+                f"({100.0 * st['on_plan'] / st['phalanges']:.0f} %)" if st["phalanges"] else "none")
+    text = (f"**Phalanges within 5° of their plan and touching** (every held grasp, `down` and "
+            f"`six`): {share(results)}")
+    return text + (f"; before: {share(before)}." if before is not None else ".")
+
+
 def table(results, no_mujoco, before=None):
     cols = "| closing shift [mm] | worst phalanx | on plan |" if before is None else \
         "| closing shift [mm], before → after | worst phalanx, before → after | on plan, before → after |"
@@ -342,6 +354,7 @@ def table(results, no_mujoco, before=None):
                  f"{rp[-1]:.1f}).")
     if before is not None:
         line += "\n\n" + stats_line("**Closing before**", closing_stats(before))
+    line += "\n\n" + share_line(results, before)
     return line + "\n\n" + "\n".join(rows) + "\n"
 
 
