@@ -112,11 +112,15 @@ def closing_of(sim, grasp):
         shift, turn = dirs[0].get("closing_translation_mm"), None
     if len(names) != len(errors):
         names = [f"finger_{k + 1}" for k in range(len(errors))]
+    # The worst phalanx: one that does not touch the object at the end of the closing (a miss),
+    # else the joint furthest from its plan.
     worst = None
-    for name, e in zip(names, errors):
+    for k, (name, e) in enumerate(zip(names, errors)):
         for j, v in enumerate(e):
-            if worst is None or abs(v) > abs(worst[2]):
-                worst = (name, j + 1, v)
+            miss = touching is not None and not touching[k][j]
+            key = (miss, abs(v))
+            if worst is None or key > worst[3]:
+                worst = (name, j + 1, v, key)
     phalanges = [
         abs(v) <= 5.0 and (touching is None or touching[k][j])
         for k, e in enumerate(errors)
@@ -133,7 +137,11 @@ def closing_of(sim, grasp):
         "phalanges": len(phalanges),
         "phalanges_within_5deg": sum(phalanges),
         "worst_finger": None if worst is None else
-        {"name": worst[0], "joint": worst[1], "error_deg": worst[2]},
+        {"name": worst[0], "joint": worst[1], "error_deg": worst[2], "miss": worst[3][0]},
+        "touching": touching,
+        # The refinement by the contact (`sim.start.refinement`): per finger the planner's ALS
+        # angles and the refined ones the check commanded.
+        "refinement": (sim.get("start") or {}).get("refinement"),
         "pushed": any(d.get("closing_pushed", False) for d in dirs),
     }
 
@@ -216,8 +224,19 @@ def fmt(x, d=1):
 
 
 def worst(d):
+    """The worst phalanx of a grasp: `finger jN miss` for one that ends the closing off the
+    object, else the joint furthest from its plan as planned minus closed bend."""
     w = d.get("worst_finger")
-    return "" if not w else f"{w['name']} j{w['joint']} {w['error_deg']:+.0f}°"
+    if not w:
+        return ""
+    if w.get("miss"):
+        return f"{w['name']} j{w['joint']} miss"
+    return f"{w['name']} j{w['joint']} {-w['error_deg']:+.0f}°"
+
+
+def on_plan(d):
+    """`k/n`: the phalanges that end touching within 5° of their plan, of the grasp's."""
+    return "" if not d.get("phalanges") else f"{d['phalanges_within_5deg']}/{d['phalanges']}"
 
 
 def closing_stats(results, key="down"):
@@ -261,13 +280,25 @@ def stats_line(name, st):
             f"{within}.")
 
 
+def share_line(results, before=None):
+    """The summary line of the phalanges on their plan (issue 33's target: 90 %), this run's and
+    the earlier run's."""
+    def share(r):
+        st = closing_stats(r)
+        return (f"{st['on_plan']} of {st['phalanges']} "
+                f"({100.0 * st['on_plan'] / st['phalanges']:.0f} %)" if st["phalanges"] else "none")
+    text = (f"**Phalanges within 5° of their plan and touching** (every held grasp, `down` and "
+            f"`six`): {share(results)}")
+    return text + (f"; before: {share(before)}." if before is not None else ".")
+
+
 def table(results, no_mujoco, before=None):
-    cols = "| closing shift [mm] | worst joint |" if before is None else \
-        "| closing shift [mm], before → after | worst joint, before → after |"
+    cols = "| closing shift [mm] | worst phalanx | on plan |" if before is None else \
+        "| closing shift [mm], before → after | worst phalanx, before → after | on plan, before → after |"
     rows = [
         "| object | label | triangles | axis | rules (relaxations) | plan | down: verdict, mm, deg "
         "| six: verdict, mm, deg | MuJoCo (down) | checked | penetration [mm] " + cols + " time [s] |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     n = {"graspable": 0, "planned": 0, "down": 0, "six": 0, "mj": 0, "agree": 0}
     for name, r in sorted(results.items()):
@@ -283,10 +314,11 @@ def table(results, no_mujoco, before=None):
             f"| {s.get('verdict')}, {fmt(s.get('translation_mm'))}, {fmt(s.get('rotation_deg'))} "
             f"| {'' if mj is None else mj['verdict'] + ('' if agree else ' (differs)')} "
             f"| {d.get('candidates_checked', '')} | {fmt(d.get('penetration_mm'), 2)} "
-            + (f"| {fmt(d.get('closing_shift_mm'))} | {worst(d)} " if before is None else
+            + (f"| {fmt(d.get('closing_shift_mm'))} | {worst(d)} | {on_plan(d)} " if before is None else
                f"| {fmt(before.get(name, {}).get('down', {}).get('closing_shift_mm'))} → "
                f"{fmt(d.get('closing_shift_mm'))} "
-               f"| {worst(before.get(name, {}).get('down', {}))} → {worst(d)} ")
+               f"| {worst(before.get(name, {}).get('down', {}))} → {worst(d)} "
+               f"| {on_plan(before.get(name, {}).get('down', {}))} → {on_plan(d)} ")
             + f"| {fmt(d.get('wall_s'))} |"
         )
         if r["label"] == "graspable":
@@ -322,6 +354,7 @@ def table(results, no_mujoco, before=None):
                  f"{rp[-1]:.1f}).")
     if before is not None:
         line += "\n\n" + stats_line("**Closing before**", closing_stats(before))
+    line += "\n\n" + share_line(results, before)
     return line + "\n\n" + "\n".join(rows) + "\n"
 
 

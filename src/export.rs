@@ -338,7 +338,7 @@ impl Keyframes {
             planned: Vec::new(),
             ctrl: Vec::new(),
         };
-        for ([t1, t2], [o1, o2]) in case.pose.theta_deg.iter().zip(&start.open_bend_rad) {
+        for ([t1, t2], [o1, o2]) in start.theta_deg.iter().zip(&start.open_bend_rad) {
             let (b1, b2) = (bend(*t1), bend(*t2));
             k.open.push(*o1);
             k.open.push(*o2);

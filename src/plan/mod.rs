@@ -7,7 +7,8 @@
 //!   which lives with the hand ([`crate::hand::kinematics`]: the hand file's validation needs it).
 //! - [`palm_grade`]: significance factors (3.4.3.3) and stage 3 (3.4.4): palm grades, sorting.
 //! - [`palm`]: palm positioning (3.5); [`finger`]: ALS finger positioning (3.6);
-//!   [`search`]: the walk over the sorted domain (3.7).
+//!   [`search`]: the walk over the sorted domain (3.7); [`refine`]: the joint angles refined by
+//!   the real contact (issue 33), which the physics check applies on its collider.
 //!
 //! Units: millimetres and degrees at the boundary (parameters, reports), radians inside. The
 //! object is in the aligned frame (principal axis +Z, bottom at Z = 0).
@@ -21,6 +22,7 @@ pub use crate::hand::kinematics;
 pub mod palm;
 pub mod palm_grade;
 pub mod params;
+pub mod refine;
 pub mod search;
 pub mod timings;
 

@@ -131,12 +131,18 @@ fn closed(
     let dt = case.params.solver.timestep_s;
     let (pc, qc) = relative(scene);
     let joint_errors_deg = joint_errors(scene);
+    // The set the check commanded: the plan, refined by the contact unless that is off.
+    let commanded: Vec<[f64; 2]> = scene
+        .fingers
+        .iter()
+        .map(|f| f.planned_bend_rad.map(crate::plan::refine::theta_deg))
+        .collect();
     let outcome = closing_outcome(
         case,
         first_contact,
         &touching(scene),
         &gaps_mm(scene),
-        &joint_errors_deg,
+        (&commanded, &joint_errors_deg),
         ((pc - p0).norm(), q0.angle_to(&qc).to_degrees()),
         steps as f64 * dt,
     );
@@ -331,7 +337,7 @@ fn closing_outcome(
     first: &FirstContacts,
     end: &Touching,
     gaps: &[[f64; 2]],
-    errors: &[[f64; 2]],
+    (commanded, errors): (&[[f64; 2]], &[[f64; 2]]),
     (shift_mm, turn_deg): (f64, f64),
     duration_s: f64,
 ) -> ClosingOutcome {
@@ -343,13 +349,14 @@ fn closing_outcome(
         .collect();
     let fingers: Vec<FingerClosing> = names
         .iter()
-        .zip(&case.pose.theta_deg)
+        .zip(commanded.iter().zip(&case.pose.theta_deg))
         .zip(errors)
         .zip(end.fingers.iter().zip(&first.fingers).zip(gaps))
         .map(
-            |(((name, planned), error), ((touching, first), gap))| FingerClosing {
+            |(((name, (planned, als)), error), ((touching, first), gap))| FingerClosing {
                 name: name.clone(),
                 planned_deg: *planned,
+                als_deg: *als,
                 final_deg: [planned[0] - error[0], planned[1] - error[1]],
                 error_deg: *error,
                 touching: *touching,

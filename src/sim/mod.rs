@@ -47,6 +47,7 @@ pub mod outcome;
 pub mod params;
 pub mod payload;
 pub mod protocol;
+pub mod refine;
 pub mod robust;
 pub mod scene;
 

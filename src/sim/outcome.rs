@@ -223,8 +223,13 @@ pub struct FirstTouch {
 pub struct FingerClosing {
     /// The finger's name.
     pub name: String,
-    /// Planned `[θ1, θ2]` `[deg]` (the Grasp Parameter Set).
+    /// Planned `[θ1, θ2]` `[deg]`: the set the check commanded (plus its squeeze), the Grasp
+    /// Parameter Set refined by the contact (`[sim] refine_contacts`, `sim::refine`), or the
+    /// planner's own when the refinement is off.
     pub planned_deg: [f64; 2],
+    /// The planner's `[θ1, θ2]` `[deg]` (the thesis's ALS angles, `plan.grasp.fingers`), before
+    /// any refinement.
+    pub als_deg: [f64; 2],
     /// `[θ1, θ2]` where the closing left the joints `[deg]`: the set a hand would be commanded
     /// to reach this grasp.
     pub final_deg: [f64; 2],
@@ -282,6 +287,7 @@ mod tests {
         let finger = |name: &str, error_deg| FingerClosing {
             name: name.to_string(),
             planned_deg: [90.0, 90.0],
+            als_deg: [90.0, 90.0],
             final_deg: [90.0, 90.0],
             error_deg,
             touching: [true, true],

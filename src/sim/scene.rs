@@ -237,6 +237,14 @@ pub struct Start {
     /// The deepest penetration of a hand collider into the object's left at the start `[mm]`
     /// (0 when everything starts clear).
     pub penetration_mm: f64,
+    /// Per finger, the `[θ1, θ2]` the check commands `[deg]` (plus the squeeze): the plan's,
+    /// or with `[sim] refine_contacts` the plan refined by the contact.
+    #[serde(skip)]
+    pub theta_deg: Vec<[f64; 2]>,
+    /// Per finger, what the refinement by the contact did (`sim::refine`); empty when it did not
+    /// run (`refine_contacts = false`, or `override_angles`).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub refinement: Vec<crate::plan::refine::FingerRefinement>,
 }
 
 /// A hand collider penetrates the object's collider deeper than this at the start `[mm]`: twice
@@ -304,14 +312,57 @@ fn open_margins(margin0: f64) -> Vec<f64> {
 /// The start of the check for `case` (see [`Start`]).
 pub fn start(case: &Case) -> Start {
     let Case {
+        hand, pose, object, ..
+    } = *case;
+    let r_palm = palm_rotation(&pose.axes);
+    let palm = [hand.palm_box()];
+    let (origin, backoff) = backed_off(pose, object, &palm);
+    let palm_pose = (origin, r_palm);
+    let refines =
+        case.params.closing.refine_contacts && case.params.input.override_angles.is_none();
+    let refinement = if refines {
+        super::refine::refine(case, &palm_pose, |theta| {
+            opened(case, &palm_pose, theta).bends
+        })
+    } else {
+        Vec::new()
+    };
+    let theta_deg: Vec<[f64; 2]> = if refines {
+        refinement.iter().map(|r| r.refined_deg).collect()
+    } else {
+        pose.theta_deg.clone()
+    };
+    let open = opened(case, &palm_pose, &theta_deg);
+    Start {
+        origin_mm: origin,
+        palm_backoff_mm: backoff,
+        open_bend_rad: open.bends,
+        open_margin_deg: open.margins,
+        penetration_mm: overlap_mm(&object.shape, &palm_pose, &palm).max(open.penetration_mm),
+        theta_deg,
+        refinement,
+    }
+}
+
+/// The fingers opened for the start (see [`Start`]).
+struct Opened {
+    /// Per finger, the bends the joints start at `[rad]`.
+    bends: Vec<[f64; 2]>,
+    /// Per finger, the margin it starts open by `[deg]`.
+    margins: Vec<f64>,
+    /// The deepest penetration of a finger no margin clears `[mm]` (0 when none).
+    penetration_mm: f64,
+}
+
+/// Each finger of `case`, commanded `theta` `[deg]` with the palm at `palm`, opened by
+/// `open_margin_deg`, or by the nearest margin at which it starts clear (see [`Start`]).
+fn opened(case: &Case, palm: &BodyPose, theta: &[[f64; 2]]) -> Opened {
+    let Case {
         hand,
-        pose,
         object,
         params,
         ..
     } = *case;
-    let r_palm = palm_rotation(&pose.axes);
-    let palm = [hand.palm_box()];
     let limits1 = [
         bend(hand.joints.theta1_range_deg[1]),
         bend(hand.joints.theta1_range_deg[0]),
@@ -320,18 +371,19 @@ pub fn start(case: &Case) -> Start {
         bend(hand.joints.theta2_range_deg[1]),
         bend(hand.joints.theta2_range_deg[0]),
     ];
-    let (origin, backoff) = backed_off(pose, object, &palm);
-    let mut penetration = overlap_mm(&object.shape, &(origin, r_palm), &palm);
     let margin0 = params.closing.open_margin_deg;
     let margins = open_margins(margin0);
-    let mut open_bend = Vec::new();
-    let mut open_margin = Vec::new();
-    for (f, [t1, t2]) in hand.finger_list.iter().zip(&pose.theta_deg) {
+    let mut out = Opened {
+        bends: Vec::new(),
+        margins: Vec::new(),
+        penetration_mm: 0.0,
+    };
+    for (f, [t1, t2]) in hand.finger_list.iter().zip(theta) {
         let (p1, p2) = hand.phalanx_boxes(f.side);
         let at = |m: f64| {
             let b1 = (bend(*t1) - m.to_radians()).max(limits1[0]);
             let b2 = (bend(*t2) - m.to_radians()).max(limits2[0]);
-            let [f1, f2] = hand.finger_poses(f, &(origin, r_palm), [b1, b2]);
+            let [f1, f2] = hand.finger_poses(f, palm, [b1, b2]);
             let d = overlap_mm(&object.shape, &f1, &[p1]).max(overlap_mm(&object.shape, &f2, &p2));
             ([b1, b2], d)
         };
@@ -344,26 +396,15 @@ pub fn start(case: &Case) -> Start {
                 (d <= START_TOLERANCE_MM).then_some((m, b))
             })
         };
-        match found {
-            Some((m, b)) => {
-                open_margin.push(m);
-                open_bend.push(b);
-            }
-            None => {
-                // No margin clears it: start as the scenario says, and report the overlap.
-                penetration = penetration.max(d0);
-                open_margin.push(margin0);
-                open_bend.push(first);
-            }
-        }
+        let (m, b) = found.unwrap_or_else(|| {
+            // No margin clears it: start as the scenario says, and report the overlap.
+            out.penetration_mm = out.penetration_mm.max(d0);
+            (margin0, first)
+        });
+        out.margins.push(m);
+        out.bends.push(b);
     }
-    Start {
-        origin_mm: origin,
-        palm_backoff_mm: backoff,
-        open_bend_rad: open_bend,
-        open_margin_deg: open_margin,
-        penetration_mm: penetration,
-    }
+    out
 }
 
 /// Builds the scene with the fingers open and gravity off.
@@ -398,7 +439,7 @@ pub fn build(case: &Case) -> Scene {
     let fingers: Vec<SimFinger> = hand
         .finger_list
         .iter()
-        .zip(&pose.theta_deg)
+        .zip(&start.theta_deg)
         .zip(&start.open_bend_rad)
         .zip(finger_torque_limits(hand, params))
         .map(|(((f, theta), open), torque_nm)| {

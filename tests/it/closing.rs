@@ -92,10 +92,13 @@ fn equal_torques_push_the_d40_towards_the_thumb() {
 
 #[test]
 fn a_palm_backed_off_10_mm_is_reported_and_bounded() {
-    // The palm 10 mm off the object: the fingers pull the object to it as they close. The shift
-    // is measured, and past `max_closing_shift_mm` the grasp is not a hold of the planned one,
+    // The palm 10 mm off the object, the plan's angles commanded as they are (no refinement by
+    // the contact, the default): the fingers pull the object to it as they close. The shift is
+    // measured, and past `max_closing_shift_mm` the grasp is not a hold of the planned one,
     // whatever the hold under gravity did ...
-    let out = d40_backed_off(10.0, &SimParams::default());
+    let unrefined = SimParams::default();
+    assert!(!unrefined.closing.refine_contacts);
+    let out = d40_backed_off(10.0, &unrefined);
     let c = &out.closing;
     assert!(
         c.shift_mm > 5.0 && c.shift_mm < 15.0,
@@ -110,12 +113,40 @@ fn a_palm_backed_off_10_mm_is_reported_and_bounded() {
         assert_eq!(d.closing_translation_mm, c.shift_mm);
     }
     // ... while with the bound above the push, the same closing is judged by the hold alone.
-    let mut loose = SimParams::default();
+    let mut loose = unrefined.clone();
     loose.hold.max_closing_shift_mm = 20.0;
     let out = d40_backed_off(10.0, &loose);
     assert!(!out.closing.pushed);
     assert_eq!(out.closing.shift_mm, c.shift_mm);
     assert_eq!(out.verdict, Verdict::Hold, "{:?}", out.directions);
+}
+
+#[test]
+fn refined_by_the_contact_a_backed_off_palm_is_commanded_the_touching_bends() {
+    // The same palm 10 mm off, refined by the contact (`[sim] refine_contacts = true`): each
+    // joint is commanded the bend at which its phalanx meets the cylinder from there, θ1 76.07°
+    // and θ2 114.35° (phalanx 1, then phalanx 2, tangent to the 20 mm circle about (−30, 0) in
+    // the palm's frame; the unit test of `sim::refine` derives them), instead of the plan's
+    // 72.11°/91.81°. The fingers then touch together, but their contact normals still have a
+    // component towards the palm: the squeeze pulls the object the 10 mm to it, the phalanx 2s
+    // close through their squeeze, and the bound refuses the grasp. Refining the fingers does not
+    // mend a palm off the object; the palm has to be placed on it.
+    let mut params = SimParams::default();
+    params.closing.refine_contacts = true;
+    let out = d40_backed_off(10.0, &params);
+    let c = &out.closing;
+    for f in &c.fingers {
+        assert!((f.als_deg[0] - 72.11).abs() < 0.01, "{f:?}");
+        assert!((f.als_deg[1] - 91.81).abs() < 0.01, "{f:?}");
+        assert!((f.planned_deg[0] - 76.07).abs() < 0.05, "{f:?}");
+        assert!((f.planned_deg[1] - 114.35).abs() < 0.05, "{f:?}");
+        assert!(
+            (f.error_deg[1] - params.fingers.squeeze2_deg).abs() < 0.5,
+            "{f:?}"
+        );
+    }
+    assert!(c.shift_mm > 5.0 && c.pushed, "{c:?}");
+    assert_ne!(out.verdict, Verdict::Hold, "{c:?}");
 }
 
 #[test]
@@ -140,6 +171,7 @@ fn the_summary_and_json_say_what_the_closing_did() {
         for key in [
             "name",
             "planned_deg",
+            "als_deg",
             "final_deg",
             "error_deg",
             "touching",
