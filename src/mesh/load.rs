@@ -461,7 +461,8 @@ fn ply_raw(bytes: &[u8], path: &Path) -> Result<Raw, MeshError> {
 /// The PLY parser's header error as a plain line: `header line 2 `format weird 1.0` is not a
 /// PLY header line`, without the parser's own Debug dump of what it expected (issue 32).
 fn ply_header_message(e: &str) -> String {
-    let plain = e.split(" Error: ").next().unwrap_or(e);
+    let e = e.split_whitespace().collect::<Vec<_>>().join(" ");
+    let plain = e.split(" Error: ").next().unwrap_or(&e);
     let line = plain
         .strip_prefix("Line ")
         .and_then(|r| r.split(':').next())
