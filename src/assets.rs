@@ -14,10 +14,7 @@ pub fn write_thesis_assets(out: &Path) -> anyhow::Result<()> {
     create(out)?;
     for (name, mesh) in crate::objects::thesis_objects() {
         let path = out.join(format!("{name}.stl"));
-        let tmp = out.join(format!(".{name}.stl.tmp"));
-        std::fs::write(&tmp, mesh.to_binary_stl())
-            .and_then(|()| std::fs::rename(&tmp, &path))
-            .with_context(|| format!("{}: cannot write", path.display()))?;
+        write_atomically(&path, &mesh.to_binary_stl())?;
         println!("{}: {} triangles", path.display(), mesh.triangles.len());
     }
     // The tuning set, each object with a scenario (the thesis hand, defaults, expected to hold).

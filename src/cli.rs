@@ -299,9 +299,16 @@ pub struct BatchArgs {
     pub flags: RunFlags,
 }
 
+/// The longest time bound accepted `[s]`: a year (a larger one overflowed the timer and
+/// panicked, issue 32).
+const MAX_SECONDS: f64 = 31_536_000.0;
+
 fn positive_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
-        Ok(t) if t > 0.0 && t.is_finite() => Ok(t),
+        Ok(t) if t > 0.0 && t <= MAX_SECONDS => Ok(t),
+        Ok(t) if t > MAX_SECONDS => Err(format!(
+            "`{s}` seconds is more than the {MAX_SECONDS} (a year) a time bound may be"
+        )),
         _ => Err(format!("`{s}` is not a positive number of seconds")),
     }
 }

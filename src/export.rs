@@ -91,7 +91,8 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     let meshes = object_meshes(input);
     for (name, mesh) in &meshes {
         let path = dir.join(format!("{name}.stl"));
-        std::fs::write(&path, mesh.to_binary_stl()).map_err(|e| io_error(&path, e))?;
+        crate::files::write_replacing(&path, &mesh.to_binary_stl())
+            .map_err(|e| io_error(&path, e))?;
     }
     // Where the rapier check starts: the palm backed off and the fingers opened clear of the
     // object's collider (`sim::scene::start`).
@@ -110,12 +111,14 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     keys.write(&mut s);
     let _ = writeln!(s, "</mujoco>");
     let path = dir.join("scene.xml");
-    std::fs::write(&path, s).map_err(|e| io_error(&path, e))?;
+    crate::files::write_replacing(&path, s.as_bytes()).map_err(|e| io_error(&path, e))?;
 
     let path = dir.join("protocol.json");
-    std::fs::write(
+    crate::files::write_replacing(
         &path,
-        serde_json::to_string_pretty(&protocol(input, &keys)).unwrap_or_default(),
+        serde_json::to_string_pretty(&protocol(input, &keys))
+            .unwrap_or_default()
+            .as_bytes(),
     )
     .map_err(|e| io_error(&path, e))?;
     Ok(())
@@ -530,5 +533,5 @@ pub fn write_urdf(dir: &Path, hand: &Hand, sim: &SimParams) -> Result<(), Export
     }
     let _ = writeln!(s, "</robot>");
     let path = dir.join("hand.urdf");
-    std::fs::write(&path, s).map_err(|e| io_error(&path, e))
+    crate::files::write_replacing(&path, s.as_bytes()).map_err(|e| io_error(&path, e))
 }

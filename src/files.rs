@@ -1,7 +1,9 @@
 //! Reading input files safely: regular files only (a FIFO would block for ever, `/dev/zero`
 //! would never end), and at most a stated size, so that no input can hang the tool or exhaust
 //! its memory. Every reader of an input file (meshes, URDFs, scenarios, hands, results files,
-//! and the batch's input hash) goes through here.
+//! and the batch's input hash) goes through here. Every output file is written through
+//! [`write_replacing`]: a temporary file beside it, then a rename onto a regular file or a new
+//! path, so a reader never sees half a file and an error (a full disk) leaves none behind.
 
 use std::io::{self, Read};
 use std::path::Path;
@@ -150,6 +152,56 @@ pub fn check_replaceable(path: &Path) -> io::Result<()> {
     }
 }
 
+/// Writes `bytes` to `path` through a temporary file beside it (`.NAME.tmp`), synced, and a
+/// rename: `path` is then either its old self or whole. On any error, a full disk included,
+/// the temporary file is removed and `path` is left as it was. Only a regular file or a new
+/// path is replaced ([`check_replaceable`]).
+///
+/// Test hook, debug builds only: with `GRASP_SIM_TEST_FAULT=enospc:NAME`, writing a file whose
+/// path contains `NAME` writes half its bytes and then fails as a full disk does (`ENOSPC`),
+/// so the tests can show that nothing half-written remains. Release builds never read it.
+///
+/// # Errors
+/// [`check_replaceable`]'s, or the error creating, writing, syncing or renaming the file.
+pub fn write_replacing(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    use std::io::Write;
+    check_replaceable(path)?;
+    let dir = path
+        .parent()
+        .filter(|d| !d.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tmp = dir.join(format!(".{name}.tmp"));
+    let written = std::fs::File::create(&tmp).and_then(|mut f| {
+        if full_disk_fault(path) {
+            f.write_all(&bytes[..bytes.len() / 2])?;
+            return Err(io::Error::from_raw_os_error(28));
+        }
+        f.write_all(bytes)?;
+        f.sync_data()
+    });
+    written
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .inspect_err(|_| {
+            let _ = std::fs::remove_file(&tmp);
+        })
+}
+
+/// Whether the debug-build fault hook of [`write_replacing`] asks this write to fail.
+fn full_disk_fault(path: &Path) -> bool {
+    #[cfg(debug_assertions)]
+    if let Ok(fault) = std::env::var("GRASP_SIM_TEST_FAULT") {
+        if let Some(("enospc", name)) = fault.split_once(':') {
+            return path.to_string_lossy().contains(name);
+        }
+    }
+    let _ = path;
+    false
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -179,5 +231,22 @@ mod tests {
         assert_eq!(e.kind(), io::ErrorKind::InvalidData);
         assert_eq!(size(MAX_MESH_BYTES), "256 MiB");
         assert_eq!(size(MAX_RESULTS_BYTES), "1 GiB");
+    }
+
+    #[test]
+    fn a_replacing_write_is_whole_and_leaves_no_temporary_file() {
+        let dir = tempfile::tempdir().unwrap();
+        let f = dir.path().join("out.json");
+        std::fs::write(&f, b"old").unwrap();
+        write_replacing(&f, b"new contents").unwrap();
+        assert_eq!(std::fs::read(&f).unwrap(), b"new contents");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+        // A folder in the way of the rename: the error, the old folder kept, no temporary file.
+        let d = dir.path().join("taken");
+        std::fs::create_dir(&d).unwrap();
+        std::fs::write(d.join("x"), b"x").unwrap();
+        assert!(write_replacing(&d, b"data").is_err());
+        assert!(d.is_dir());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
     }
 }

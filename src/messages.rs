@@ -24,6 +24,28 @@ pub fn plural(n: usize, thing: &str) -> String {
     }
 }
 
+/// `message` with every number written in more than 24 characters (`1e300` printed in full is
+/// 301 digits) rewritten in the shortest exponent form that reads back the same (`1e300`), so
+/// that an error line about an absurd value stays one short line (issue 32).
+pub(crate) fn short_numbers(message: &str) -> String {
+    let mut out = String::with_capacity(message.len().min(512));
+    let mut rest = message;
+    while let Some(start) = rest.find(|c: char| c.is_ascii_digit()) {
+        let len = rest[start..]
+            .find(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .unwrap_or(rest.len() - start);
+        let token = &rest[start..start + len];
+        out.push_str(&rest[..start]);
+        match token.parse::<f64>() {
+            Ok(v) if token.len() > 24 => out.push_str(&format!("{v:e}")),
+            _ => out.push_str(token),
+        }
+        rest = &rest[start + len..];
+    }
+    out.push_str(rest);
+    out
+}
+
 /// A short, stable description of an I/O error.
 pub(crate) fn io_message(e: &std::io::Error) -> String {
     match e.kind() {
@@ -183,6 +205,15 @@ fn edit_distance(a: &str, b: &str) -> usize {
 #[cfg(test)]
 mod tests {
     use super::{did_you_mean, edit_distance, toml_message};
+
+    #[test]
+    fn absurd_numbers_are_written_short() {
+        let long = format!("must be in (0, 2], got {}", 1e300);
+        assert_eq!(long.len(), 23 + 301);
+        assert_eq!(super::short_numbers(&long), "must be in (0, 2], got 1e300");
+        let m = format!("got {} and {}", 123456.5, 1.5e-300);
+        assert_eq!(super::short_numbers(&m), "got 123456.5 and 1.5e-300");
+    }
 
     #[test]
     fn a_huge_offending_line_is_echoed_in_part() {

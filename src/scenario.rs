@@ -330,7 +330,7 @@ impl Scenario {
         let invalid = |key: &str, problem: String| ScenarioError::Invalid {
             path: path.to_path_buf(),
             key: key.to_string(),
-            problem,
+            problem: crate::messages::short_numbers(&problem),
         };
         let dir = path.parent().unwrap_or(Path::new("."));
         let o = raw.object;

@@ -136,23 +136,7 @@ impl Journal {
 /// # Errors
 /// [`BatchError::Io`] naming `path`.
 pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), BatchError> {
-    crate::files::check_replaceable(path).map_err(|e| BatchError::io(path, e))?;
-    let dir = path
-        .parent()
-        .filter(|d| !d.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp"));
-    File::create(&tmp)
-        .and_then(|mut f| f.write_all(bytes).and_then(|()| f.sync_data()))
-        .and_then(|()| std::fs::rename(&tmp, path))
-        .map_err(|e| {
-            let _ = std::fs::remove_file(&tmp);
-            BatchError::io(path, e)
-        })
+    crate::files::write_replacing(path, bytes).map_err(|e| BatchError::io(path, e))
 }
 
 /// The lock every batch run that writes `--out FILE` holds for its whole run, plain or

@@ -15,6 +15,7 @@
 mod align;
 mod load;
 mod mass;
+mod polygon_limits;
 pub mod primitives;
 pub mod slice;
 pub mod urdf;
@@ -23,7 +24,10 @@ pub use align::{
     align, align_about, align_with, align_with_rule, canonical_rotation, AlignedObject, FrameRule,
     GraspAxis,
 };
-pub use load::{load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh, MeshFormat};
+pub use load::{
+    check_planner_work, load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh,
+    MeshFormat,
+};
 pub use mass::{mass_properties, sliced_mass_properties, surface_mass_properties, MassProperties};
 
 use nalgebra::{Point3, Vector3};
@@ -182,6 +186,24 @@ pub enum MeshError {
         path: PathBuf,
         /// What is wrong.
         detail: String,
+    },
+    /// The object is so large for the planner's steps that its slices would not fit in memory
+    /// (issue 32): the planner holds a slice's crossings for every indexed elevation and every
+    /// approach angle.
+    #[error("{path}: the object is {extent_mm:.0} mm across: at height_step_mm = {height_step_mm} and angular_step_deg = {angular_step_deg} that is {cells} elevation-angle cells for the planner, more than the {limit} it takes (check the units, or plan in coarser steps)")]
+    TooLarge {
+        /// The mesh file.
+        path: PathBuf,
+        /// The diagonal of its bounding box `[mm]`.
+        extent_mm: f64,
+        /// The planner's height step `[mm]`.
+        height_step_mm: f64,
+        /// The planner's angular step `[deg]`.
+        angular_step_deg: f64,
+        /// Indexed elevations (at most) times approach angles.
+        cells: u64,
+        /// The most cells the planner takes.
+        limit: u64,
     },
     /// The surface encloses no volume, so it has no mass properties or principal axis.
     #[error("{path}: the surface encloses no volume ({volume_mm3:.3e} mm^3): not a closed solid")]

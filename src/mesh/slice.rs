@@ -910,7 +910,11 @@ pub fn join_open(contours: &mut Vec<Contour>, tol: f64) -> bool {
     let open: Vec<usize> = (0..contours.len())
         .filter(|&i| !contours[i].is_closed)
         .collect();
-    if open.is_empty() || tol.is_nan() || tol <= 0.0 {
+    if open.is_empty()
+        || tol.is_nan()
+        || tol <= 0.0
+        || !super::polygon_limits::join_allowed(open.len())
+    {
         return false;
     }
     let Some((next, has_prev)) = links(contours, &open, tol) else {
@@ -978,19 +982,17 @@ fn links(
     let last = |i: usize| *contours[i].points.last().expect("a contour has points");
     // Candidate links (end of a → start of b), nearest first; ties broken by index so the
     // result is deterministic.
-    let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-    for &a in open {
-        for &b in open {
-            let d = (first(b) - last(a)).norm();
-            if d <= tol {
-                pairs.push((d, a, b));
-            }
-        }
-    }
+    let (ends, starts): (Vec<[f64; 2]>, Vec<[f64; 2]>) = open
+        .iter()
+        .map(|&i| ([last(i).x, last(i).y], [first(i).x, first(i).y]))
+        .unzip();
+    let pairs: Vec<(f64, usize, usize)> = super::polygon_limits::pairs_within(&ends, &starts, tol)?
+        .into_iter()
+        .map(|(d, a, b)| (d, open[a], open[b]))
+        .collect();
     if pairs.is_empty() {
         return None;
     }
-    pairs.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)).then(x.2.cmp(&y.2)));
     let mut next: HashMap<usize, usize> = HashMap::new();
     let mut has_prev: HashSet<usize> = HashSet::new();
     for &(_, a, b) in &pairs {
@@ -1023,9 +1025,7 @@ fn has_overlapping_outers(contours: &[Contour]) -> bool {
 /// shells become one outline, a hole stays a hole where no other shell fills it. Open contours
 /// are kept as they are.
 fn union_closed(contours: Vec<Contour>) -> Vec<Contour> {
-    use i_overlay::core::fill_rule::FillRule;
-    use i_overlay::float::simplify::SimplifyShape;
-    map_closed(contours, |rings| rings.simplify_shape(FillRule::NonZero))
+    map_closed(contours, super::polygon_limits::union_rings)
 }
 
 /// Applies a polygon operation of i_overlay to the closed contours (as float rings) and turns
@@ -1238,15 +1238,12 @@ fn outward_offset(q: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> f64 {
 /// Morphological closing of the closed contours by a polygon of inradius `r` (i_overlay's outline
 /// offset, grown then shrunk); open contours are kept as they are.
 fn close_gaps(contours: Vec<Contour>, r: f64) -> Vec<Contour> {
-    use i_overlay::mesh::float::outline::offset::OutlineOffset;
-    use i_overlay::mesh::float::style::{LineJoin, OutlineStyle};
     // Bevel joins: the structuring element is then a polygon rather than a disc (convex corners
     // come back exactly, a bridged gap's edge is straight to within r (1 - cos(turn / 2))), and
     // the offset makes no arc points, which on a slice of many pieces costs several times more
     // than the rest of the planner.
     map_closed(contours, |rings| {
-        let grown = rings.outline(&OutlineStyle::new(r).line_join(LineJoin::Bevel));
-        grown.outline(&OutlineStyle::new(-r).line_join(LineJoin::Bevel))
+        super::polygon_limits::close_rings(rings, r)
     })
 }
 

@@ -125,8 +125,10 @@ pub(crate) fn resolve(path: &Path, filename: &str) -> Option<PathBuf> {
         }
         return None;
     }
+    // Anything there (a folder, a FIFO, a device) is returned, so that reading it says what it
+    // is rather than "not found".
     let p = dir.join(filename);
-    p.is_file().then_some(p)
+    p.exists().then_some(p)
 }
 
 /// The geometry of one `<visual>` or `<collision>` element, or why it cannot be read.

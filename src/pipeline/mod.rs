@@ -240,6 +240,13 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
 pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Error> {
     let mut timings = StageTimings::default();
     let object = PreparedObject::load(&scenario.object, &mut timings)?;
+    let p = &scenario.planner;
+    mesh::check_planner_work(
+        object.mesh(),
+        &scenario.object.mesh,
+        p.height_step_mm,
+        p.angular_step_deg,
+    )?;
     let selection = select_grasps(scenario, options, &object, &mut timings);
     let qualities = qualities(scenario, options, &selection);
     let plan = build::plan_report(scenario, &selection, &qualities, timings);

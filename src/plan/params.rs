@@ -42,6 +42,11 @@ pub struct PlannerParams {
 /// The default [`PlannerParams::candidate_budget`]: a rule set's candidates over all axes.
 pub const DEFAULT_CANDIDATE_BUDGET: usize = 1500;
 
+/// The largest [`PlannerParams::candidate_budget`] accepted (issue 32): a million candidates per
+/// rule set, hours of search, far past what any object needs (the default is 1500); a larger
+/// budget is a mistyped one.
+pub const MAX_CANDIDATE_BUDGET: usize = 1_000_000;
+
 impl Default for PlannerParams {
     fn default() -> Self {
         PlannerParams {
@@ -73,6 +78,15 @@ impl PlannerParams {
     /// `(key, problem)`.
     pub fn validate(&self, hand: &Hand, friction: f64) -> Result<(), (&'static str, String)> {
         let p = self;
+        if p.candidate_budget > MAX_CANDIDATE_BUDGET {
+            return Err((
+                "planner.candidate_budget",
+                format!(
+                    "must be at most {MAX_CANDIDATE_BUDGET} (0: no limit), got {}",
+                    p.candidate_budget
+                ),
+            ));
+        }
         p.validate_height_step(hand)?;
         let a = p.angular_step_deg;
         if a.is_finite() && a > 0.0 && a < MIN_ANGULAR_STEP_DEG {
@@ -138,7 +152,9 @@ impl PlannerParams {
             ));
         }
         let ratio = hand.fingers.gap_mm / step;
-        if (ratio - ratio.round()).abs() > 1e-9 * ratio.max(1.0) {
+        // A step longer than the gap divides it zero times, which is no division (issue 32:
+        // 1e308 passed as dividing 20 mm, giving one elevation).
+        if ratio.round() < 1.0 || (ratio - ratio.round()).abs() > 1e-9 * ratio.max(1.0) {
             return Err((
                 "planner.height_step_mm",
                 format!(

@@ -83,7 +83,7 @@ pub fn write_report(
     remove_stale(dir, &written, &scenes)?;
     let path = dir.join("report.html");
     let page = html::page(report, &figs, &scenes, (&view_figs, &view_legend));
-    std::fs::write(&path, page).map_err(|e| export_error(&path, e))?;
+    crate::files::write_replacing(&path, page.as_bytes()).map_err(|e| export_error(&path, e))?;
     Ok(figs.into_iter().chain(view_figs).map(|(n, _)| n).collect())
 }
 
@@ -131,7 +131,7 @@ fn stage_figures(
 fn write_svgs(dir: &Path, figs: &[(String, String)]) -> Result<(), ExportError> {
     for (name, svg) in figs {
         let path = dir.join(format!("{name}.svg"));
-        std::fs::write(&path, svg).map_err(|e| export_error(&path, e))?;
+        crate::files::write_replacing(&path, svg.as_bytes()).map_err(|e| export_error(&path, e))?;
     }
     Ok(())
 }
@@ -153,14 +153,15 @@ fn write_scenes(
         nalgebra::UnitQuaternion::identity(),
     ));
     let path = dir.join("grasp_planned.glb");
-    std::fs::write(&path, glb::glb(&bodies)).map_err(|e| export_error(&path, e))?;
+    crate::files::write_replacing(&path, &glb::glb(&bodies)).map_err(|e| export_error(&path, e))?;
     scenes.push("grasp_planned.glb");
     if let Some(poses) = simulated.filter(|p| p.len() == planned.len() + 1) {
         let mut bodies = glb::hand_bodies(hand, &poses[..planned.len()]);
         let (t, r) = poses[planned.len()];
         bodies.push(glb::object_body(mesh, t, r));
         let path = dir.join("grasp_simulated.glb");
-        std::fs::write(&path, glb::glb(&bodies)).map_err(|e| export_error(&path, e))?;
+        crate::files::write_replacing(&path, &glb::glb(&bodies))
+            .map_err(|e| export_error(&path, e))?;
         scenes.push("grasp_simulated.glb");
     }
     Ok(scenes)

@@ -552,3 +552,323 @@ fn a_urdf_that_is_not_a_tree_of_its_links_is_refused() {
         refused(&out, &["t.urdf", needle]);
     }
 }
+
+/// A binary STL of `triangles`.
+fn binary_stl(triangles: &[[[f32; 3]; 3]]) -> Vec<u8> {
+    let mut b = vec![0u8; 80];
+    b.extend((triangles.len() as u32).to_le_bytes());
+    for t in triangles {
+        b.extend([0u8; 12]);
+        for p in t {
+            for c in p {
+                b.extend(c.to_le_bytes());
+            }
+        }
+        b.extend([0u8; 2]);
+    }
+    b
+}
+
+/// The 12 outward triangles of the axis-aligned cube of side `s` with its low corner at `o`.
+fn cube(o: [f32; 3], s: f32) -> Vec<[[f32; 3]; 3]> {
+    let c = |i: usize| {
+        [
+            o[0] + s * (i & 1) as f32,
+            o[1] + s * ((i >> 1) & 1) as f32,
+            o[2] + s * ((i >> 2) & 1) as f32,
+        ]
+    };
+    // Faces as corner quads, counter-clockwise seen from outside.
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    quads
+        .iter()
+        .flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]])
+        .collect()
+}
+
+/// The JSON line of a `--no-sim --json` run of `path`, which must exit 0 within the given time
+/// bound (a hang would be reported past it, as an error line).
+fn plan_json(path: &std::path::Path) -> serde_json::Value {
+    let out = grasp_sim()
+        .args(["--no-sim", "--json", "--time-limit", "300"])
+        .arg(path)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// Thirty overlapping 20 mm cubes, each 1 mm above the last, in one mesh (18 KB): one union of
+/// all their cuts in i_overlay grew past 4 GB and aborted. Now the union is taken two shapes at
+/// a time, and the volume is the union's: 20 × 20 × 49 mm³, not 30 cubes' 240,000.
+#[test]
+fn thirty_stacked_overlapping_cubes_unite_to_their_volume() {
+    let dir = tempfile::tempdir().unwrap();
+    let tris: Vec<_> = (0..30)
+        .flat_map(|k| cube([0.0, 0.0, k as f32], 20.0))
+        .collect();
+    let path = dir.path().join("cubes30.stl");
+    std::fs::write(&path, binary_stl(&tris)).unwrap();
+    assert_eq!(std::fs::metadata(&path).unwrap().len(), 84 + 50 * 360);
+    let v = plan_json(&path);
+    let vol = v["object"]["volume_mm3"].as_f64().unwrap();
+    assert!((vol - 19_600.0).abs() < 1.0, "{vol}");
+    assert_eq!(v["object"]["height_mm"].as_f64().unwrap(), 49.0);
+}
+
+/// A URDF chain of 300 overlapping 1 mm boxes, each 0.5 mm along x from its parent (more than
+/// 100 s before, in the open-end join: every other box shares corners with the next but one, so
+/// the welded mesh is not manifold and each cut is thousands of open pieces, which the join
+/// tested all against all; now through a grid). It ends, a bar 1 mm thick, too thin for the
+/// hand. The same chain stepped 0.2 mm up as well (no shared corners, a closed union) has the
+/// union's volume, 300 − 299 × (0.5 × 1 × 0.8) = 180.4 mm³.
+#[test]
+fn a_chain_of_three_hundred_overlapping_boxes_ends_with_its_volume() {
+    let dir = tempfile::tempdir().unwrap();
+    for (step, volume) in [("0.0005 0 0", None), ("0.0005 0 0.0002", Some(180.4))] {
+        let mut urdf = String::from("<robot name=\"chain\">");
+        let b = "<geometry><box size=\"0.001 0.001 0.001\"/></geometry>";
+        for k in 0..300 {
+            urdf += &format!("<link name=\"l{k}\"><visual>{b}</visual></link>");
+            if k > 0 {
+                urdf += &format!(
+                    "<joint name=\"j{k}\" type=\"fixed\"><parent link=\"l{}\"/><child link=\"l{k}\"/><origin xyz=\"{step}\"/></joint>",
+                    k - 1
+                );
+            }
+        }
+        urdf += "</robot>\n";
+        let path = dir.path().join("chain300.urdf");
+        std::fs::write(&path, urdf).unwrap();
+        let v = plan_json(&path);
+        let reason = v["plan"]["reason"].as_str().unwrap_or_default();
+        assert!(reason.starts_with("too thin"), "{step}: {reason}");
+        let vol = v["object"]["volume_mm3"].as_f64().unwrap();
+        if let Some(volume) = volume {
+            assert!((vol - volume).abs() < 0.005 * volume, "{step}: {vol}");
+        }
+    }
+}
+
+/// An OBJ cylinder (64 segments, 20 mm radius, 60 mm tall) whose face indices are off by one:
+/// one extra `v` line before it. Its faces are then a tangle of slivers; it ends, with or
+/// without a grasp, and the well-indexed one has the 64-gon prism's volume.
+#[test]
+fn an_obj_with_indices_off_by_one_ends() {
+    let dir = tempfile::tempdir().unwrap();
+    let cylinder = |extra: bool| {
+        let n = 64;
+        let mut s = String::new();
+        if extra {
+            s += "v 0 0 0\n";
+        }
+        for i in 0..n {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let (x, y) = (20.0 * a.cos(), 20.0 * a.sin());
+            s += &format!("v {x} {y} 0\nv {x} {y} 60\n");
+        }
+        s += "v 0 0 0\nv 0 0 60\n";
+        for i in 0..n {
+            let j = (i + 1) % n;
+            let (b0, t0, b1, t1) = (2 * i + 1, 2 * i + 2, 2 * j + 1, 2 * j + 2);
+            s += &format!("f {b0} {b1} {t1}\nf {b0} {t1} {t0}\n");
+            s += &format!("f {} {b1} {b0}\nf {} {t0} {t1}\n", 2 * n + 1, 2 * n + 2);
+        }
+        s
+    };
+    let good = dir.path().join("good.obj");
+    std::fs::write(&good, cylinder(false)).unwrap();
+    let vol = plan_json(&good)["object"]["volume_mm3"].as_f64().unwrap();
+    let prism = 0.5 * 64.0 * 400.0 * (std::f64::consts::TAU / 64.0).sin() * 60.0;
+    assert!((vol - prism).abs() < 1e-6 * prism, "{vol} vs {prism}");
+    let bad = dir.path().join("off_by_one.obj");
+    std::fs::write(&bad, cylinder(true)).unwrap();
+    let out = grasp_sim()
+        .args(["--no-sim", "--json", "--time-limit", "300"])
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !err.contains("panicked") && !err.contains("no result within"),
+        "{err}"
+    );
+    assert!(matches!(out.status.code(), Some(0) | Some(2)), "{err}");
+}
+
+/// A full disk while an output is written (the debug build's fault hook fails the write of the
+/// named file half-way with ENOSPC): exit 2 with one line naming the file, and neither the file
+/// nor its temporary remains, for `--export-mjcf`, `--export-urdf`, `--report` and `gen-assets`.
+#[test]
+fn a_full_disk_leaves_no_half_written_output() {
+    let cases: [(&[&str], &str, &str); 4] = [
+        (&["--no-sim", "--export-mjcf"], "scene.xml", "cup"),
+        (&["--no-sim", "--export-urdf"], "hand.urdf", "cup"),
+        (&["--no-sim", "--report"], "report.html", "cup"),
+        (&["gen-assets", "--out"], "prism.stl", ""),
+    ];
+    for (args, file, sub) in cases {
+        let dir = tempfile::tempdir().unwrap();
+        let mut cmd = grasp_sim();
+        cmd.args(args)
+            .arg(dir.path())
+            .env("GRASP_SIM_TEST_FAULT", format!("enospc:{file}"));
+        if sub == "cup" {
+            cmd.arg("scenarios/cup.toml");
+        }
+        let out = cmd.output().unwrap();
+        refused(&out, &[file]);
+        let folder = dir.path().join(sub);
+        let names: Vec<String> = std::fs::read_dir(&folder)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        assert!(
+            !names
+                .iter()
+                .any(|n| n.contains(file) || n.ends_with(".tmp")),
+            "{file}: {names:?}"
+        );
+    }
+}
+
+/// An output whose rename must fail (a folder where `hand.urdf` goes): exit 2 naming it, the
+/// folder left as it was, and no temporary file beside it.
+#[test]
+fn an_output_that_cannot_be_renamed_into_place_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let taken = dir.path().join("cup/hand.urdf");
+    std::fs::create_dir_all(taken.join("inside")).unwrap();
+    let out = grasp_sim()
+        .args(["--no-sim", "--export-urdf"])
+        .arg(dir.path())
+        .arg("scenarios/cup.toml")
+        .output()
+        .unwrap();
+    refused(&out, &["hand.urdf"]);
+    assert!(taken.join("inside").is_dir());
+    assert_eq!(
+        std::fs::read_dir(dir.path().join("cup")).unwrap().count(),
+        1
+    );
+}
+
+/// Absurd values are refused in a short line: a friction of 1e300 is written `1e300`, not in
+/// 301 digits; a candidate budget of u64::MAX is past the stated cap; an unknown PLY format is
+/// named in words, not as the parser's Debug dump.
+#[test]
+fn absurd_values_get_short_plain_messages() {
+    let dir = tempfile::tempdir().unwrap();
+    let mesh = crate::root().join("assets/objects/cylinder_d40.stl");
+    let scenario = |name: &str, extra: &str, object: &str| {
+        let p = dir.path().join(name);
+        std::fs::write(
+            &p,
+            format!(
+                "name = \"x\"\n{extra}\n[object]\nmesh = \"{}\"\n{object}\n",
+                mesh.display()
+            ),
+        )
+        .unwrap();
+        p
+    };
+    let friction = scenario("friction.toml", "", "friction = 1e300");
+    let out = grasp_sim().arg("--no-sim").arg(&friction).output().unwrap();
+    let line = refused(&out, &["object.friction", "got 1e300"]);
+    assert!(line.len() < 200, "{line}");
+    let budget = scenario(
+        "budget.toml",
+        &format!("[planner]\ncandidate_budget = {}\n", u64::MAX),
+        "",
+    );
+    let out = grasp_sim().arg("--no-sim").arg(&budget).output().unwrap();
+    let text = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(out.status.code(), Some(2), "{text}");
+    assert!(text.contains("candidate_budget"), "{text}");
+    let budget = scenario(
+        "budget2.toml",
+        "[planner]\ncandidate_budget = 1000001\n",
+        "",
+    );
+    let out = grasp_sim().arg("--no-sim").arg(&budget).output().unwrap();
+    refused(&out, &["planner.candidate_budget", "at most 1000000"]);
+    let ply = dir.path().join("weird.ply");
+    std::fs::write(
+        &ply,
+        "ply\nformat weird 1.0\nelement vertex 0\nend_header\n",
+    )
+    .unwrap();
+    let out = grasp_sim().arg("--no-sim").arg(&ply).output().unwrap();
+    let line = refused(&out, &["weird.ply", "header line 2 `format weird 1.0`"]);
+    assert!(
+        !line.contains("ParseError") && !line.contains('{'),
+        "{line}"
+    );
+}
+
+/// A 1 km cube (a file in millimetres read as such, 600 bytes) asked the planner for 400,000
+/// elevations at every approach angle and aborted past 4 GB. The planner's work is bounded by
+/// the object's extent over its steps, with the limit stated; a 10 m cube at the defaults still
+/// plans, and refused at `height_step_mm = 0.1`.
+#[test]
+fn an_object_too_large_for_the_planner_steps_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let km = dir.path().join("km.stl");
+    std::fs::write(&km, binary_stl(&cube([0.0; 3], 1e6))).unwrap();
+    let out = grasp_sim().arg("--no-sim").arg(&km).output().unwrap();
+    refused(
+        &out,
+        &["km.stl", "elevation-angle cells", "more than the 400000"],
+    );
+    let ten = dir.path().join("ten.stl");
+    std::fs::write(&ten, binary_stl(&cube([0.0; 3], 1e4))).unwrap();
+    let v = plan_json(&ten);
+    assert!((v["object"]["volume_mm3"].as_f64().unwrap() - 1e12).abs() < 1e3);
+    let fine = dir.path().join("fine.toml");
+    std::fs::write(
+        &fine,
+        "name = \"fine\"\n[planner]\nheight_step_mm = 0.1\n[object]\nmesh = \"ten.stl\"\n",
+    )
+    .unwrap();
+    let out = grasp_sim().arg("--no-sim").arg(&fine).output().unwrap();
+    refused(
+        &out,
+        &[
+            "ten.stl",
+            "height_step_mm = 0.1",
+            "3117708 elevation-angle cells",
+        ],
+    );
+}
+
+/// From the probe (issue 32): a time bound of 1e300 s overflowed the timer and panicked (now
+/// refused, the cap stated); a URDF naming a mesh that is a link to `/dev/zero` said "not
+/// found" (now: what it is).
+#[test]
+fn probe_findings_are_plain_errors() {
+    let out = grasp_sim()
+        .args(["--no-sim", "--time-limit", "1e300", "scenarios/cup.toml"])
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(!err.contains("panicked") && err.contains("a year"), "{err}");
+    let dir = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink("/dev/zero", dir.path().join("zero.stl")).unwrap();
+    let urdf = dir.path().join("r.urdf");
+    std::fs::write(
+        &urdf,
+        "<robot name=\"r\"><link name=\"a\"><visual><geometry><mesh filename=\"zero.stl\"/></geometry></visual></link></robot>\n",
+    )
+    .unwrap();
+    let out = grasp_sim().arg("--no-sim").arg(&urdf).output().unwrap();
+    refused(&out, &["zero.stl", "not a regular file (a device)"]);
+}
