@@ -252,21 +252,7 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
     let plan = build::plan_report(scenario, &selection, &qualities, timings);
     let checked_axis = checked_axis(options, &selection)?;
     let checked_on = checked_axis.map_or(&object.aligned, |i| &selection.axes[i].aligned);
-    let posed = match &options.given {
-        Some(given) => Ok((
-            given
-                .pose_in(checked_on, scenario.hand.finger_list.len())
-                .map_err(Error::Given)?,
-            GraspSource::Given,
-            None,
-        )),
-        None => sim_pose(
-            scenario,
-            checked_on,
-            &selection.axes[0].graded,
-            selection.chosen().map(|c| (&c.grasp, c.check.clone())),
-        ),
-    };
+    let posed = posed(scenario, options, &selection, checked_on)?;
     let (sim, sim_poses, ran) = run_sim(scenario, options, &object, checked_on, &posed);
     // A check that ran here (not in the candidate search: `override_angles`) closed its own
     // grip: the quality is that grip's, not the planned contacts'.
@@ -316,6 +302,33 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
         selection,
         sim_poses,
         checked_axis,
+    })
+}
+
+/// The pose to check on `checked_on`: the given grasp's, else [`sim_pose`]'s.
+///
+/// # Errors
+/// [`Error::Given`] for a given grasp that cannot be posed.
+fn posed(
+    scenario: &Scenario,
+    options: &RunOptions,
+    selection: &select::Selection,
+    checked_on: &mesh::AlignedObject,
+) -> Result<Posed, Error> {
+    Ok(match &options.given {
+        Some(given) => Ok((
+            given
+                .pose_in(checked_on, scenario.hand.finger_list.len())
+                .map_err(Error::Given)?,
+            GraspSource::Given,
+            None,
+        )),
+        None => sim_pose(
+            scenario,
+            checked_on,
+            &selection.axes[0].graded,
+            selection.chosen().map(|c| (&c.grasp, c.check.clone())),
+        ),
     })
 }
 
