@@ -1135,6 +1135,7 @@ pub fn check_planner_work(
             u64::MAX
         },
         limit: MAX_PLANNER_CELLS,
+        hint: String::new(),
     })
 }
 

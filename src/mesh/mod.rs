@@ -190,7 +190,7 @@ pub enum MeshError {
     /// The object is so large for the planner's steps that its slices would not fit in memory
     /// (issue 32): the planner holds a slice's crossings for every indexed elevation and every
     /// approach angle.
-    #[error("{path}: the object is {extent_mm:.0} mm across: at height_step_mm = {height_step_mm} and angular_step_deg = {angular_step_deg} that is {cells} elevation-angle cells for the planner, more than the {limit} it takes (check the units, or plan in coarser steps)")]
+    #[error("{path}: the object is {extent_mm:.0} mm across: at height_step_mm = {height_step_mm} and angular_step_deg = {angular_step_deg} that is {cells} elevation-angle cells for the planner, more than the {limit} it takes (check the units, or plan in coarser steps){hint}")]
     TooLarge {
         /// The mesh file.
         path: PathBuf,
@@ -204,6 +204,8 @@ pub enum MeshError {
         cells: u64,
         /// The most cells the planner takes.
         limit: u64,
+        /// `; ` and the units warning when the size is implausible for a hand (else empty).
+        hint: String,
     },
     /// The surface encloses no volume, so it has no mass properties or principal axis.
     #[error("{path}: the surface encloses no volume ({volume_mm3:.3e} mm^3): not a closed solid")]

@@ -246,7 +246,16 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
         &scenario.object.mesh,
         p.height_step_mm,
         p.angular_step_deg,
-    )?;
+    )
+    .map_err(|mut e| {
+        // An object too large for the planner is most often one read in the wrong unit: say so.
+        if let mesh::MeshError::TooLarge { hint, .. } = &mut e {
+            if let Some(w) = object.loaded.units_warning() {
+                *hint = format!("; {w}");
+            }
+        }
+        e
+    })?;
     let selection = select_grasps(scenario, options, &object, &mut timings);
     let qualities = qualities(scenario, options, &selection);
     let plan = build::plan_report(scenario, &selection, &qualities, timings);
