@@ -174,6 +174,26 @@ pub struct Derived {
     pub zero_theta_deg: Vec<[f64; 2]>,
 }
 
+/// A hand file's text, read as a regular file under the text cap and refused when its elements
+/// nest deeper than the URDF reader's limit; `kind` names the format in the message (`a URDF`).
+pub(crate) fn read_xml_text(path: &Path, kind: &str) -> Result<String, HandError> {
+    use crate::mesh::urdf::{nesting_deeper_than, MAX_DEPTH};
+    let text =
+        crate::files::read_regular_string(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
+            HandError::Io {
+                path: path.to_path_buf(),
+                error: e,
+            }
+        })?;
+    if let Some(depth) = nesting_deeper_than(&text, MAX_DEPTH) {
+        return Err(err(
+            path,
+            format!("elements nested {depth} deep; {kind} is read to at most {MAX_DEPTH} levels"),
+        ));
+    }
+    Ok(text)
+}
+
 pub(crate) fn err(path: &Path, message: impl Into<String>) -> HandError {
     HandError::Parse {
         path: path.to_path_buf(),

@@ -11,7 +11,6 @@
 
 use super::import::{err, FileCoupling, Geom, GeomShape, Joint, JointKind, Link, Tree};
 use super::HandError;
-use crate::mesh::urdf::{nesting_deeper_than, MAX_DEPTH};
 use nalgebra::{Isometry3, Point3, Translation3, Unit, UnitQuaternion, Vector3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -371,19 +370,7 @@ fn equality(cx: &Context, root: roxmltree::Node, tree: &mut Tree) -> Result<(), 
 /// `<mujoco>`, no `<worldbody>`, a body with two joints, a mesh that is not there, malformed
 /// numbers.
 pub fn read(path: &Path) -> Result<Tree, HandError> {
-    let text =
-        crate::files::read_regular_string(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
-            HandError::Io {
-                path: path.to_path_buf(),
-                error: e,
-            }
-        })?;
-    if let Some(depth) = nesting_deeper_than(&text, MAX_DEPTH) {
-        return Err(err(
-            path,
-            format!("elements nested {depth} deep; an MJCF is read to at most {MAX_DEPTH} levels"),
-        ));
-    }
+    let text = super::import::read_xml_text(path, "an MJCF")?;
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| err(path, format!("not well-formed XML: {e}")))?;
     let root = doc.root_element();

@@ -9,7 +9,7 @@
 
 use super::import::{err, FileCoupling, Geom, GeomShape, Joint, JointKind, Link, Tree};
 use super::HandError;
-use crate::mesh::urdf::{element_geometry, nesting_deeper_than, numbers, origin, Shape, MAX_DEPTH};
+use crate::mesh::urdf::{element_geometry, numbers, origin, Shape};
 use crate::mesh::MeshError;
 use nalgebra::{Isometry3, Point3, Translation3, Unit, Vector3};
 use std::path::Path;
@@ -185,19 +185,7 @@ fn joint(
 /// `<robot>`, a joint without links or naming a missing one, a link with two parents, a mesh
 /// that is not there, malformed numbers.
 pub fn read(path: &Path) -> Result<Tree, HandError> {
-    let text =
-        crate::files::read_regular_string(path, crate::files::MAX_TEXT_BYTES).map_err(|e| {
-            HandError::Io {
-                path: path.to_path_buf(),
-                error: e,
-            }
-        })?;
-    if let Some(depth) = nesting_deeper_than(&text, MAX_DEPTH) {
-        return Err(err(
-            path,
-            format!("elements nested {depth} deep; a URDF is read to at most {MAX_DEPTH} levels"),
-        ));
-    }
+    let text = super::import::read_xml_text(path, "a URDF")?;
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| err(path, format!("not well-formed XML: {e}")))?;
     let robot = doc.root_element();
