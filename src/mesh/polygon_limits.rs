@@ -30,9 +30,35 @@ pub const DIRECT_RINGS: usize = 4;
 /// open pieces is left open (and reported so) rather than joined.
 pub const MAX_JOIN_OPEN: usize = 20_000;
 
+/// The thinnest ring the union and the closing take `[mm]`, as its mean width (twice its area
+/// over its perimeter). A thinner ring encloses no material a finger can feel: it is the cut of
+/// a degenerate or flattened face. Such rings are dropped, since i_overlay's split solver takes
+/// time without bound on many of them: a 135-byte OBJ of near-collinear faces gave 500 rings
+/// 1e-9 mm wide, whose 7 mm closing took 41 s (fuzz finding, issue 32).
+pub const MIN_RING_WIDTH_MM: f64 = 1e-3;
+
+/// `rings` without those thinner than [`MIN_RING_WIDTH_MM`] (see there), in their order.
+fn material(mut rings: Vec<Ring>) -> Vec<Ring> {
+    rings.retain(|r| area2(r).abs() > MIN_RING_WIDTH_MM * perimeter(r));
+    rings
+}
+
+/// The length of a closed ring's boundary `[mm]`.
+fn perimeter(ring: &Ring) -> f64 {
+    let n = ring.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (ring[i], ring[(i + 1) % n]);
+            (b[0] - a[0]).hypot(b[1] - a[1])
+        })
+        .sum()
+}
+
 /// The union of `rings` by the non-zero rule, bounded: one call of i_overlay for at most
-/// [`DIRECT_RINGS`] rings, a balanced tree of unions of two shapes each above that.
+/// [`DIRECT_RINGS`] rings, a balanced tree of unions of two shapes each above that. Rings
+/// thinner than [`MIN_RING_WIDTH_MM`] are left out.
 pub fn union_rings(rings: Vec<Ring>) -> Shapes {
+    let rings = material(rings);
     if rings.len() <= DIRECT_RINGS {
         return rings.simplify_shape(FillRule::NonZero);
     }
@@ -52,7 +78,9 @@ pub fn union_rings(rings: Vec<Ring>) -> Shapes {
 /// The morphological closing of `rings` by a bevel-joined polygon of inradius `r` (grown by
 /// `r`, then shrunk by `r`), bounded: in one call for at most [`DIRECT_RINGS`] rings, else each
 /// shape grown on its own, the grown shapes united as in [`union_rings`], and the union shrunk.
+/// Rings thinner than [`MIN_RING_WIDTH_MM`] are left out.
 pub fn close_rings(rings: Vec<Ring>, r: f64) -> Shapes {
+    let rings = material(rings);
     let grow = OutlineStyle::new(r).line_join(LineJoin::Bevel);
     let shrink = OutlineStyle::new(-r).line_join(LineJoin::Bevel);
     if rings.len() <= DIRECT_RINGS {
@@ -288,6 +316,33 @@ mod tests {
     /// The closing of many overlapping turned squares is bounded, and bridges a 1 mm gap to a
     /// square beside them (the grown shapes meet): one outline, with most of the 20 mm² gap
     /// filled (the bevelled corners of the bridge keep about 1 mm² of it open).
+    /// Rings thinner than a micrometre (the cut of flattened faces, 1e-9 mm wide) are left out of
+    /// the union and the closing, whatever their length; a ring 0.01 mm wide is kept, and two
+    /// 1 mm × 20 mm strips 10 mm apart are still bridged by a 7 mm closing into one shape
+    /// 1 + 10 + 1 mm wide.
+    #[test]
+    fn rings_thinner_than_a_micrometre_are_no_material() {
+        let strip = |x0: f64, w: f64| -> Ring {
+            vec![[x0, 0.0], [x0 + w, 0.0], [x0 + w, 20.0], [x0, 20.0]]
+        };
+        let sliver: Ring = vec![[0.0, 0.0], [30.0, 1e-9], [15.0, 1e-9], [30.0, 2e-9]];
+        assert!(union_rings(vec![sliver.clone(); 3]).is_empty());
+        assert!(close_rings(vec![sliver.clone(); 500], 7.0).is_empty());
+        let thin = union_rings(vec![strip(0.0, 0.01)]);
+        assert_eq!(thin.len(), 1);
+        let a = area2(&thin[0][0]).abs() / 2.0;
+        assert!((a - 0.2).abs() < 1e-4, "{a}");
+        let mut rings = vec![strip(0.0, 1.0), strip(11.0, 1.0)];
+        rings.extend(vec![sliver; 6]);
+        let closed = close_rings(rings, 7.0);
+        assert_eq!(closed.len(), 1, "{closed:?}");
+        let xs: Vec<f64> = closed[0][0].iter().map(|p| p[0]).collect();
+        let (lo, hi) = xs
+            .iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)));
+        assert!(lo.abs() < 1e-6 && (hi - 12.0).abs() < 1e-6, "{lo} {hi}");
+    }
+
     #[test]
     fn the_closing_of_many_shapes_is_bounded_and_bridges_gaps() {
         let mut rings: Vec<Ring> = (0..30)
