@@ -24,12 +24,13 @@ use grasp_sim::sim::{EarlyDecision, Verdict};
 use grasp_sim::{run, RunOptions};
 
 /// (window `[s]`, margin) pairs studied.
-const RULES: [(f64, f64); 8] = [
+const RULES: [(f64, f64); 9] = [
     (0.1, 1.0),
     (0.2, 1.0),
     (0.3, 1.0),
     (0.5, 1.0),
     (0.1, 0.8),
+    (0.15, 0.8),
     (0.2, 0.8),
     (0.3, 0.8),
     (0.5, 0.8),

@@ -12,6 +12,8 @@ the same closing rule; its simulation loop timed alone). Prints one Markdown row
 (each variant's verdict and wall time, MuJoCo's, agreement) and per variant: how many verdicts
 agree with MuJoCo's, the sum of the checks' wall times against MuJoCo's, and D40's ratio.
 --json writes {variant: {scenario: {"rapier", "mujoco", "agree", "rapier_ms", "mujoco_ms"}}}.
+--mujoco-from FILE takes MuJoCo's verdicts and times from such a file (an earlier run's, same
+scenarios) instead of exporting and replaying again: more variants judged against one replay.
 """
 import argparse
 import json
@@ -69,6 +71,7 @@ def main():
     ap.add_argument("--out", default=str(ROOT / "out" / "engine_agreement"))
     ap.add_argument("--variant", action="append", default=[], metavar="NAME=KEY=VALUE,...")
     ap.add_argument("--json")
+    ap.add_argument("--mujoco-from", metavar="MJ.json")
     ap.add_argument("scenarios", nargs="+")
     a = ap.parse_args()
     base = {"max_checked": "1", "gravity": '"down"'}
@@ -86,10 +89,15 @@ def main():
         for i, (name, keys) in enumerate(variants):
             d = pathlib.Path(tmp) / name
             d.mkdir()
-            results[name] = run_variant(a.binary, a.scenarios, keys, d, out if i == 0 else None)
+            export = out if i == 0 and not a.mujoco_from else None
+            results[name] = run_variant(a.binary, a.scenarios, keys, d, export)
     names = [n for n, _ in variants]
     mj = {}
-    for scen in results["base"]:
+    if a.mujoco_from:
+        earlier = json.loads(pathlib.Path(a.mujoco_from).read_text())["base"]
+        mj = {scen: {"verdict": r["mujoco"], "wall_ms": r["mujoco_ms"]}
+              for scen, r in earlier.items() if scen in results["base"]}
+    for scen in results["base"] if not a.mujoco_from else []:
         if (out / scen / "scene.xml").is_file():
             mj[scen] = mujoco_replay.replay(out / scen)
     table = {n: {} for n in names}

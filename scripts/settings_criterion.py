@@ -12,25 +12,37 @@ half of the criterion when every direction whose verdict it changes is in the nu
 second half, agreement with MuJoCo not dropping, takes `--mujoco`: the file
 `scripts/engine_agreement.py --json` writes, whose variant `base` is the defaults and whose
 other variants are named as the candidates here. Prints a Markdown table: changed, changed outside the
-null set, steps and wall time against BASE, MuJoCo agreement, pass/fail.
+null set, steps and wall time against BASE, MuJoCo agreement, pass/fail. `--substeps
+NAME=CLOSE/HOLD` gives a run's substeps per step while closing and while holding (default
+8/8, the defaults' `solver_iterations`); the table then also gives the substeps in all against
+BASE's, the cost of the physics as the solver counts it (a substep costs about the same in
+either phase), which no load can change.
 """
 import argparse
 import json
 import sys
 
 
-def load(path):
-    """{(scenario, direction index): verdict}, total steps, total wall [ms]."""
-    verdicts, steps, wall = {}, 0, 0.0
+def load(path, substeps=(8, 8)):
+    """{(scenario, direction index): verdict}, total steps, total wall [ms], total substeps
+    (`substeps`: per step while closing, while holding)."""
+    verdicts, steps, wall, sub = {}, 0, 0.0, 0.0
     with open(path) as f:
         for line in f:
             d = json.loads(line)
             sim = d["sim"]
-            steps += sim.get("steps") or 0
+            n = sim.get("steps") or 0
+            steps += n
             wall += sim.get("wall_ms") or 0.0
-            for k, dr in enumerate(sim.get("directions") or []):
+            dirs = sim.get("directions") or []
+            # The closing's share of the steps: closed_at_s against the time simulated.
+            t_close = dirs[0]["closed_at_s"] if dirs else 0.0
+            t_all = t_close + sum(dr["decided_at_s"] for dr in dirs)
+            closing = n * t_close / t_all if t_all > 0 else 0.0
+            sub += closing * substeps[0] + (n - closing) * substeps[1]
+            for k, dr in enumerate(dirs):
                 verdicts[(d["scenario"], k)] = dr["verdict"]
-    return verdicts, steps, wall
+    return verdicts, steps, wall, sub
 
 
 def changed(base, other):
@@ -44,13 +56,19 @@ def main():
     ap.add_argument("--base", required=True)
     ap.add_argument("--null", action="append", default=[])
     ap.add_argument("--mujoco", action="append", default=[], metavar="MJ.json")
+    ap.add_argument("--substeps", action="append", default=[], metavar="NAME=CLOSE/HOLD")
     ap.add_argument("candidates", nargs="*", metavar="NAME=FILE")
     a = ap.parse_args()
-    base, bsteps, bwall = load(a.base)
+    subs = {}
+    for kv in a.substeps:
+        name, v = kv.split("=", 1)
+        c, h = v.split("/")
+        subs[name] = (int(c), int(h))
+    base, bsteps, bwall, bsub = load(a.base)
     null_set = set()
     rows = []
     for path in a.null:
-        v, s, w = load(path)
+        v, s, w, _ = load(path)
         c = changed(base, v)
         rows.append((f"null: {path}", c, s, w))
         null_set |= c
@@ -69,18 +87,19 @@ def main():
     print(f"directions: {len(base)}; null set: {len(null_set)} directions of "
           f"{len({k[0] for k in null_set})} objects from {len(a.null)} nulls")
     print()
-    print("| run | verdicts changed | outside the null set | objects | steps / base | wall / base "
-          "| MuJoCo agrees (`down`) | passes |")
-    print("|---|---|---|---|---|---|---|---|")
-    print(f"| base: {a.base} | 0 | 0 | 0 | {bsteps:,} | {bwall / 1000:.1f} s | {agreement('base')} | |")
+    print("| run | verdicts changed | outside the null set | objects | steps / base "
+          "| substeps / base | wall / base | MuJoCo agrees (`down`) | passes |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    print(f"| base: {a.base} | 0 | 0 | 0 | {bsteps:,} | {bsub:,.0f} | {bwall / 1000:.1f} s "
+          f"| {agreement('base')} | |")
     for i, (name, c, s, w) in enumerate(rows):
         others = set().union(*[n for j, n in enumerate(nulls) if j != i])
         print(f"| {name} | {len(c)} | {len(c - others)} outside the other nulls | "
-              f"{len({k[0] for k in c})} | {s / bsteps:.3f} | {w / bwall:.3f} | | |")
+              f"{len({k[0] for k in c})} | {s / bsteps:.3f} | | {w / bwall:.3f} | | |")
     failed = False
     for kv in a.candidates:
         name, path = kv.split("=", 1)
-        v, s, w = load(path)
+        v, s, w, sub = load(path, subs.get(name, (8, 8)))
         c = changed(base, v)
         out = c - null_set
         ok = not out
@@ -90,10 +109,11 @@ def main():
             ok = ok and agree_c >= agree_b
         failed |= not ok
         print(f"| {name} | {len(c)} | {len(out)} | {len({k[0] for k in c})} | {s / bsteps:.3f} "
-              f"| {w / bwall:.3f} | {agreement(name)} | {'yes' if ok else '**no**'} |")
+              f"| {sub / bsub:.3f} | {w / bwall:.3f} | {agreement(name)} "
+              f"| {'yes' if ok else '**no**'} |")
         if out:
             objs = sorted({k[0] for k in out})
-            print(f"|  outside: {', '.join(objs)} | | | | | | | |")
+            print(f"|  outside: {', '.join(objs)} | | | | | | | | |")
     return 1 if failed else 0
 
 

@@ -173,10 +173,11 @@ pub(super) fn rotations(qc: &UnitQuaternion<f64>, q: &UnitQuaternion<f64>) -> (f
 mod tests {
     use super::*;
 
-    /// The default rule: a 0.2 s window, projected at twice its speed, within 0.8 of the
-    /// thresholds (5 mm, 5°).
+    /// The rule with a 0.2 s window (the default until issue 35 made it 0.1 s), projected at
+    /// twice its speed, within 0.8 of the thresholds (5 mm, 5°).
     fn rule() -> (EarlyDecision, SimParams) {
-        let params = SimParams::default();
+        let mut params = SimParams::default();
+        params.early.rest_window_s = 0.2;
         (EarlyDecision::from_params(&params), params)
     }
 

@@ -41,7 +41,7 @@ pub(super) fn out_of_reach(
     if touches_hand(scene) {
         return None;
     }
-    let substeps = params.solver.solver_iterations.max(1);
+    let substeps = params.solver.hold_substeps().max(1);
     let h = params.solver.timestep_s / substeps as f64;
     let v_max = f64::from(ip.max_linear_velocity());
     let mut v = v3(obj.linvel());
@@ -145,7 +145,7 @@ pub(super) fn clear_of_hand(
     let obj_collider = &w.colliders[scene.object_collider];
     let v3 = |v: Vector| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z));
     let ip = &w.integration_parameters;
-    let substeps = params.solver.solver_iterations.max(1);
+    let substeps = params.solver.hold_substeps().max(1);
     let h = params.solver.timestep_s / substeps as f64;
     let total = steps * substeps;
     let remaining_s = total as f64 * h;

@@ -53,8 +53,9 @@ pub fn traced<R>(f: impl FnOnce() -> R) -> (R, Vec<HoldTrace>) {
     (r, traces)
 }
 
-/// Turns gravity on along `gravity` and holds: to the end of `duration_s`, or with `early`
-/// until the verdict can no longer change. Returns the outcome and the steps taken.
+/// Turns gravity on along `gravity` and holds, at `hold_solver_iterations` substeps a step: to
+/// the end of `duration_s`, or with `early` until the verdict can no longer change. Returns the
+/// outcome and the steps taken.
 pub(super) fn hold(
     scene: &mut Scene,
     gravity: Vector3<f64>,
@@ -67,6 +68,7 @@ pub(super) fn hold(
     let hold_steps = (params.hold.duration_s / dt).round() as usize;
     let g = gravity * G;
     scene.world.gravity = Vector::new(g.x as f32, g.y as f32, g.z as f32);
+    scene.world.integration_parameters.num_solver_iterations = params.solver.hold_substeps();
     let sample_every = ((SAMPLE_S / dt).round() as usize).max(1);
     let tracing = TRACES.with(|t| t.borrow().is_some());
     let frame = RestFrame {

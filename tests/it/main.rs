@@ -17,6 +17,7 @@ mod quality;
 mod real_meshes;
 mod resume;
 mod robust;
+mod settings;
 mod sim;
 mod summarize;
 mod thesis_table;

@@ -1,0 +1,186 @@
+#!/usr/bin/env python3
+"""Issue 35's three speed figures in one run, each variant beside the defaults, alternating.
+
+    python3 scripts/speed_ratios.py [--binary target/release/grasp-sim] [--rounds 5]
+        [--scenario scenarios/cylinder_d40.toml] [--variant NAME=KEY=VALUE[,KEY=VALUE...] ...]
+        [--batch] [--jobs 2] [--batch-dir assets/real/scenarios] [--json FILE]
+
+Per round, for the defaults (`base`) and each variant in turn: the scenario's check with
+gravity `down` and with `six` (grasp-sim's `sim.wall_ms`: the physics check alone, planning
+excluded), and once per round MuJoCo's replay of the same exported `down` scene
+(scripts/mujoco_replay.py, its simulation loop timed alone). Each ratio is taken within its
+round and the median over the rounds printed:
+
+- `down`: rapier's `down` check / MuJoCo's replay (issue 35's target: at most 0.1);
+- `six`: rapier's `six` check / MuJoCo's `down` replay (target: at most 0.15);
+
+and the steps of each check (`sim.steps`, deterministic). With --batch, every real-object
+scenario (the book left out: its planning takes minutes) is written with `gravity = "six"` (and
+the variant's keys) and run by `grasp-sim batch --jobs N`, base and variants one after another:
+the six-direction checks (`plan.candidates_checked`, summed) per second of the batch's wall time
+(target: at least 20 on 2 cores), and per CPU-second of its worker processes. The load average
+(`/proc/loadavg`) is printed with every figure: wall times on a shared machine are only as good
+as the load lets them be.
+"""
+import argparse
+import json
+import os
+import pathlib
+import resource
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import mujoco_replay  # noqa: E402
+from engine_agreement import with_sim  # noqa: E402
+
+ROOT = pathlib.Path(__file__).resolve().parent.parent
+
+
+def load():
+    return " ".join(pathlib.Path("/proc/loadavg").read_text().split()[:3])
+
+
+def check(binary, scenario, keys, tmp, export=None):
+    """grasp-sim's JSON `sim` of `scenario` with `keys` in its [sim]."""
+    f = pathlib.Path(tmp) / pathlib.Path(scenario).name
+    f.write_text(with_sim(scenario, keys))
+    cmd = [binary, "--json", str(f)]
+    if export is not None:
+        cmd[1:1] = ["--export-mjcf", str(export)]
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    if p.returncode == 2:
+        sys.exit(p.stderr)
+    return json.loads(p.stdout.splitlines()[0])["sim"]
+
+
+def parse_variants(specs):
+    variants = [("base", {})]
+    for v in specs:
+        name, kvs = v.split("=", 1)
+        keys = {}
+        for kv in kvs.split(","):
+            k, val = kv.split("=", 1)
+            keys[k.strip()] = val.strip()
+        variants.append((name, keys))
+    return variants
+
+
+def ratios(a, variants, tmp):
+    """Per variant: the rounds' `down` and `six` ratios, steps and walls."""
+    out = {n: {"down": [], "six": [], "down_ms": [], "six_ms": [], "mujoco_ms": []}
+           for n, _ in variants}
+    scen = pathlib.Path(a.scenario).stem
+    for r in range(a.rounds):
+        exp = pathlib.Path(tmp) / f"export{r}"
+        sims = {}
+        for i, (name, keys) in enumerate(variants):
+            d = pathlib.Path(tmp) / f"r{r}_{name}"
+            d.mkdir()
+            base = {"max_checked": "1"}
+            down = check(a.binary, a.scenario, {**base, **keys, "gravity": '"down"'}, d,
+                         exp if i == 0 else None)
+            six = check(a.binary, a.scenario, {**base, **keys, "gravity": '"six"'}, d)
+            sims[name] = (down, six)
+        mj = mujoco_replay.replay(exp / scen)
+        for name, (down, six) in sims.items():
+            o = out[name]
+            o["down"].append(down["wall_ms"] / mj["wall_ms"])
+            o["six"].append(six["wall_ms"] / mj["wall_ms"])
+            o["down_ms"].append(down["wall_ms"])
+            o["six_ms"].append(six["wall_ms"])
+            o["mujoco_ms"].append(mj["wall_ms"])
+            o["steps"] = (down["steps"], six["steps"])
+            o["verdicts"] = (down["verdict"], six["verdict"], mj["verdict"])
+        print(f"round {r + 1}: load {load()}; MuJoCo {mj['wall_ms']:.1f} ms; "
+              + "; ".join(f"{n} down {out[n]['down_ms'][-1]:.1f} six {out[n]['six_ms'][-1]:.1f} ms"
+                          for n in out), file=sys.stderr)
+    return out
+
+
+def batch(a, keys, tmp, name):
+    """The batch over the real-object set in six directions: checks, wall, CPU, load."""
+    d = pathlib.Path(tmp) / f"batch_{name}"
+    d.mkdir()
+    for s in sorted(pathlib.Path(a.batch_dir).glob("*.toml")):
+        if any(k in s.stem for k in a.skip):
+            continue
+        (d / s.name).write_text(with_sim(s, {**keys, "gravity": '"six"'}))
+    out = pathlib.Path(tmp) / f"batch_{name}.jsonl"
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
+    l0 = load()
+    t0 = time.monotonic()
+    p = subprocess.run([a.binary, "batch", "--jobs", str(a.jobs), "--out", str(out), str(d)],
+                       capture_output=True, text=True)
+    wall = time.monotonic() - t0
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    if p.returncode == 2 and not out.is_file():
+        sys.exit(p.stderr)
+    cpu = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
+    checks, objects, sim_ms, verdicts = 0, 0, 0.0, {}
+    for line in out.read_text().splitlines():
+        rec = json.loads(line)
+        objects += 1
+        checks += (rec.get("plan") or {}).get("candidates_checked") or 0
+        sim = rec.get("sim") or {}
+        v = sim.get("verdict", "not_run")
+        verdicts[v] = verdicts.get(v, 0) + 1
+    return {"objects": objects, "checks": checks, "wall_s": wall, "cpu_s": cpu,
+            "rate": checks / wall, "per_cpu_s": checks / cpu if cpu else 0.0,
+            "load": f"{l0} → {load()}", "verdicts": verdicts, "sim_ms": sim_ms}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--binary", default=str(ROOT / "target" / "release" / "grasp-sim"))
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--scenario", default=str(ROOT / "scenarios" / "cylinder_d40.toml"))
+    ap.add_argument("--variant", action="append", default=[], metavar="NAME=KEY=VALUE,...")
+    ap.add_argument("--batch", action="store_true")
+    ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--batch-dir", default=str(ROOT / "assets" / "real" / "scenarios"))
+    ap.add_argument("--skip", action="append", default=["black_book"],
+                    help="leave out scenarios whose name contains this (default: the book)")
+    ap.add_argument("--batch-only", action="append", default=[], metavar="NAME",
+                    help="run the batch for these variants only (default: all)")
+    ap.add_argument("--json")
+    a = ap.parse_args()
+    variants = parse_variants(a.variant)
+    result = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        print(f"load at the start: {load()}", file=sys.stderr)
+        r = ratios(a, variants, tmp) if a.rounds > 0 else {}
+        b = {n: batch(a, keys, tmp, n) for n, keys in variants
+             if a.batch and (not a.batch_only or n in a.batch_only)}
+    print(f"| variant | `down` / MuJoCo (target ≤ 0.1) | `six` / MuJoCo's `down` (≤ 0.15) | "
+          f"steps down, six | six-direction checks a second, batch --jobs {a.jobs} (≥ 20) |")
+    print("|---|---|---|---|---|")
+    for n, _ in variants:
+        cells = ["", "", "", ""]
+        if n in r:
+            o = r[n]
+            cells[0] = (f"{statistics.median(o['down']):.3f} ({min(o['down']):.3f}–"
+                        f"{max(o['down']):.3f}; {statistics.median(o['down_ms']):.1f} against "
+                        f"{statistics.median(o['mujoco_ms']):.1f} ms)")
+            cells[1] = (f"{statistics.median(o['six']):.3f} ({min(o['six']):.3f}–"
+                        f"{max(o['six']):.3f}; {statistics.median(o['six_ms']):.1f} ms)")
+            cells[2] = f"{o['steps'][0]:,}, {o['steps'][1]:,} ({'/'.join(o['verdicts'])})"
+        if n in b:
+            x = b[n]
+            cells[3] = (f"{x['rate']:.2f} ({x['checks']} checks of {x['objects']} objects in "
+                        f"{x['wall_s']:.0f} s; {x['per_cpu_s']:.2f} per CPU-second; load "
+                        f"{x['load']})")
+        print(f"| {n} | " + " | ".join(cells) + " |")
+        result[n] = {"ratios": r.get(n), "batch": b.get(n)}
+    print(f"\n{a.rounds} rounds alternating; load at the end: {load()}; "
+          f"{os.cpu_count()} CPUs")
+    if a.json:
+        pathlib.Path(a.json).write_text(json.dumps(result, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
