@@ -204,3 +204,101 @@ fn the_samples_flag_overrides_the_scenario_and_the_summary_says_it() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// The index in `plan.grasps` of the chosen grasp (`plan.grasp`).
+fn chosen_index(r: &RunReport) -> usize {
+    let chosen = r.plan.grasp.as_ref().expect("a chosen grasp");
+    r.plan
+        .grasps
+        .iter()
+        .position(|g| g.is_same_grasp(chosen))
+        .expect("the chosen grasp among the candidates")
+}
+
+#[test]
+fn robust_choice_passes_over_a_marginal_hold_for_a_later_robust_grasp() {
+    // Chapter 4's object, gravity down, 8 samples. The search checks candidates until one
+    // succeeds: under `choose = "first"` the second candidate (the first slips) holds in its
+    // main check and is taken, though only 6 of its 8 samples hold (lower bound 0.41). Under
+    // `choose = "robust"` success is a lower bound of at least 0.6, which only 8 of 8 (0.676)
+    // reaches: the search goes on past it and takes the 7th candidate, the first whose samples
+    // all held.
+    let (_d, first) = variant("chapter4", "samples = 8", "");
+    let (_e, robust) = variant(
+        "chapter4",
+        "samples = 8\nchoose = \"robust\"\nchoose_min_lower_bound = 0.6",
+        "",
+    );
+    let f = run_on(2, &first);
+    let rf = f.sim.robust.as_ref().unwrap();
+    assert_eq!(f.sim.verdict.verdict(), Some(Verdict::Hold));
+    assert_eq!(chosen_index(&f), 1);
+    assert_eq!(f.plan.candidates_checked, 2);
+    assert_eq!(rf.counts.hold, 6, "{:?}", rf.verdicts);
+    assert!(rf.interval[0] < 0.6, "{:?}", rf.interval);
+    let r = run_on(2, &robust);
+    let rr = r.sim.robust.as_ref().unwrap();
+    let k = chosen_index(&r);
+    // The search stopped at the first candidate that passed: every one before it was checked
+    // and failed the bound (else the search would have stopped there).
+    assert_eq!(r.plan.candidates_checked, k + 1);
+    assert_eq!(k, 6);
+    assert!(!r.plan.grasps[k].is_same_grasp(&f.plan.grasps[1]));
+    assert_eq!(rr.counts.hold, 8, "{:?}", rr.verdicts);
+    assert!((rr.interval[0] - all_held_lower(8.0)).abs() < 1e-12 && rr.interval[0] >= 0.6);
+    assert_eq!(r.sim.verdict.verdict(), Some(Verdict::Hold));
+    // The first choice's grasp is among those passed over, with its main check a hold.
+    let passed_over = &r.plan.grasps[1];
+    assert!(passed_over.is_same_grasp(&f.plan.grasps[1]));
+    assert_eq!(
+        passed_over.check.as_ref().map(|c| c.verdict),
+        Some(Verdict::Hold)
+    );
+}
+
+#[test]
+fn tune_ranks_settings_by_the_mean_hold_probability_first() {
+    // Chapter 4 with 8 samples over three values of Sf_c: each setting's grasp holds in its
+    // main check (hold rate 1 everywhere), but Sf_c = 0.3 finds one that holds in 6 of 8
+    // samples while 0.5 and 0.7 find ones that hold in 7 of 8. By the payload margin and the
+    // translation alone 0.3 would come before 0.7 (the same margin, less translation); ranked
+    // by the hold probability first it comes last.
+    use grasp_sim::batch::{default_template, expand};
+    use grasp_sim::tune::{parse_sweep, rank, tune};
+    let (dir, _s) = variant("chapter4", "samples = 8", "");
+    let items = expand(&[dir.path().join("chapter4.toml")]).unwrap();
+    let r = tune(
+        &items,
+        &default_template(),
+        &[parse_sweep("sf_c=0.3:0.7:0.2").unwrap()],
+        1,
+        2,
+    )
+    .unwrap();
+    let p: Vec<f64> = r
+        .settings
+        .iter()
+        .map(|s| s.mean_hold_probability.unwrap())
+        .collect();
+    assert_eq!(p, [6.0 / 8.0, 7.0 / 8.0, 7.0 / 8.0]);
+    for s in &r.settings {
+        assert_eq!(s.hold_rate, 1.0, "{:?}", s.values);
+        assert_eq!(s.objects[0].hold_probability, s.mean_hold_probability);
+    }
+    let mut order: Vec<usize> = (0..3).collect();
+    order.sort_by(|&a, &b| rank(&r.settings[a], &r.settings[b]));
+    assert_eq!(order, [1, 2, 0], "{:?}", r.settings);
+    assert_eq!(r.best, 1);
+    // Without the probability the last two would swap: the criteria that follow it order
+    // Sf_c = 0.3 before 0.7.
+    let unsampled = |i: usize| grasp_sim::tune::SettingResult {
+        mean_hold_probability: None,
+        ..r.settings[i].clone()
+    };
+    assert_eq!(
+        rank(&unsampled(0), &unsampled(2)),
+        std::cmp::Ordering::Less,
+        "{:?}",
+        r.settings
+    );
+}
