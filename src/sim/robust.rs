@@ -7,7 +7,9 @@
 //! samples, nor on the threads): `[sim] replay_sample = k` runs the main check under it, and
 //! the MJCF export writes it for MuJoCo. The samples run in parallel, each its own check on the
 //! one object collider (its convex decomposition is made once per run: [`ObjectShape`] is
-//! shared by reference).
+//! shared by reference). Under `six` a sample closes the hand once and holds each direction from
+//! a copy of its closed scene (the `fast` protocol's [`super::protocol::Closed`]); no closing is
+//! shared between samples, since every sample moves the object relative to the hand.
 //!
 //! The probability is the fraction of samples whose every gravity direction held, with its
 //! 95 % Wilson score interval: with few samples an all-held count is far from certainty (8 of 8

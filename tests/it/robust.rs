@@ -302,3 +302,34 @@ fn tune_ranks_settings_by_the_mean_hold_probability_first() {
         r.settings
     );
 }
+
+#[test]
+fn the_six_directions_of_a_sample_continue_from_its_one_closing() {
+    // Under `six` a perturbed sample closes the hand once and holds each direction from a copy
+    // of the closed scene: its steps are one closing's plus each direction's hold, not six
+    // closings (as `protocol = "full"` takes them, which closes afresh per direction).
+    let (_d, s) = variant("cylinder_d40", "gravity = \"six\"\nreplay_sample = 3", "");
+    let r = run_on(2, &s);
+    let dt = s.sim.solver.timestep_s;
+    let steps = |t: f64| (t / dt).round() as usize;
+    let closing = steps(r.sim.closing.as_ref().unwrap().duration_s);
+    assert!(closing > 0, "{closing}");
+    let dirs = &r.sim.directions;
+    assert_eq!(dirs.len(), 6);
+    let holds: usize = dirs.iter().map(|d| steps(d.decided_at_s)).sum();
+    assert_eq!(r.sim.steps, Some(closing + holds));
+    // Every direction starts from the same closed pose, bit for bit.
+    for d in dirs {
+        assert_eq!(d.closed_at_s, dirs[0].closed_at_s);
+        assert_eq!(
+            d.closing_translation_mm.to_bits(),
+            dirs[0].closing_translation_mm.to_bits()
+        );
+    }
+    let mut full = s.clone();
+    full.sim.protocol = grasp_sim::sim::params::Protocol::Full;
+    let f = run_on(2, &full);
+    let fdirs = &f.sim.directions;
+    let holds: usize = fdirs.iter().map(|d| steps(d.decided_at_s)).sum();
+    assert_eq!(f.sim.steps, Some(6 * closing + holds));
+}
