@@ -115,16 +115,10 @@ def agreement(rows):
     if not both:
         return None
 
-    def p_of(vs):
-        return sum(v == "hold" for v in vs) / len(vs)
-
     def brier(p_engine, other):
         terms = [(r[p_engine] - (v == "hold")) ** 2 for r in both for v in r[other]]
         return sum(terms) / len(terms)
 
-    for r in both:
-        r["mujoco_p"] = p_of(r["mujoco"]["verdicts"])
-        r["mujoco_verdicts"] = r["mujoco"]["verdicts"]
     return {
         "grasps": len(both),
         "mean_abs_diff": sum(abs(r["p"] - r["mujoco_p"]) for r in both) / len(both),
@@ -170,7 +164,8 @@ def table(rows, labels):
     out += ["", f"{len(rows)} objects, {len(sampled)} grasps sampled ({len(rows) - len(sampled)} without "
             f"a grasp to sample); distribution of p: {dist}",
             f"main-check holds: {len(holds)}; of those with a 95 % lower bound under 0.9: {len(weak)}; "
-            f"with p < 1: {len(below1)} ({named(below1)})",
+            f"with p < 1: {len(below1)} ({named(below1)}); with p < 0.5: "
+            f"{sum(r['p'] < 0.5 for r in holds)}",
             f"main check not `hold` but some samples held: {len(lucky)} "
             f"({named(lucky)})"]
     a = agreement(rows)
@@ -272,7 +267,8 @@ def row_of(name, r, m):
                per_direction=[d["counts"]["hold"] for d in rb["directions"]], verdicts=rb["verdicts"],
                wall_ms=rb["wall_ms"])
     if m:
-        row["mujoco"] = m
+        row.update(mujoco=m, mujoco_verdicts=m["verdicts"],
+                   mujoco_p=sum(v == "hold" for v in m["verdicts"]) / len(m["verdicts"]))
     return row
 
 
