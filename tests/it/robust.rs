@@ -333,3 +333,33 @@ fn the_six_directions_of_a_sample_continue_from_its_one_closing() {
     let holds: usize = fdirs.iter().map(|d| steps(d.decided_at_s)).sum();
     assert_eq!(f.sim.steps, Some(6 * closing + holds));
 }
+
+#[test]
+fn a_replayed_sample_is_of_the_grasp_chosen_without_it() {
+    // Chapter 4's chosen grasp (the second candidate) fails some of its 8 samples. Replaying
+    // the first failure must check that grasp under it: the candidate search judges the
+    // candidates as given, not under the replayed perturbation (under which the chosen grasp
+    // fails, and the search would go on to another candidate that holds under it).
+    let (_d, s) = variant("chapter4", "samples = 8", "");
+    let r = run_on(2, &s);
+    let first = r
+        .sim
+        .robust
+        .as_ref()
+        .unwrap()
+        .first_failure
+        .clone()
+        .unwrap();
+    let (_e, replay) = variant("chapter4", &format!("replay_sample = {}", first.sample), "");
+    let replayed = run_on(2, &replay);
+    assert_eq!(replayed.plan.candidates_checked, r.plan.candidates_checked);
+    assert!(replayed
+        .plan
+        .grasp
+        .as_ref()
+        .unwrap()
+        .is_same_grasp(r.plan.grasp.as_ref().unwrap()));
+    assert_eq!(replayed.sim.replay.as_ref(), Some(&first.perturbation));
+    assert_eq!(replayed.sim.verdict.verdict(), Some(first.verdict));
+    assert!(replayed.sim.robust.is_none());
+}
