@@ -7,7 +7,9 @@
 //! samples, nor on the threads): `[sim] replay_sample = k` runs the main check under it, and
 //! the MJCF export writes it for MuJoCo. The samples run in parallel, each its own check on the
 //! one object collider (its convex decomposition is made once per run: [`ObjectShape`] is
-//! shared by reference).
+//! shared by reference). Under `six` a sample closes the hand once and holds each direction from
+//! a copy of its closed scene (the `fast` protocol's [`super::protocol::Closed`]); no closing is
+//! shared between samples, since every sample moves the object relative to the hand.
 //!
 //! The probability is the fraction of samples whose every gravity direction held, with its
 //! 95 % Wilson score interval: with few samples an all-held count is far from certainty (8 of 8
@@ -356,10 +358,12 @@ pub fn sample(case: &Case) -> Robust {
     }
 }
 
-/// The check of `case` the candidate search runs: [`check_nominal`], and with
-/// `choose = "robust"` and more than one sample, the samples too.
+/// The check of `case` the candidate search runs: the scenario's case as given (never
+/// `[sim] replay_sample`'s perturbation, so that a replay checks the grasp the run without it
+/// chose: [`add_samples`] replays it), and with `choose = "robust"` and more than one sample,
+/// the samples too.
 pub fn check_candidate(case: &Case) -> SimOutcome {
-    let mut out = check_nominal(case);
+    let mut out = super::check(case);
     let rp = &case.params.robust;
     if rp.samples > 1 && rp.choose == super::params::Choose::Robust {
         out.robust = Some(sample(case));
@@ -367,9 +371,17 @@ pub fn check_candidate(case: &Case) -> SimOutcome {
     out
 }
 
-/// Adds the samples to `out` (the main check of `case`) when `[sim] samples` asks for more
-/// than one and they have not run yet.
+/// Completes `out`, the main check of the chosen grasp `case`: with `[sim] replay_sample = k`,
+/// replaces it by the check under sample k's perturbation unless it already is that (the
+/// candidate search checks the case as given, so that it chooses the grasp whose sample k is
+/// replayed); then adds the samples when `[sim] samples` asks for more than one and they have
+/// not run yet.
 pub fn add_samples(case: &Case, out: &mut SimOutcome) {
+    if case.params.robust.replay_sample.is_some() && out.replay.is_none() {
+        let robust = out.robust.take();
+        *out = check_nominal(case);
+        out.robust = robust;
+    }
     if case.params.robust.samples > 1 && out.robust.is_none() {
         out.robust = Some(sample(case));
     }

@@ -204,3 +204,162 @@ fn the_samples_flag_overrides_the_scenario_and_the_summary_says_it() {
         .unwrap();
     assert_eq!(out.status.code(), Some(2));
 }
+
+/// The index in `plan.grasps` of the chosen grasp (`plan.grasp`).
+fn chosen_index(r: &RunReport) -> usize {
+    let chosen = r.plan.grasp.as_ref().expect("a chosen grasp");
+    r.plan
+        .grasps
+        .iter()
+        .position(|g| g.is_same_grasp(chosen))
+        .expect("the chosen grasp among the candidates")
+}
+
+#[test]
+fn robust_choice_passes_over_a_marginal_hold_for_a_later_robust_grasp() {
+    // Chapter 4's object, gravity down, 8 samples. The search checks candidates until one
+    // succeeds: under `choose = "first"` the second candidate (the first slips) holds in its
+    // main check and is taken, though only 6 of its 8 samples hold (lower bound 0.41). Under
+    // `choose = "robust"` success is a lower bound of at least 0.6, which only 8 of 8 (0.676)
+    // reaches: the search goes on past it and takes the 7th candidate, the first whose samples
+    // all held.
+    let (_d, first) = variant("chapter4", "samples = 8", "");
+    let (_e, robust) = variant(
+        "chapter4",
+        "samples = 8\nchoose = \"robust\"\nchoose_min_lower_bound = 0.6",
+        "",
+    );
+    let f = run_on(2, &first);
+    let rf = f.sim.robust.as_ref().unwrap();
+    assert_eq!(f.sim.verdict.verdict(), Some(Verdict::Hold));
+    assert_eq!(chosen_index(&f), 1);
+    assert_eq!(f.plan.candidates_checked, 2);
+    assert_eq!(rf.counts.hold, 6, "{:?}", rf.verdicts);
+    assert!(rf.interval[0] < 0.6, "{:?}", rf.interval);
+    let r = run_on(2, &robust);
+    let rr = r.sim.robust.as_ref().unwrap();
+    let k = chosen_index(&r);
+    // The search stopped at the first candidate that passed: every one before it was checked
+    // and failed the bound (else the search would have stopped there).
+    assert_eq!(r.plan.candidates_checked, k + 1);
+    assert_eq!(k, 6);
+    assert!(!r.plan.grasps[k].is_same_grasp(&f.plan.grasps[1]));
+    assert_eq!(rr.counts.hold, 8, "{:?}", rr.verdicts);
+    assert!((rr.interval[0] - all_held_lower(8.0)).abs() < 1e-12 && rr.interval[0] >= 0.6);
+    assert_eq!(r.sim.verdict.verdict(), Some(Verdict::Hold));
+    // The first choice's grasp is among those passed over, with its main check a hold.
+    let passed_over = &r.plan.grasps[1];
+    assert!(passed_over.is_same_grasp(&f.plan.grasps[1]));
+    assert_eq!(
+        passed_over.check.as_ref().map(|c| c.verdict),
+        Some(Verdict::Hold)
+    );
+}
+
+#[test]
+fn tune_ranks_settings_by_the_mean_hold_probability_first() {
+    // Chapter 4 with 8 samples over three values of Sf_c: each setting's grasp holds in its
+    // main check (hold rate 1 everywhere), but Sf_c = 0.3 finds one that holds in 6 of 8
+    // samples while 0.5 and 0.7 find ones that hold in 7 of 8. By the payload margin and the
+    // translation alone 0.3 would come before 0.7 (the same margin, less translation); ranked
+    // by the hold probability first it comes last.
+    use grasp_sim::batch::{default_template, expand};
+    use grasp_sim::tune::{parse_sweep, rank, tune};
+    let (dir, _s) = variant("chapter4", "samples = 8", "");
+    let items = expand(&[dir.path().join("chapter4.toml")]).unwrap();
+    let r = tune(
+        &items,
+        &default_template(),
+        &[parse_sweep("sf_c=0.3:0.7:0.2").unwrap()],
+        1,
+        2,
+    )
+    .unwrap();
+    let p: Vec<f64> = r
+        .settings
+        .iter()
+        .map(|s| s.mean_hold_probability.unwrap())
+        .collect();
+    assert_eq!(p, [6.0 / 8.0, 7.0 / 8.0, 7.0 / 8.0]);
+    for s in &r.settings {
+        assert_eq!(s.hold_rate, 1.0, "{:?}", s.values);
+        assert_eq!(s.objects[0].hold_probability, s.mean_hold_probability);
+    }
+    let mut order: Vec<usize> = (0..3).collect();
+    order.sort_by(|&a, &b| rank(&r.settings[a], &r.settings[b]));
+    assert_eq!(order, [1, 2, 0], "{:?}", r.settings);
+    assert_eq!(r.best, 1);
+    // Without the probability the last two would swap: the criteria that follow it order
+    // Sf_c = 0.3 before 0.7.
+    let unsampled = |i: usize| grasp_sim::tune::SettingResult {
+        mean_hold_probability: None,
+        ..r.settings[i].clone()
+    };
+    assert_eq!(
+        rank(&unsampled(0), &unsampled(2)),
+        std::cmp::Ordering::Less,
+        "{:?}",
+        r.settings
+    );
+}
+
+#[test]
+fn the_six_directions_of_a_sample_continue_from_its_one_closing() {
+    // Under `six` a perturbed sample closes the hand once and holds each direction from a copy
+    // of the closed scene: its steps are one closing's plus each direction's hold, not six
+    // closings (as `protocol = "full"` takes them, which closes afresh per direction).
+    let (_d, s) = variant("cylinder_d40", "gravity = \"six\"\nreplay_sample = 3", "");
+    let r = run_on(2, &s);
+    let dt = s.sim.solver.timestep_s;
+    let steps = |t: f64| (t / dt).round() as usize;
+    let closing = steps(r.sim.closing.as_ref().unwrap().duration_s);
+    assert!(closing > 0, "{closing}");
+    let dirs = &r.sim.directions;
+    assert_eq!(dirs.len(), 6);
+    let holds: usize = dirs.iter().map(|d| steps(d.decided_at_s)).sum();
+    assert_eq!(r.sim.steps, Some(closing + holds));
+    // Every direction starts from the same closed pose, bit for bit.
+    for d in dirs {
+        assert_eq!(d.closed_at_s, dirs[0].closed_at_s);
+        assert_eq!(
+            d.closing_translation_mm.to_bits(),
+            dirs[0].closing_translation_mm.to_bits()
+        );
+    }
+    let mut full = s.clone();
+    full.sim.protocol = grasp_sim::sim::params::Protocol::Full;
+    let f = run_on(2, &full);
+    let fdirs = &f.sim.directions;
+    let holds: usize = fdirs.iter().map(|d| steps(d.decided_at_s)).sum();
+    assert_eq!(f.sim.steps, Some(6 * closing + holds));
+}
+
+#[test]
+fn a_replayed_sample_is_of_the_grasp_chosen_without_it() {
+    // Chapter 4's chosen grasp (the second candidate) fails some of its 8 samples. Replaying
+    // the first failure must check that grasp under it: the candidate search judges the
+    // candidates as given, not under the replayed perturbation (under which the chosen grasp
+    // fails, and the search would go on to another candidate that holds under it).
+    let (_d, s) = variant("chapter4", "samples = 8", "");
+    let r = run_on(2, &s);
+    let first = r
+        .sim
+        .robust
+        .as_ref()
+        .unwrap()
+        .first_failure
+        .clone()
+        .unwrap();
+    let (_e, replay) = variant("chapter4", &format!("replay_sample = {}", first.sample), "");
+    let replayed = run_on(2, &replay);
+    assert_eq!(replayed.plan.candidates_checked, r.plan.candidates_checked);
+    assert!(replayed
+        .plan
+        .grasp
+        .as_ref()
+        .unwrap()
+        .is_same_grasp(r.plan.grasp.as_ref().unwrap()));
+    assert_eq!(replayed.sim.replay.as_ref(), Some(&first.perturbation));
+    assert_eq!(replayed.sim.verdict.verdict(), Some(first.verdict));
+    assert!(replayed.sim.robust.is_none());
+}
