@@ -281,6 +281,6 @@ fn timed_fingers_arrive_together_when_the_ramp_ends() {
     let mut params = SimParams::default();
     params.closing.approach = grasp_sim::scenario::Approach::Timed;
     for t in first(&params) {
-        assert!(t >= sim::RAMP_S - 0.005 && t < sim::RAMP_S + 0.01, "{t}");
+        assert!((sim::RAMP_S - 0.005..sim::RAMP_S + 0.01).contains(&t), "{t}");
     }
 }
