@@ -233,8 +233,9 @@ pub struct ClosingParams {
     /// The fingers start this much more open than planned at each joint `[deg]`.
     pub open_margin_deg: f64,
     /// How joint 1 closes: `squeeze` (each finger straight to its target, the check before
-    /// issue 33) or `together` (a finger that touches the object stops there until every
-    /// finger has touched, or the others have stopped, then all squeeze at once).
+    /// issue 33), `together` (a finger that touches the object stops there until every
+    /// finger has touched, or the others have stopped, then all squeeze at once) or `timed`
+    /// (every finger's target ramps to its planned bend in the same time, then the squeeze).
     pub approach: Approach,
     /// Refine the planned joint angles by the real contact before closing (`sim::refine`,
     /// docs/SIM.md "Refining the plan by the contact"): each joint is commanded the bend at

@@ -281,6 +281,9 @@ fn timed_fingers_arrive_together_when_the_ramp_ends() {
     let mut params = SimParams::default();
     params.closing.approach = grasp_sim::scenario::Approach::Timed;
     for t in first(&params) {
-        assert!((sim::RAMP_S - 0.005..sim::RAMP_S + 0.01).contains(&t), "{t}");
+        assert!(
+            (sim::RAMP_S - 0.005..sim::RAMP_S + 0.01).contains(&t),
+            "{t}"
+        );
     }
 }
