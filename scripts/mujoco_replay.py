@@ -109,24 +109,72 @@ def replay(scene_dir, directions=None):
                 d.ctrl[2 * k] = target[2 * k]
             held[k] = False
 
+    # `approach = "timed"` (issue 33): every joint 1 target moves from its open bend to its
+    # planned bend in the same `ramp_s`, then on to the squeeze target (as grasp-sim's).
+    planned = proto.get("planned_bend_rad")
+    ramp_steps = max(1, round(proto.get("ramp_s", 0.1) / dt))
+    ramp = 0 if proto.get("approach") == "timed" else None
+    if ramp is not None:
+        for k in range(n):
+            d.ctrl[2 * k] = opened[2 * k]
+    # `reseat` (issue 33): after joint 2, each locked joint 1 whose phalanx 1 does not touch the
+    # object moves on at `reseat_rad_s` until it touches or reaches its squeeze target.
+    reseat_step = proto.get("reseat_rad_s", 0.0) * dt
+    phalanx1 = [m.body(f"{f}_phalanx_1").id for f in proto["fingers"]]
+
+    def phalanx1_touching():
+        out = [False] * n
+        for c in d.contact[: d.ncon]:
+            b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
+            other = b2 if b1 == obj else b1 if b2 == obj else None
+            for k in range(n):
+                out[k] = out[k] or other == phalanx1[k]
+        return out
+
+    def lock_joint1():
+        for k in range(n):
+            a = 2 * k
+            joint = m.actuator_trnid[a, 0]
+            d.ctrl[a] = d.qpos[m.jnt_qposadr[joint]]
+            m.actuator_gainprm[a, 0] = 10.0 * kp
+            m.actuator_biasprm[a, 1] = -10.0 * kp
+            m.actuator_forcerange[a] = [-lock, lock]
+
+    phases = [close_steps // 2, close_steps - close_steps // 2]
+    if proto.get("reseat"):
+        phases.append(close_steps // 2)
     closed = 0
-    for phase, max_steps in enumerate([close_steps // 2, close_steps - close_steps // 2]):
+    for phase, max_steps in enumerate(phases):
         if phase == 1:
             if waiting:
                 release()
                 waiting = False
+            if ramp is not None:
+                ramp = None
+                for k in range(n):
+                    d.ctrl[2 * k] = target[2 * k]
+            lock_joint1()
             for k in range(n):
-                a = 2 * k
-                joint = m.actuator_trnid[a, 0]
-                d.ctrl[a] = d.qpos[m.jnt_qposadr[joint]]
-                m.actuator_gainprm[a, 0] = 10.0 * kp
-                m.actuator_biasprm[a, 1] = -10.0 * kp
-                m.actuator_forcerange[a] = [-lock, lock]
-                d.ctrl[a + 1] = target[a + 1]
+                d.ctrl[2 * k + 1] = target[2 * k + 1]
         quiet_steps = 0
         for _ in range(max_steps):
+            moving = False
+            if phase == 2:
+                for k, t1 in enumerate(phalanx1_touching()):
+                    if not t1 and d.ctrl[2 * k] < target[2 * k]:
+                        d.ctrl[2 * k] = min(d.ctrl[2 * k] + reseat_step, target[2 * k])
+                        moving = True
+            if ramp is not None and ramp < ramp_steps:
+                ramp += 1
+                s = ramp / ramp_steps
+                for k in range(n):
+                    d.ctrl[2 * k] = target[2 * k] if ramp == ramp_steps else \
+                        opened[2 * k] + (planned[2 * k] - opened[2 * k]) * s
             mujoco.mj_step(m, d)
             closed += 1
+            if ramp is not None and ramp < ramp_steps:
+                quiet_steps = 0
+                continue
             if waiting:
                 for k, t in enumerate(touching_fingers()):
                     if t and not held[k]:
@@ -138,7 +186,7 @@ def replay(scene_dir, directions=None):
                     quiet_steps = 0
             if stall is None:
                 continue
-            if quiet():
+            if quiet() and not moving:
                 quiet_steps += 1
                 if quiet_steps * dt >= stall["window_s"]:
                     if waiting:

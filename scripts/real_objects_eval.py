@@ -43,7 +43,7 @@ def scenario_text(path, gravity, sim=()):
     return text + f'\n[sim]\ngravity = "{gravity}"\n' + extra
 
 
-def run_one(binary, scenario, gravity, tmp, mjcf_dir, sim=()):
+def run_one(binary, scenario, gravity, tmp, mjcf_dir, sim=(), raw_dir=None):
     s = pathlib.Path(tmp) / f"{scenario.stem}_{gravity}.toml"
     s.write_text(scenario_text(scenario, gravity, sim))
     cmd = [binary, "--json", s.as_posix()]
@@ -59,6 +59,8 @@ def run_one(binary, scenario, gravity, tmp, mjcf_dir, sim=()):
         return {"error": p.stderr.strip().splitlines()[-1] if p.stderr.strip() else "no output",
                 "wall_s": wall}
     r = json.loads(p.stdout.splitlines()[0])
+    if raw_dir is not None:
+        (pathlib.Path(raw_dir) / f"{scenario.stem}_{gravity}.json").write_text(p.stdout.splitlines()[0])
     r["wall_s"] = wall
     return r
 
@@ -161,6 +163,8 @@ def main():
     ap.add_argument("--mujoco-only", action="store_true",
                     help="replay OUT/mjcf in MuJoCo again for OUT/results.json, without running "
                          "grasp-sim (after a change to scripts/mujoco_replay.py)")
+    ap.add_argument("--raw", action="store_true",
+                    help="keep each run's JSON as OUT/raw/NAME_GRAVITY.json (for per-phalanx studies)")
     ap.add_argument("names", nargs="*", help="only these objects")
     a = ap.parse_args()
 
@@ -176,12 +180,16 @@ def main():
     out = pathlib.Path(a.out)
     mjcf = out / "mjcf"
     mjcf.mkdir(parents=True, exist_ok=True)
+    raw = out / "raw" if a.raw else None
+    if raw is not None:
+        raw.mkdir(parents=True, exist_ok=True)
     results = {}
     if a.mujoco_only:
         results = json.loads((out / "results.json").read_text())
     with tempfile.TemporaryDirectory() as tmp, ThreadPoolExecutor(a.jobs) as pool:
         jobs = {
-            (s.stem, g): pool.submit(run_one, a.binary, s, g, tmp, mjcf if g == "down" else None, a.sim)
+            (s.stem, g): pool.submit(run_one, a.binary, s, g, tmp, mjcf if g == "down" else None, a.sim,
+                        raw)
             for s in scenarios
             for g in ("down", "six")
         } if not a.mujoco_only else {}

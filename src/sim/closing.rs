@@ -67,56 +67,207 @@ pub(super) struct Closing {
     pub(super) contacts: Vec<super::contacts::GripContact>,
 }
 
+/// How long the `timed` approach (`[sim] approach = "timed"`) takes to move every finger's
+/// joint 1 target from its open bend to its planned bend `[s]`: the fingers arrive together.
+pub const RAMP_S: f64 = 0.1;
+
 /// Closes the hand, gravity off: joint 1 first, then joint 2, each for half `close_duration_s`
-/// or, with `close_until_stalled`, until the hand and the object have stopped ([`STALL`]).
+/// or, with `close_until_stalled`, until the hand and the object have stopped ([`STALL`]); with
+/// `reseat`, the locked joint 1s move on until their phalanx 1 touches (for at most another
+/// half).
 pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
     let params = case.params;
-    let stall = params.closing.close_until_stalled.then_some(&STALL);
     let dt = params.solver.timestep_s;
     let close_steps = (params.closing.close_duration_s / dt).round() as usize;
     let (p0, q0) = relative(scene);
-    let mut first_contact = FirstContacts::new(scene.fingers.len());
-    // Joint 1 closes for at most half the closing time, joint 2 for the rest.
-    let phases = [close_steps / 2, close_steps - close_steps / 2];
-    let mut steps = 0;
-    let mut together = Together {
-        waiting: params.closing.approach == super::params::Approach::Together,
-        held: vec![false; scene.fingers.len()],
+    let mut run = Phases {
+        stall: params.closing.close_until_stalled.then_some(&STALL),
+        dt,
+        steps: 0,
+        first_contact: FirstContacts::new(scene.fingers.len()),
+        together: Together {
+            waiting: params.closing.approach == super::params::Approach::Together,
+            held: vec![false; scene.fingers.len()],
+        },
+        ramp: (params.closing.approach == super::params::Approach::Timed)
+            .then(|| Ramp::new(scene, case, (RAMP_S / dt).round().max(1.0) as usize)),
     };
-    for (phase, max_steps) in phases.into_iter().enumerate() {
-        if phase == 1 {
-            if together.waiting {
-                together.release(scene);
-            }
-            scene.release_joint2();
-        }
+    // Joint 1 closes for at most half the closing time, joint 2 for the rest.
+    run.phase(scene, close_steps / 2);
+    if run.together.waiting {
+        run.together.release(scene);
+    }
+    if let Some(ramp) = run.ramp.take() {
+        ramp.finish(scene);
+    }
+    scene.release_joint2();
+    run.phase(scene, close_steps - close_steps / 2);
+    if params.closing.reseat {
+        reseat(scene, case, &mut run, close_steps / 2);
+    }
+    closed(scene, case, (p0, q0), &run.first_contact, run.steps)
+}
+
+/// The closing's running state: its stall rule, the steps taken, the first contacts, and the
+/// approach's state.
+struct Phases<'a> {
+    stall: Option<&'a Stall>,
+    dt: f64,
+    steps: usize,
+    first_contact: FirstContacts,
+    together: Together,
+    ramp: Option<Ramp>,
+}
+
+impl Phases<'_> {
+    /// Steps one closing phase: at most `max_steps`, or until the hand and the object stop.
+    fn phase(&mut self, scene: &mut Scene, max_steps: usize) {
         let mut quiet_steps = 0;
         for _ in 0..max_steps {
+            if let Some(ramp) = &mut self.ramp {
+                ramp.advance(scene);
+            }
             scene.world.step();
-            steps += 1;
+            self.steps += 1;
             let now = touching(scene);
-            first_contact.update(&now, steps as f64 * dt);
-            if together.hold_touching(scene, &now) {
+            self.first_contact.update(&now, self.steps as f64 * self.dt);
+            if self.together.hold_touching(scene, &now) {
                 quiet_steps = 0;
             }
-            let Some(rule) = stall else { continue };
-            if rule.quiet(motion(scene)) {
-                quiet_steps += 1;
-                if quiet_steps as f64 * dt >= rule.window_s {
-                    if together.waiting {
-                        // A finger that stopped without touching: the others squeeze now.
-                        together.release(scene);
-                        quiet_steps = 0;
-                        continue;
-                    }
-                    break;
-                }
-            } else {
+            let Some(rule) = self.stall else { continue };
+            if self.ramp.as_ref().is_some_and(|r| !r.done()) || !rule.quiet(motion(scene)) {
                 quiet_steps = 0;
+                continue;
+            }
+            quiet_steps += 1;
+            if quiet_steps as f64 * self.dt >= rule.window_s {
+                if self.together.waiting {
+                    // A finger that stopped without touching: the others squeeze now.
+                    self.together.release(scene);
+                    quiet_steps = 0;
+                    continue;
+                }
+                break;
             }
         }
     }
-    closed(scene, case, (p0, q0), &first_contact, steps)
+}
+
+/// The `timed` approach: every finger's joint 1 target moves from where it starts to its planned
+/// bend over the same number of steps, then to its squeeze target.
+struct Ramp {
+    /// Per finger, joint 1's bend at the start `[rad]`.
+    open: Vec<f32>,
+    /// Steps taken, and the steps the ramp lasts.
+    step: usize,
+    steps: usize,
+    /// The motors' stiffness and damping.
+    gains: (f32, f32),
+}
+
+impl Ramp {
+    fn new(scene: &Scene, case: &Case, steps: usize) -> Ramp {
+        let open = scene
+            .fingers
+            .iter()
+            .map(|f| f.joint1.angle(&scene.world).unwrap_or(0.0))
+            .collect();
+        Ramp {
+            open,
+            step: 0,
+            steps,
+            gains: motor_gains(case),
+        }
+    }
+
+    /// True once every target has reached its planned bend.
+    fn done(&self) -> bool {
+        self.step >= self.steps
+    }
+
+    /// Moves every target one step on; at the end of the ramp, on to the squeeze targets.
+    fn advance(&mut self, scene: &mut Scene) {
+        if self.done() {
+            return;
+        }
+        self.step += 1;
+        if self.done() {
+            return self.finish(scene);
+        }
+        let s = self.step as f32 / self.steps as f32;
+        for (k, open) in self.open.iter().enumerate() {
+            let planned = scene.fingers[k].planned_bend_rad[0] as f32;
+            self.target(scene, k, open + (planned - open) * s);
+        }
+    }
+
+    /// Every finger's joint 1 on to its squeeze target.
+    fn finish(&self, scene: &mut Scene) {
+        for k in 0..self.open.len() {
+            self.target(scene, k, scene.fingers[k].joint1_target);
+        }
+    }
+
+    /// Finger `k`'s joint 1 motor aims at `bend` `[rad]` (its torque limit kept).
+    fn target(&self, scene: &mut Scene, k: usize, bend: f32) {
+        let f = scene.fingers[k];
+        f.joint1.set_motor(&mut scene.world, bend, self.gains, None);
+    }
+}
+
+/// The finger motors' (stiffness, damping) of `case`.
+fn motor_gains(case: &Case) -> (f32, f32) {
+    let fingers = &case.params.fingers;
+    (
+        fingers.motor_stiffness_nm_per_rad as f32,
+        fingers.motor_damping_nms_per_rad as f32,
+    )
+}
+
+/// How fast `[sim] reseat` moves a locked joint 1 on towards its squeeze target `[rad/s]`
+/// (20°/s: a phalanx lifted 0.5 mm off at 50 mm is back on in 30 ms).
+pub const RESEAT_RAD_S: f64 = 0.349_065_850_398_865_9;
+
+/// `[sim] reseat`, after joint 2 has closed: every locked joint 1 whose phalanx 1 does not
+/// touch the object moves on, position-controlled by its lock (its stiffness, its torque), at
+/// [`RESEAT_RAD_S`] until its phalanx touches or it reaches its squeeze target; the phase ends
+/// when no joint moves on any more and the hand and the object have stopped ([`STALL`]), or
+/// after `max_steps`.
+fn reseat(scene: &mut Scene, case: &Case, run: &mut Phases, max_steps: usize) {
+    let (k, d) = motor_gains(case);
+    let lock = Some(case.params.fingers.joint1_lock_torque_nm as f32);
+    let step_rad = (RESEAT_RAD_S * run.dt) as f32;
+    let mut at: Vec<f32> = scene
+        .fingers
+        .iter()
+        .map(|f| f.joint1.angle(&scene.world).unwrap_or(f.joint1_target))
+        .collect();
+    let mut quiet_steps = 0;
+    for _ in 0..max_steps {
+        let now = touching(scene);
+        let mut moving = false;
+        for (f, (a, t)) in scene.fingers.iter().zip(at.iter_mut().zip(&now.fingers)) {
+            if !t[0] && *a < f.joint1_target {
+                *a = (*a + step_rad).min(f.joint1_target);
+                f.joint1
+                    .set_motor(&mut scene.world, *a, (k * 10.0, d), lock);
+                moving = true;
+            }
+        }
+        scene.world.step();
+        run.steps += 1;
+        run.first_contact
+            .update(&touching(scene), run.steps as f64 * run.dt);
+        let Some(rule) = run.stall else { continue };
+        if moving || !rule.quiet(motion(scene)) {
+            quiet_steps = 0;
+        } else {
+            quiet_steps += 1;
+            if quiet_steps as f64 * run.dt >= rule.window_s {
+                break;
+            }
+        }
+    }
 }
 
 /// Where the closing left the hand and the object after `steps`, from the object's pose

@@ -51,7 +51,7 @@ pub mod refine;
 pub mod robust;
 pub mod scene;
 
-pub use closing::{Stall, STALL};
+pub use closing::{Stall, RAMP_S, RESEAT_RAD_S, STALL};
 pub use collider::{collider_inertia, ColliderKind, ColliderReport, ObjectShape};
 pub use early::EarlyDecision;
 pub use outcome::{

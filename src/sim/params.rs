@@ -246,8 +246,9 @@ pub struct ClosingParams {
     /// The fingers start this much more open than planned at each joint `[deg]`.
     pub open_margin_deg: f64,
     /// How joint 1 closes: `squeeze` (each finger straight to its target, the check before
-    /// issue 33) or `together` (a finger that touches the object stops there until every
-    /// finger has touched, or the others have stopped, then all squeeze at once).
+    /// issue 33), `together` (a finger that touches the object stops there until every
+    /// finger has touched, or the others have stopped, then all squeeze at once) or `timed`
+    /// (every finger's target ramps to its planned bend in the same time, then the squeeze).
     pub approach: Approach,
     /// Refine the planned joint angles by the real contact before closing (`sim::refine`,
     /// docs/SIM.md "Refining the plan by the contact"): each joint is commanded the bend at
@@ -258,6 +259,12 @@ pub struct ClosingParams {
     /// scenario that does not use it keeps its batch input hash.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub refine_contacts: bool,
+    /// After joint 2 has closed, joint 1 closes again (its motor, its torque limit) until the
+    /// hand and the object stop, then locks where it stopped (docs/SIM.md "What the closing
+    /// does"): phalanx 1 comes back onto an object that joint 2 seated away from it. Left out of
+    /// the serialised parameters when off.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub reseat: bool,
 }
 
 impl Default for ClosingParams {
@@ -268,6 +275,7 @@ impl Default for ClosingParams {
             open_margin_deg: 20.0,
             approach: Approach::Squeeze,
             refine_contacts: false,
+            reseat: false,
         }
     }
 }
@@ -366,6 +374,10 @@ pub enum Approach {
     /// A finger stops where it touches until every finger has touched (or the hand has
     /// stopped), then all squeeze together.
     Together,
+    /// Every finger's joint 1 target moves from its open bend to its planned bend in the same
+    /// time (`sim::closing::RAMP_S`), so the fingers arrive together, each at a speed set by
+    /// its distance to its planned contact; then the squeeze.
+    Timed,
 }
 
 impl Default for SimParams {
@@ -428,6 +440,7 @@ mod flat {
         pub(super) hold_solver_iterations: usize,
         pub(super) open_margin_deg: f64,
         pub(super) refine_contacts: bool,
+        pub(super) reseat: bool,
         pub(super) override_angles: Option<Vec<[f64; 2]>>,
         pub(super) override_index: Option<usize>,
         pub(super) max_checked: usize,
@@ -483,6 +496,7 @@ mod flat {
                     open_margin_deg: s.open_margin_deg,
                     approach: s.approach,
                     refine_contacts: s.refine_contacts,
+                    reseat: s.reseat,
                 },
                 hold: super::HoldParams {
                     duration_s: s.duration_s,
@@ -548,6 +562,7 @@ mod flat {
                 hold_solver_iterations: s.solver.hold_solver_iterations,
                 open_margin_deg: s.closing.open_margin_deg,
                 refine_contacts: s.closing.refine_contacts,
+                reseat: s.closing.reseat,
                 override_angles: s.input.override_angles,
                 override_index: s.input.override_index,
                 max_checked: s.selection.max_checked,

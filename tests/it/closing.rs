@@ -213,3 +213,77 @@ fn a_push_beyond_the_bound_moves_the_search_on() {
     assert_eq!(check.verdict, Verdict::Slip, "{first:?}");
     assert!(r.plan.candidates_checked >= 2);
 }
+
+#[test]
+fn reseated_every_phalanx_of_the_d40_ends_on_its_plan() {
+    // As planned, joint 1 locks where phalanx 1 met the cylinder, then joint 2's squeeze seats
+    // the object on the palm and phalanx 2, and the outer fingers' phalanx 1 are left just clear
+    // of it (4 of 6 phalanges on the object within 5° of their plan). With `[sim] reseat` (and
+    // a 3° squeeze, the setting studied in docs/SIM.md) the locked joint 1s move on, under their
+    // lock, until their phalanx touches again: all 6 end on the object within 5°, and the
+    // cylinder moves by less than a millimetre.
+    let plain = d40_backed_off(0.0, &SimParams::default()).closing;
+    assert_eq!(plain.phalanges_on_plan, 4, "{plain:?}");
+    assert!(plain.fingers.iter().any(|f| !f.touching[0]), "{plain:?}");
+    let mut params = SimParams::default();
+    params.closing.reseat = true;
+    params.fingers.squeeze_deg = 3.0;
+    params.fingers.squeeze2_deg = 3.0;
+    let out = d40_backed_off(0.0, &params);
+    let c = &out.closing;
+    assert_eq!(out.verdict, Verdict::Hold, "{c:?}");
+    assert_eq!(c.phalanges_on_plan, 6, "{c:?}");
+    for f in &c.fingers {
+        assert_eq!(f.touching, [true, true], "{f:?}");
+        assert!(f.error_deg.iter().all(|e| e.abs() <= 5.0), "{f:?}");
+    }
+    assert!(c.shift_mm < 1.0, "{c:?}");
+}
+
+#[test]
+fn a_bounded_squeeze_keeps_every_joint_within_it_of_its_command() {
+    // The palm 10 mm off the D40, refined by the contact (the test above): with the default 10°
+    // squeeze the phalanx 2s close through all of it as the object is pulled to the palm. With a
+    // 3° squeeze no joint can end more than about 3° past its commanded bend (a position motor
+    // pulls back beyond its target), so a phalanx more than 5° off its plan is one the object
+    // pushed back, not one that closed through its squeeze.
+    let past = |c: &sim::ClosingOutcome| {
+        c.fingers
+            .iter()
+            .flat_map(|f| f.error_deg)
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    let mut params = SimParams::default();
+    params.closing.refine_contacts = true;
+    let wide = d40_backed_off(10.0, &params).closing;
+    assert!(past(&wide) > 9.0, "{wide:?}");
+    params.fingers.squeeze_deg = 3.0;
+    params.fingers.squeeze2_deg = 3.0;
+    let narrow = d40_backed_off(10.0, &params).closing;
+    assert!(past(&narrow) < 3.5, "{narrow:?}");
+}
+
+#[test]
+fn timed_fingers_arrive_together_when_the_ramp_ends() {
+    // `[sim] approach = "timed"`: every joint 1 target moves from its open bend to its planned
+    // bend in `RAMP_S` (0.1 s), so on the D40, planned on the object, every phalanx 1 first
+    // touches within a few steps of 0.1 s; driven straight at its target (the default) each
+    // touches within 30 ms.
+    let first = |params: &SimParams| -> Vec<f64> {
+        d40_backed_off(0.0, params)
+            .closing
+            .fingers
+            .iter()
+            .map(|f| f.first_contact_s[0].expect("phalanx 1 touches"))
+            .collect()
+    };
+    assert!(first(&SimParams::default()).iter().all(|t| *t < 0.03));
+    let mut params = SimParams::default();
+    params.closing.approach = grasp_sim::scenario::Approach::Timed;
+    for t in first(&params) {
+        assert!(
+            (sim::RAMP_S - 0.005..sim::RAMP_S + 0.01).contains(&t),
+            "{t}"
+        );
+    }
+}
