@@ -485,6 +485,7 @@ fn model(
             offset_mm: ext[0].1 - ext[0].0,
             margin_mm: margin.max(0.0),
             half_width_mm: 0.5 * (ext[1].1 - ext[1].0),
+            standoff_max_mm: None,
         },
         joints: super::Joints {
             lateral_mm: lateral,
@@ -523,6 +524,38 @@ fn model(
             })
             .collect(),
         coupling: Vec::new(),
+    }
+}
+
+/// A hand that wraps, resting on its palm, no object narrower than the span between its
+/// opposing joint-1 axes (a distal joint that closes at most 90° against a long phalanx 1, as the
+/// Schunk SDH-2's: it wraps nothing under 92 mm on its palm, its axes 57 mm apart) is given a
+/// palm stand-off: the planner may hold the object in front of the palm, between the
+/// phalanges, up to half phalanx 1's length out (so that phalanx 1 still reaches round it), and
+/// the note says so. A hand that wraps such objects on its palm (the thesis hand, the BH8)
+/// keeps the thesis's model.
+fn standoff_if_needed(hand: &mut Hand, notes: &mut Vec<String>) {
+    let span = 2.0 * hand.joints.lateral_mm;
+    let smallest = super::kinematics::graspable_circle_radii(hand).map(|(lo, _)| 2.0 * lo);
+    if hand.palm.standoff_max_mm.is_some() || smallest.is_some_and(|d| d <= span) {
+        return;
+    }
+    let max = (0.5 * hand.phalanx_1.length_mm).floor();
+    let mut with = hand.clone();
+    with.palm.standoff_max_mm = Some(max);
+    if let Some((lo, _)) = super::kinematics::graspable_circle_radii(&with) {
+        *hand = with;
+        let on_palm = smallest.map_or("no object".to_string(), |d| {
+            format!("no object under {d:.1} mm")
+        });
+        notes.push(format!(
+            "resting on the palm the fingers wrap {on_palm} (joint 2 closes to at most \
+             {:.1}°), and the opposing joint-1 axes are {span:.1} mm apart: objects are also \
+             held in front of the palm, between the phalanges, up to {max:.0} mm out \
+             (palm.standoff_max_mm, half phalanx 1; wrapped from {:.1} mm across)",
+            hand.joints.theta2_range_deg[0],
+            2.0 * lo
+        ));
     }
 }
 
@@ -566,6 +599,7 @@ fn finish(
             )),
         }
     }
+    standoff_if_needed(&mut hand, &mut notes);
     let text = toml::to_string(&hand).map_err(|e| err(&tree.file, e.to_string()))?;
     let hand = Hand::parse(&text, &tree.file, overrides)?;
     let model = |p: &Point3<f64>| frame.to_model(p);
