@@ -15,6 +15,7 @@ mod geometry;
 pub mod import;
 mod import_frame;
 pub mod kinematics;
+pub mod link_geometry;
 pub mod mjcf_hand;
 pub mod urdf_hand;
 pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
@@ -106,6 +107,11 @@ pub struct Hand {
     /// plan is checked against each coupling ([`Hand::coupling_checks`]), not refused.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub coupling: Vec<Coupling>,
+    /// The hand file's own link geometry where its links have meshes (issue 37: a hand read
+    /// from a URDF or MJCF), which the physics check and `--export-mjcf` use instead of the
+    /// model's boxes for those bodies. Never in a hand TOML, never serialised.
+    #[serde(skip)]
+    pub link_geometry: Option<std::sync::Arc<link_geometry::LinkGeometry>>,
 }
 
 /// A coupling between two joints of the model: θ(follower) = multiplier × θ(leader) +

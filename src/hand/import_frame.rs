@@ -459,7 +459,72 @@ pub(super) fn build(
         (setback, lateral, l1, l2, offset),
         [r1, r2],
     );
-    finish(tree, pose, palm, chains, &frame, &m, hand, notes, overrides)
+    let mut derived = finish(tree, pose, palm, chains, &frame, &m, hand, notes, overrides)?;
+    let geometry = link_geometry(tree, pose, palm, chains, &frame, &m, finger_axes);
+    if !geometry.is_empty() {
+        derived.notes.push(
+            "links with meshes: the convex hull of each of their geometry elements stands for the \
+             model's box of that body in the physics check and --export-mjcf"
+                .to_string(),
+        );
+        derived.hand.link_geometry = Some(std::sync::Arc::new(geometry));
+    }
+    Ok(derived)
+}
+
+/// The file's own geometry per model body ([`super::link_geometry`]): the palm's (with the
+/// spread links, held with it) in the palm frame, each phalanx's about its own joint.
+fn link_geometry(
+    tree: &Tree,
+    pose: &[Option<Isometry3<f64>>],
+    palm: usize,
+    chains: &[ChainInfo],
+    frame: &Frame,
+    m: &[Measured],
+    finger_axes: &[super::import::FingerAxesRef],
+) -> super::link_geometry::LinkGeometry {
+    use super::import::pieces_of_body;
+    use super::link_geometry::{body_pieces, turn};
+    let to_model = |p: &Point3<f64>| frame.to_model(p);
+    let mut palm_pieces = pieces_of_body(tree, pose, palm);
+    for &c in &frame.order {
+        if let Some(s) = chains[c].2 {
+            palm_pieces.extend(pieces_of_body(tree, pose, tree.joints[s].child));
+        }
+    }
+    let identity = (Point3::origin(), UnitQuaternion::identity());
+    let sides = [1.0, -1.0, 1.0];
+    let phalanges = frame
+        .order
+        .iter()
+        .enumerate()
+        .map(|(k, &c)| {
+            let a = axes_of(&finger_axes[c]);
+            let at = |p: &Point3<f64>| {
+                let q = frame.to_model(p);
+                Point3::new(q.x, q.y, m[k].height)
+            };
+            let r1 = turn(sides[k], super::bend(m[k].theta0[0]));
+            let r2 = r1 * turn(sides[k], super::bend(m[k].theta0[1]));
+            let (j1, j2) = (chains[c].0, chains[c].1);
+            [
+                body_pieces(
+                    pieces_of_body(tree, pose, tree.joints[j1].child),
+                    to_model,
+                    (at(&a[0].0), r1),
+                ),
+                body_pieces(
+                    pieces_of_body(tree, pose, tree.joints[j2].child),
+                    to_model,
+                    (at(&a[1].0), r2),
+                ),
+            ]
+        })
+        .collect();
+    super::link_geometry::LinkGeometry {
+        palm: body_pieces(palm_pieces, to_model, identity),
+        phalanges,
+    }
 }
 
 /// The model's numbers as a [`Hand`] (unvalidated), with the thesis hand's proportions for
@@ -509,6 +574,7 @@ fn model(
             unusable_proximal_mm: l2 * 2.0 / 20.0,
             unusable_distal_mm: 0.0,
         },
+        link_geometry: None,
         finger_list: names
             .iter()
             .zip(heights)

@@ -370,3 +370,121 @@ fn a_mapping_names_the_fingers_or_is_refused() {
         );
     }
 }
+
+/// The SDH-2 with its proximal links as meshes (an octagonal prism, the box's extents with its
+/// four long edges chamfered 5 mm): the model is the box file's (the same extents), but the
+/// physics check and `--export-mjcf` use the meshes' hulls: each proximal link's collider is the
+/// prism (its volume, its place about its joint), the exported scene carries the meshes, and the
+/// check's closing differs from the boxes' while the cup is still held.
+#[test]
+fn link_meshes_are_the_colliders_of_their_bodies() {
+    use grasp_sim::hand::import::{load, Mapping};
+    let dir = tempfile::tempdir().unwrap();
+    let (hx, hy, l, c) = (0.01465, 0.0139, 0.0865, 0.005);
+    let ring = [
+        (hx - c, hy),
+        (hx, hy - c),
+        (hx, -(hy - c)),
+        (hx - c, -hy),
+        (-(hx - c), -hy),
+        (-hx, -(hy - c)),
+        (-hx, hy - c),
+        (-(hx - c), hy),
+    ];
+    let mut obj = String::new();
+    for z in [0.0, l] {
+        for (x, y) in ring {
+            obj.push_str(&format!("v {x} {y} {z}\n"));
+        }
+    }
+    for k in 0..8 {
+        let (a, b) = (k + 1, (k + 1) % 8 + 1);
+        obj.push_str(&format!("f {a} {b} {}\nf {a} {} {}\n", b + 8, b + 8, a + 8));
+    }
+    obj.push_str("f 1 2 3 4 5 6 7 8\nf 16 15 14 13 12 11 10 9\n");
+    std::fs::write(dir.path().join("proximal.obj"), obj).unwrap();
+    let boxes = std::fs::read_to_string(asset("assets/hands/sdh2.urdf")).unwrap();
+    let box_geom =
+        "<origin xyz=\"0.000000 0.0 0.043250\"/><geometry><box size=\"0.029300 0.0278 0.0865\"/>";
+    assert_eq!(boxes.matches(box_geom).count(), 3);
+    let meshes = boxes.replace(box_geom, "<geometry><mesh filename=\"proximal.obj\"/>");
+    let file = dir.path().join("sdh2_mesh.urdf");
+    std::fs::write(&file, meshes).unwrap();
+    let d = load(&file, &Mapping::default(), &[]).unwrap();
+    let reference = load(&asset("assets/hands/sdh2.urdf"), &Mapping::default(), &[]).unwrap();
+    assert!(reference.hand.link_geometry.is_none());
+    assert!(
+        d.notes.iter().any(|n| n.contains("links with meshes")),
+        "{:?}",
+        d.notes
+    );
+    let area = 4.0 * hx * hy - 2.0 * c * c;
+    for (k, f) in d.hand.finger_list.iter().enumerate() {
+        let shapes = grasp_sim::sim::hand_shapes::link_shapes(&d.hand, 1 + 2 * k).unwrap();
+        assert_eq!(shapes.len(), 1);
+        let hull = shapes[0].as_convex_polyhedron().unwrap();
+        assert_eq!(hull.points().len(), 16, "{}", f.name);
+        let volume = f64::from(shapes[0].mass_properties(1.0).mass());
+        assert!(
+            (volume - area * l).abs() < 1e-3 * area * l,
+            "{volume} vs {}",
+            area * l
+        );
+        // Along the phalanx (the body's y on its side, from its joint) and across it.
+        let aabb = shapes[0].compute_local_aabb();
+        let s = f.side.sign();
+        let (lo, hi) = (aabb.mins, aabb.maxs);
+        let (from, to) = if s > 0.0 {
+            (lo.y, hi.y)
+        } else {
+            (-hi.y, -lo.y)
+        };
+        let near = |a: f32, b: f64| (f64::from(a) - b).abs() < 1e-5;
+        assert!(
+            near(from, 0.0) && near(to, l) && near(hi.x, hx) && near(lo.x, -hx),
+            "{}: {lo:?} {hi:?}",
+            f.name
+        );
+        assert!(
+            near(hi.z, hy) && near(lo.z, -hy),
+            "{}: {lo:?} {hi:?}",
+            f.name
+        );
+        // The distal links stay the model's boxes.
+        assert!(grasp_sim::sim::hand_shapes::link_shapes(&d.hand, 2 + 2 * k).is_none());
+    }
+    assert!(grasp_sim::sim::hand_shapes::link_shapes(&d.hand, 0).is_none());
+    // Planned as the box file (the same model); checked with the prisms.
+    let rest = "[planner]\nheight_step_mm = 3.0\n[sim]\nopen_margin_deg = 10.0";
+    let run = |f: &Path, name: &str| {
+        let hand = format!("urdf = \"{}\"\n{rest}", f.display());
+        let export = dir.path().join(format!("x_{name}"));
+        let v = run_json(
+            &["--export-mjcf", export.to_str().unwrap()],
+            &cup_scenario(dir.path(), name, &hand),
+        );
+        let scene = std::fs::read_to_string(export.join(name).join("scene.xml")).unwrap();
+        (v, scene)
+    };
+    let (vb, sb) = run(&asset("assets/hands/sdh2.urdf"), "boxes");
+    let (vm, sm) = run(&file, "meshes");
+    assert_same_grasp(
+        &grasp_numbers(&vm),
+        &grasp_numbers(&vb),
+        "meshes against boxes",
+    );
+    assert_eq!(vm["sim"]["verdict"], "hold", "{}", vm["sim"]);
+    assert!(!sb.contains("type=\"mesh\" mesh=\"hand_"));
+    for f in ["finger_1", "finger_2", "finger_3"] {
+        let name = format!("hand_{f}_phalanx_1_0");
+        assert!(
+            sm.contains(&format!("<mesh name=\"{name}\" vertex=\"")),
+            "{name}"
+        );
+        assert!(sm.contains(&format!(
+            "<geom name=\"{name}\" type=\"mesh\" mesh=\"{name}\""
+        )));
+    }
+    let finals = |v: &serde_json::Value| v["sim"]["closing"]["fingers"].to_string();
+    assert_ne!(finals(&vm), finals(&vb));
+}
