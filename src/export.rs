@@ -203,7 +203,64 @@ fn mjcf_options(s: &mut String, case: &Case, meshes: &[(String, Mesh)]) {
     for (name, _) in meshes {
         let _ = writeln!(s, "    <mesh name=\"{name}\" file=\"{name}.stl\"/>");
     }
+    // A hand file's own link meshes (issue 37): each piece's vertices, whose convex hull
+    // MuJoCo takes, as the rapier check does.
+    for (name, piece) in hand_pieces(case.hand) {
+        let v: Vec<String> = piece.iter().map(|p| v3(&(p.coords * MM))).collect();
+        let _ = writeln!(s, "    <mesh name=\"{name}\" vertex=\"{}\"/>", v.join(" "));
+    }
     let _ = writeln!(s, "  </asset>");
+}
+
+/// The hand's link-mesh pieces ([`crate::hand::link_geometry`]) with their MJCF mesh names
+/// (`hand_<body>_<n>`), in body order (palm, then each finger's phalanx 1 and 2).
+fn hand_pieces(hand: &Hand) -> Vec<(String, &[nalgebra::Point3<f64>])> {
+    let Some(g) = hand.link_geometry.as_deref() else {
+        return Vec::new();
+    };
+    let mut names = vec!["palm".to_string()];
+    for f in &hand.finger_list {
+        names.push(format!("{}_phalanx_1", f.name));
+        names.push(format!("{}_phalanx_2", f.name));
+    }
+    let mut out = Vec::new();
+    for (k, body) in names.iter().enumerate() {
+        for (n, piece) in g.body(k).iter().enumerate() {
+            out.push((format!("hand_{body}_{n}"), piece.as_slice()));
+        }
+    }
+    out
+}
+
+/// Writes body `body`'s geoms: its link-mesh pieces where it has them, else the model's boxes
+/// (`boxes`, each with its geom name).
+fn hand_body_geoms(
+    s: &mut String,
+    indent: &str,
+    hand: &Hand,
+    body: &str,
+    boxes: &[(String, HandBox)],
+    extra: &str,
+) {
+    let pieces: Vec<String> = hand_pieces(hand)
+        .into_iter()
+        .map(|(name, _)| name)
+        .filter(|name| {
+            name.strip_prefix(&format!("hand_{body}_"))
+                .is_some_and(|n| n.bytes().all(|b| b.is_ascii_digit()))
+        })
+        .collect();
+    if pieces.is_empty() {
+        for (name, b) in boxes {
+            box_geom(s, indent, name, b, extra);
+        }
+    }
+    for name in pieces {
+        let _ = writeln!(
+            s,
+            "{indent}<geom name=\"{name}\" type=\"mesh\" mesh=\"{name}\"{extra}/>"
+        );
+    }
 }
 
 /// The palm body welded at the start pose, and each finger's two phalanx bodies with their
@@ -217,7 +274,8 @@ fn mjcf_hand(s: &mut String, case: &Case, start: &Start) {
         v3(&(start.origin_mm.coords * MM)),
         quat(&palm_rotation(&case.pose.axes))
     );
-    box_geom(s, "      ", "palm", &hand.palm_box(), "");
+    let palm = [("palm".to_string(), hand.palm_box())];
+    hand_body_geoms(s, "      ", hand, "palm", &palm, "");
     let density = format!(" density=\"{}\"", case.params.fingers.finger_density_kg_m3);
     for f in &hand.finger_list {
         let sd = f.side.sign();
@@ -233,7 +291,8 @@ fn mjcf_hand(s: &mut String, case: &Case, start: &Start) {
             s,
             "        <joint name=\"{n}_joint_1\" type=\"hinge\" axis=\"0 0 {sd}\" range=\"{lo1:.9} {hi1:.9}\" damping=\"0\"/>"
         );
-        box_geom(s, "        ", &format!("{n}_phalanx_1"), &p1, &density);
+        let body = format!("{n}_phalanx_1");
+        hand_body_geoms(s, "        ", hand, &body, &[(body.clone(), p1)], &density);
         let _ = writeln!(
             s,
             "        <body name=\"{n}_phalanx_2\" pos=\"{}\">",
@@ -244,9 +303,19 @@ fn mjcf_hand(s: &mut String, case: &Case, start: &Start) {
             "          <joint name=\"{n}_joint_2\" type=\"hinge\" axis=\"0 0 {sd}\" range=\"{lo2:.9} {hi2:.9}\" damping=\"0\"/>"
         );
         // The contact part of phalanx 2, then its thinned tip if it has one.
-        for (b, part) in p2.iter().zip(["phalanx_2", "tip"]) {
-            box_geom(s, "          ", &format!("{n}_{part}"), b, &density);
-        }
+        let boxes: Vec<(String, HandBox)> = p2
+            .iter()
+            .zip(["phalanx_2", "tip"])
+            .map(|(b, part)| (format!("{n}_{part}"), *b))
+            .collect();
+        hand_body_geoms(
+            s,
+            "          ",
+            hand,
+            &format!("{n}_phalanx_2"),
+            &boxes,
+            &density,
+        );
         let _ = writeln!(s, "        </body>");
         let _ = writeln!(s, "      </body>");
     }

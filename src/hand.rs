@@ -15,6 +15,7 @@ mod geometry;
 pub mod import;
 mod import_frame;
 pub mod kinematics;
+pub mod link_geometry;
 pub mod mjcf_hand;
 pub mod urdf_hand;
 pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
@@ -106,6 +107,11 @@ pub struct Hand {
     /// plan is checked against each coupling ([`Hand::coupling_checks`]), not refused.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub coupling: Vec<Coupling>,
+    /// The hand file's own link geometry where its links have meshes (issue 37: a hand read
+    /// from a URDF or MJCF), which the physics check and `--export-mjcf` use instead of the
+    /// model's boxes for those bodies. Never in a hand TOML, never serialised.
+    #[serde(skip)]
+    pub link_geometry: Option<std::sync::Arc<link_geometry::LinkGeometry>>,
 }
 
 /// A coupling between two joints of the model: θ(follower) = multiplier × θ(leader) +
@@ -134,6 +140,9 @@ pub struct CouplingCheck {
     /// The follower's planned angle minus the angle the coupling gives it `[deg]`.
     pub error_deg: f64,
 }
+
+/// The step between the palm stand-offs the planner tries ([`Hand::palm_standoffs_mm`]) `[mm]`.
+pub const STANDOFF_STEP_MM: f64 = 2.0;
 
 /// How closely a plan must keep a coupling to keep it `[deg]`: the thesis's Joint Angular
 /// Deviation.
@@ -168,6 +177,13 @@ pub struct Palm {
     pub margin_mm: f64,
     /// Half the palm's width across the fingers' curling direction `[mm]`.
     pub half_width_mm: f64,
+    /// How far in front of the palm's contact surface the fingers may hold an object they
+    /// cannot wrap resting on it `[mm]` (beyond the thesis, issue 37): the object is held
+    /// between the phalanges, the palm stood off it. Optional: without it (or at 0) the
+    /// thesis's model, every object rests on the palm. A hand whose distal joint closes at
+    /// most 90° (the Schunk SDH-2) wraps nothing resting on its palm and needs it.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub standoff_max_mm: Option<f64>,
 }
 
 /// Where the joint-1 axes are and how far each joint turns.
@@ -237,6 +253,15 @@ pub struct Finger {
 }
 
 impl Hand {
+    /// The palm's stand-offs the planner tries, nearest first `[mm]`: 0 (the object resting on
+    /// the palm, the thesis's model), then [`STANDOFF_STEP_MM`] steps up to
+    /// `palm.standoff_max_mm`. Just `[0]` for a hand without a stand-off.
+    pub fn palm_standoffs_mm(&self) -> Vec<f64> {
+        let max = self.palm.standoff_max_mm.unwrap_or(0.0);
+        let steps = (max / STANDOFF_STEP_MM).floor() as usize;
+        (0..=steps).map(|k| k as f64 * STANDOFF_STEP_MM).collect()
+    }
+
     /// Checks planned joint angles `[θ1, θ2]` per finger (model order, degrees) against every
     /// coupling: the planner does not refuse a plan that breaks one, the check says by how much.
     pub fn coupling_checks(&self, theta_deg: &[[f64; 2]]) -> Vec<CouplingCheck> {
@@ -386,6 +411,10 @@ impl Hand {
         let non_negative = [
             ("palm.margin_mm", self.palm.margin_mm),
             ("joints.setback_mm", self.joints.setback_mm),
+            (
+                "palm.standoff_max_mm",
+                self.palm.standoff_max_mm.unwrap_or(0.0),
+            ),
             (
                 "phalanx_1.unusable_proximal_mm",
                 self.phalanx_1.unusable_proximal_mm,

@@ -68,6 +68,9 @@ pub fn table(d: &Derived, file: &str) -> String {
     for (k, v) in rows {
         let _ = writeln!(s, "{k:<31} {v:>9.3}");
     }
+    if let Some(v) = h.palm.standoff_max_mm {
+        let _ = writeln!(s, "{:<31} {v:>9.3}", "palm.standoff_max_mm");
+    }
     for (k, [lo, hi]) in [
         ("joints.theta1_range_deg", h.joints.theta1_range_deg),
         ("joints.theta2_range_deg", h.joints.theta2_range_deg),

@@ -677,6 +677,27 @@ pub(crate) fn points_of_body(
     out
 }
 
+/// The geometry elements of the rigid body of `link`, each as its points in the frame the poses
+/// are in, with whether it is a mesh (for [`super::link_geometry`]).
+pub(crate) fn pieces_of_body(
+    tree: &Tree,
+    pose: &[Option<Isometry3<f64>>],
+    link: usize,
+) -> Vec<super::link_geometry::Piece> {
+    let mut out = Vec::new();
+    for l in tree.rigid_subtree(link) {
+        let Some(p) = pose[l] else { continue };
+        for g in &tree.links[l].geoms {
+            let points = shape_points(&g.shape)
+                .iter()
+                .map(|v| p * (g.pose * v))
+                .collect();
+            out.push((points, matches!(g.shape, GeomShape::Points(_))));
+        }
+    }
+    out
+}
+
 /// A finger's joints in the palm link's frame.
 pub(crate) struct FingerAxes {
     /// Joint 1: a point, the axis.

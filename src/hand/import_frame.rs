@@ -459,7 +459,72 @@ pub(super) fn build(
         (setback, lateral, l1, l2, offset),
         [r1, r2],
     );
-    finish(tree, pose, palm, chains, &frame, &m, hand, notes, overrides)
+    let mut derived = finish(tree, pose, palm, chains, &frame, &m, hand, notes, overrides)?;
+    let geometry = link_geometry(tree, pose, palm, chains, &frame, &m, finger_axes);
+    if !geometry.is_empty() {
+        derived.notes.push(
+            "links with meshes: the convex hull of each of their geometry elements stands for the \
+             model's box of that body in the physics check and --export-mjcf"
+                .to_string(),
+        );
+        derived.hand.link_geometry = Some(std::sync::Arc::new(geometry));
+    }
+    Ok(derived)
+}
+
+/// The file's own geometry per model body ([`super::link_geometry`]): the palm's (with the
+/// spread links, held with it) in the palm frame, each phalanx's about its own joint.
+fn link_geometry(
+    tree: &Tree,
+    pose: &[Option<Isometry3<f64>>],
+    palm: usize,
+    chains: &[ChainInfo],
+    frame: &Frame,
+    m: &[Measured],
+    finger_axes: &[super::import::FingerAxesRef],
+) -> super::link_geometry::LinkGeometry {
+    use super::import::pieces_of_body;
+    use super::link_geometry::{body_pieces, turn};
+    let to_model = |p: &Point3<f64>| frame.to_model(p);
+    let mut palm_pieces = pieces_of_body(tree, pose, palm);
+    for &c in &frame.order {
+        if let Some(s) = chains[c].2 {
+            palm_pieces.extend(pieces_of_body(tree, pose, tree.joints[s].child));
+        }
+    }
+    let identity = (Point3::origin(), UnitQuaternion::identity());
+    let sides = [1.0, -1.0, 1.0];
+    let phalanges = frame
+        .order
+        .iter()
+        .enumerate()
+        .map(|(k, &c)| {
+            let a = axes_of(&finger_axes[c]);
+            let at = |p: &Point3<f64>| {
+                let q = frame.to_model(p);
+                Point3::new(q.x, q.y, m[k].height)
+            };
+            let r1 = turn(sides[k], super::bend(m[k].theta0[0]));
+            let r2 = r1 * turn(sides[k], super::bend(m[k].theta0[1]));
+            let (j1, j2) = (chains[c].0, chains[c].1);
+            [
+                body_pieces(
+                    pieces_of_body(tree, pose, tree.joints[j1].child),
+                    to_model,
+                    (at(&a[0].0), r1),
+                ),
+                body_pieces(
+                    pieces_of_body(tree, pose, tree.joints[j2].child),
+                    to_model,
+                    (at(&a[1].0), r2),
+                ),
+            ]
+        })
+        .collect();
+    super::link_geometry::LinkGeometry {
+        palm: body_pieces(palm_pieces, to_model, identity),
+        phalanges,
+    }
 }
 
 /// The model's numbers as a [`Hand`] (unvalidated), with the thesis hand's proportions for
@@ -485,6 +550,7 @@ fn model(
             offset_mm: ext[0].1 - ext[0].0,
             margin_mm: margin.max(0.0),
             half_width_mm: 0.5 * (ext[1].1 - ext[1].0),
+            standoff_max_mm: None,
         },
         joints: super::Joints {
             lateral_mm: lateral,
@@ -508,6 +574,7 @@ fn model(
             unusable_proximal_mm: l2 * 2.0 / 20.0,
             unusable_distal_mm: 0.0,
         },
+        link_geometry: None,
         finger_list: names
             .iter()
             .zip(heights)
@@ -523,6 +590,38 @@ fn model(
             })
             .collect(),
         coupling: Vec::new(),
+    }
+}
+
+/// A hand that wraps, resting on its palm, no object narrower than the span between its
+/// opposing joint-1 axes (a distal joint that closes at most 90° against a long phalanx 1, as the
+/// Schunk SDH-2's: it wraps nothing under 92 mm on its palm, its axes 57 mm apart) is given a
+/// palm stand-off: the planner may hold the object in front of the palm, between the
+/// phalanges, up to half phalanx 1's length out (so that phalanx 1 still reaches round it), and
+/// the note says so. A hand that wraps such objects on its palm (the thesis hand, the BH8)
+/// keeps the thesis's model.
+fn standoff_if_needed(hand: &mut Hand, notes: &mut Vec<String>) {
+    let span = 2.0 * hand.joints.lateral_mm;
+    let smallest = super::kinematics::graspable_circle_radii(hand).map(|(lo, _)| 2.0 * lo);
+    if hand.palm.standoff_max_mm.is_some() || smallest.is_some_and(|d| d <= span) {
+        return;
+    }
+    let max = (0.5 * hand.phalanx_1.length_mm).floor();
+    let mut with = hand.clone();
+    with.palm.standoff_max_mm = Some(max);
+    if let Some((lo, _)) = super::kinematics::graspable_circle_radii(&with) {
+        *hand = with;
+        let on_palm = smallest.map_or("no object".to_string(), |d| {
+            format!("no object under {d:.1} mm")
+        });
+        notes.push(format!(
+            "resting on the palm the fingers wrap {on_palm} (joint 2 closes to at most \
+             {:.1}°), and the opposing joint-1 axes are {span:.1} mm apart: objects are also \
+             held in front of the palm, between the phalanges, up to {max:.0} mm out \
+             (palm.standoff_max_mm, half phalanx 1; wrapped from {:.1} mm across)",
+            hand.joints.theta2_range_deg[0],
+            2.0 * lo
+        ));
     }
 }
 
@@ -566,6 +665,7 @@ fn finish(
             )),
         }
     }
+    standoff_if_needed(&mut hand, &mut notes);
     let text = toml::to_string(&hand).map_err(|e| err(&tree.file, e.to_string()))?;
     let hand = Hand::parse(&text, &tree.file, overrides)?;
     let model = |p: &Point3<f64>| frame.to_model(p);

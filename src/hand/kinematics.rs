@@ -20,6 +20,11 @@
 //!   bend back), and the old scan, started at eq. 3.2's circle, stopped there and reported a
 //!   largest diameter of 0. A hand whose range is empty (it wraps no circle, or none larger than
 //!   eq. 3.2's) is refused when its hand file is read, with the reason.
+//! - Beyond the thesis (issue 37): a hand with `palm.standoff_max_mm` may also hold the circle in
+//!   front of the palm, on its normal through the centre, between the phalanges
+//!   ([`wrapping_standoff`]): a circle counts as wrapped at the nearest stand-off (0 first, in
+//!   1 mm steps) where both phalanges touch it within their ranges. The Schunk SDH-2's distal
+//!   joint closes at most 90°, and resting on its palm it wraps nothing under 89 mm.
 
 use super::Hand;
 use nalgebra::{Point2, Rotation2, Vector2};
@@ -170,8 +175,14 @@ fn first_touch_bend(
 /// `r` resting on the palm centre, closing each phalanx in turn; `None` if a phalanx never
 /// touches.
 pub fn circle_contact_angles(hand: &Hand, r: f64) -> Option<[f64; 2]> {
+    circle_contact_angles_off(hand, r, 0.0)
+}
+
+/// As [`circle_contact_angles`] for the circle held `standoff` in front of the palm's contact
+/// surface (on the palm's normal through its centre) instead of resting on it `[mm]`.
+pub fn circle_contact_angles_off(hand: &Hand, r: f64, standoff: f64) -> Option<[f64; 2]> {
     let o = hand.fingers.offset_mm;
-    let c = Point2::new(-r, 0.0);
+    let c = Point2::new(-r - standoff, 0.0);
     let j1 = joint1(hand);
     let p1 = &hand.phalanx_1;
     let straight1 = phalanx1_direction(std::f64::consts::PI);
@@ -204,9 +215,18 @@ pub fn circle_contact_angles(hand: &Hand, r: f64) -> Option<[f64; 2]> {
 }
 
 /// Returns true if and only if both phalanges of the +y finger touch the circle of radius `r`
-/// resting on the palm centre with joint angles inside their ranges.
+/// resting on the palm centre with joint angles inside their ranges; for a hand with a palm
+/// stand-off (`palm.standoff_max_mm`), resting on the palm or held in front of it at one of
+/// [`Hand::palm_standoffs_mm`] (in 1 mm steps here, finer than the planner's).
 fn wraps_circle(hand: &Hand, r: f64) -> bool {
-    match circle_contact_angles(hand, r) {
+    let max = hand.palm.standoff_max_mm.unwrap_or(0.0);
+    let steps = max.floor() as usize;
+    (0..=steps).any(|k| wraps_circle_at(hand, r, (k as f64).min(max)))
+}
+
+/// [`wraps_circle`] with the circle held `standoff` in front of the palm `[mm]`.
+fn wraps_circle_at(hand: &Hand, r: f64, standoff: f64) -> bool {
+    match circle_contact_angles_off(hand, r, standoff) {
         Some([t1, t2]) => {
             let [a1, b1] = hand.joints.theta1_range_deg;
             let [a2, b2] = hand.joints.theta2_range_deg;
@@ -214,6 +234,17 @@ fn wraps_circle(hand: &Hand, r: f64) -> bool {
         }
         None => false,
     }
+}
+
+/// The nearest stand-off in front of the palm `[mm]` (in 1 mm steps, up to
+/// `palm.standoff_max_mm`) at which both phalanges wrap the circle of radius `r`, with the joint
+/// angles there; `None` if none does. 0 is the thesis's circle resting on the palm.
+pub fn wrapping_standoff(hand: &Hand, r: f64) -> Option<(f64, [f64; 2])> {
+    let max = hand.palm.standoff_max_mm.unwrap_or(0.0);
+    (0..=max.floor() as usize)
+        .map(|k| (k as f64).min(max))
+        .find(|&d| wraps_circle_at(hand, r, d))
+        .and_then(|d| circle_contact_angles_off(hand, r, d).map(|a| (d, a)))
 }
 
 /// Largest radius the scan looks at `[mm]`: a 2 m object is no object for a hand.
@@ -450,5 +481,36 @@ mod tests {
         // Wider than the thesis hand at both ends: its fingers are longer and further apart.
         assert!(r.min_mm > 20.0 && r.min_mm < 40.0, "{r:?}");
         assert!(r.max_kinematic_mm > 150.0, "{r:?}");
+    }
+
+    /// A palm stand-off (issue 37) changes nothing for a circle the hand wraps resting on its
+    /// palm (the nearest stand-off is 0, the angles are the thesis model's), and wraps circles
+    /// below the smallest the palm allows (resting on it, the thesis hand's joint 1 would have
+    /// to close past 45°), at the nearest stand-off with every angle in range.
+    #[test]
+    fn a_palm_standoff_wraps_circles_the_palm_cannot() {
+        let (_, text) = crate::hand::bundled("thesis").unwrap();
+        let path = std::path::Path::new("thesis.toml");
+        let on_palm = Hand::parse(text, path, &[]).unwrap();
+        let with = text.replacen("[palm]\n", "[palm]\nstandoff_max_mm = 30.0\n", 1);
+        let off = Hand::parse(&with, path, &[]).unwrap();
+        assert_eq!(off.palm_standoffs_mm().len(), 16);
+        assert_eq!(on_palm.palm_standoffs_mm(), vec![0.0]);
+        let (d, a) = wrapping_standoff(&off, 20.0).unwrap();
+        assert_eq!(d, 0.0);
+        assert_eq!(a, circle_contact_angles(&on_palm, 20.0).unwrap());
+        let (lo, _) = graspable_circle_radii(&on_palm).unwrap();
+        let r = lo - 1.5;
+        assert!(wrapping_standoff(&on_palm, r).is_none());
+        let (d, [t1, t2]) = wrapping_standoff(&off, r).unwrap();
+        assert!((1.0..=30.0).contains(&d), "{d}");
+        assert!(!wraps_circle_at(&off, r, d - 1.0));
+        let [a1, b1] = off.joints.theta1_range_deg;
+        let [a2, b2] = off.joints.theta2_range_deg;
+        assert!(
+            (a1..=b1).contains(&t1) && (a2..=b2).contains(&t2),
+            "{t1} {t2}"
+        );
+        assert!(graspable_circle_radii(&off).unwrap().0 < lo - 1.5);
     }
 }

@@ -282,6 +282,7 @@ fn grasp_report(
     report::GraspReport {
         approach_angle_deg: g.approach_angle_deg,
         palm_pitch_deg: g.palm.pitch_rad.to_degrees(),
+        palm_standoff_mm: (g.palm.standoff_mm > 0.0).then_some(g.palm.standoff_mm),
         elevation_index: g.elevation_index,
         elevation_mm: g.elevation_mm,
         palm_pose: pose_report(&aligned.to_original(&g.palm.origin), &r_original),

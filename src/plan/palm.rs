@@ -51,6 +51,9 @@ pub struct PalmPlacement {
     /// How far the palm was moved back from its thesis position so as not to take in the
     /// object (extended rules only; else 0) `[mm]`.
     pub backed_off_mm: f64,
+    /// How far the palm stands off the object beyond that, the object held between the
+    /// phalanges (issue 37: a hand with `palm.standoff_max_mm`; else 0) `[mm]`.
+    pub standoff_mm: f64,
 }
 
 /// Why a palm placement failed.
@@ -161,6 +164,7 @@ pub fn place_palm_on(
         contacts,
         slice: vslice.clone(),
         backed_off_mm,
+        standoff_mm: 0.0,
     })
 }
 

@@ -328,13 +328,31 @@ fn try_candidate(
             palm.backed_off_mm += depth;
         }
     }
-    let fingers = (0..hand.finger_list.len())
-        .map(|k| {
-            place_finger(mesh, index, hand, &palm, k, deviation, rules)
-                .map_err(|r| Rejection::Finger(k, r))
-        })
-        .collect::<Result<Vec<_>, _>>()?;
-    Ok((palm, fingers))
+    // The palm on the object (the thesis), then for a hand with a palm stand-off
+    // (issue 37) held off it in steps, the object between the phalanges: the nearest that
+    // places every finger. A failure reports the rejection with the palm on the object.
+    let mut first = None;
+    let mut at = 0.0;
+    for standoff in hand.palm_standoffs_mm() {
+        if standoff != at {
+            palm.origin += palm.axes[0] * (standoff - at);
+            palm.standoff_mm = standoff;
+            at = standoff;
+        }
+        let fingers = (0..hand.finger_list.len())
+            .map(|k| {
+                place_finger(mesh, index, hand, &palm, k, deviation, rules)
+                    .map_err(|r| Rejection::Finger(k, r))
+            })
+            .collect::<Result<Vec<_>, _>>();
+        match fingers {
+            Ok(fingers) => return Ok((palm, fingers)),
+            Err(r) => {
+                first.get_or_insert(r);
+            }
+        }
+    }
+    Err(first.unwrap_or(Rejection::Palm(PalmRejection::NoContact)))
 }
 
 /// Returns true if and only if a finger of the grasp at Finger_1's `index` sits on an elevation

@@ -207,6 +207,11 @@ pub struct GraspReport {
     pub rules: crate::plan::RuleSet,
     /// The thesis rules the grasp relaxed (empty under the thesis's rules).
     pub relaxations: Vec<crate::plan::Relaxation>,
+    /// How far the palm stands off the object, which the phalanges hold in front of it
+    /// (issue 37: a hand with `palm.standoff_max_mm`, such as the Schunk SDH-2) `[mm]`; left out
+    /// where the object rests on the palm (the thesis's model).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub palm_standoff_mm: Option<f64>,
     /// The physics check on this grasp, when it ran on it.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub check: Option<CandidateCheck>,

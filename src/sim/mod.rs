@@ -41,6 +41,7 @@ pub mod contacts;
 pub mod convert;
 pub mod early;
 pub mod flight;
+pub mod hand_shapes;
 pub mod hold;
 pub mod impulse_hand;
 pub mod outcome;

@@ -431,11 +431,9 @@ pub fn build(case: &Case) -> Scene {
     let palm = world
         .bodies
         .insert(RigidBodyBuilder::fixed().pose(convert::pose(&start.origin_mm, &r_palm)));
-    let mut hand_colliders = vec![world.colliders.insert_with_parent(
-        hand_collider(&hand.palm_box(), friction),
-        palm,
-        &mut world.bodies,
-    )];
+    // The palm's colliders: its box, or the hand file's own link meshes (`hand_shapes`).
+    let palm_box = || vec![hand_collider(&hand.palm_box(), friction)];
+    let mut hand_colliders = super::hand_shapes::insert(&mut world, palm, hand, friction, palm_box);
     let fingers: Vec<SimFinger> = hand
         .finger_list
         .iter()
@@ -573,13 +571,22 @@ fn insert_finger(
     };
     let (p1, p2) = hand.phalanx_boxes(f.side);
     let [(j1, r1), (j2, r2)] = hand.finger_poses(f, &at.palm_pose, [open1, open2]);
-    let mut phalanx = |world: &mut PhysicsWorld, pose: Pose, boxes: &[HandBox]| {
+    // Body `k` of the hand (`Hand::body_poses`' order): phalanx 1 of finger `i` is 1 + 2i.
+    let first = 1 + 2 * hand
+        .finger_list
+        .iter()
+        .position(|g| std::ptr::eq(g, f))
+        .unwrap_or(0);
+    let mut phalanx = |world: &mut PhysicsWorld, pose: Pose, boxes: &[HandBox], k: usize| {
         let body = world
             .bodies
             .insert(RigidBodyBuilder::dynamic().pose(pose).can_sleep(false));
-        for b in boxes {
+        let colliders = super::hand_shapes::colliders(hand, k, friction, || {
+            boxes.iter().map(|b| hand_collider(b, friction)).collect()
+        });
+        for c in colliders {
             hand_colliders.push(world.colliders.insert_with_parent(
-                hand_collider(b, friction).density(density),
+                c.density(density),
                 body,
                 &mut world.bodies,
             ));
@@ -590,7 +597,7 @@ fn insert_finger(
     let squeeze2 = params.fingers.squeeze2_deg.to_radians();
     // Body, colliders, joint, in this order for each phalanx: rapier's state (and so the run)
     // depends on the order of insertion.
-    let b1 = phalanx(world, convert::pose(&j1, &r1), &[p1]);
+    let b1 = phalanx(world, convert::pose(&j1, &r1), &[p1], first);
     let joint1 = revolute(
         &hand.joint1_anchor_mm(f),
         limits1,
@@ -598,7 +605,7 @@ fn insert_finger(
     );
     let kind = params.solver.hand_joints;
     let joint1 = insert_joint(world, kind, palm, b1, joint1);
-    let b2 = phalanx(world, convert::pose(&j2, &r2), &p2);
+    let b2 = phalanx(world, convert::pose(&j2, &r2), &p2, first + 1);
     // Joint 2 is held at its open angle until released (see `Scene::release_joint2`).
     let joint2 = revolute(&hand.joint2_anchor_mm(f.side), limits2, open2 as f32);
     let joint2 = insert_joint(world, kind, b1, b2, joint2);
