@@ -107,12 +107,7 @@ pub fn rank_with(
         .map(|i| Some(sf * curv[i]? + (1.0 - sf) * diam[i]?))
         .collect();
 
-    let top = hand.finger_list[0].height_mm;
-    let finger_offsets: Vec<i64> = hand
-        .finger_list
-        .iter()
-        .map(|f| ((top - f.height_mm) / step).round() as i64)
-        .collect();
+    let finger_offsets = finger_offsets(hand, step);
     let spread = *finger_offsets.iter().max().unwrap_or(&0);
     let low = *finger_offsets.iter().min().unwrap_or(&0);
 
@@ -157,6 +152,15 @@ pub fn rank_with(
         reason,
         curvature_relaxed: vec![false; n],
     }
+}
+
+/// Each finger's index offset below Finger_1's, in hand order, for a HeightStep of `step_mm`.
+pub fn finger_offsets(hand: &Hand, step_mm: f64) -> Vec<i64> {
+    let top = hand.finger_list.first().map_or(0.0, |f| f.height_mm);
+    hand.finger_list
+        .iter()
+        .map(|f| ((top - f.height_mm) / step_mm).round() as i64)
+        .collect()
 }
 
 /// The number of steps of the Largest Span Height: the longest run between consecutive
