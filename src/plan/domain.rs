@@ -38,7 +38,8 @@ pub struct Domain {
     pub slice_z_range_mm: Vec<[f64; 2]>,
     /// The outermost crossings of each indexed elevation with each slice, found once here for
     /// every stage that grades by them: `crossings[i][k]` is [`Domain::touches`]`(k,
-    /// elevations[i])`.
+    /// elevations[i])`, or `None` where the elevation is within [`SLICE_END_MM`] of the
+    /// slice's lowest or highest point.
     pub crossings: Vec<Vec<Option<(Touch, Touch)>>>,
     /// Outward directions of the object's large flat side faces, as angles from +X `[deg]`
     /// (see [`face_directions_deg`]); the palm approaching at such an angle lies flat on the face.
@@ -120,7 +121,19 @@ impl Domain {
             .map(|&z| {
                 slices
                     .iter()
-                    .map(|s| outermost_crossings(&s.contours, z))
+                    .zip(&slice_z_range_mm)
+                    .map(|(s, &[a, b])| {
+                        // Within SLICE_END_MM of the slice's lowest or highest point the line
+                        // meets only its end: a flat bottom cut at its own height, whose
+                        // chord is all of it in the file's frame and a sliver or nothing in
+                        // another (issue 30). The extended rules' elevations may land there
+                        // exactly (the finger offset less the overlap, a whole number of steps).
+                        if z <= a + SLICE_END_MM || z >= b - SLICE_END_MM {
+                            None
+                        } else {
+                            outermost_crossings(&s.contours, z)
+                        }
+                    })
                     .collect()
             })
             .collect();
@@ -196,6 +209,11 @@ pub fn cannot_grade(mesh: &Mesh, params: &PlannerParams, hand: &Hand, angles_deg
     let min = super::kinematics::graspable_range_with(hand, params.magnify_factor).used()[0];
     mean + MARGIN_MM < min
 }
+
+/// How near a slice's lowest or highest point an elevation counts as missing that slice
+/// `[mm]`: far above the round-off of a file written in single precision in another frame
+/// (some 1e-5 mm on an object 500 mm from its origin), far below anything a finger feels.
+pub const SLICE_END_MM: f64 = 1e-4;
 
 /// The lowest and highest elevation of `contours`' points, `[lo, hi]` `[mm]` (`[∞, −∞]` when
 /// there are none).
