@@ -290,7 +290,7 @@ pub fn covariant_mass_properties(mesh: &Mesh) -> Option<MassProperties> {
         area += w;
         first += w * (a.coords + b.coords + c.coords) / 3.0;
     }
-    if !(area > 0.0) {
+    if area.is_nan() || area <= 0.0 {
         return None;
     }
     let o = first / area;
