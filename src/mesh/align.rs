@@ -54,6 +54,18 @@ impl AlignedObject {
 
 const DEGENERATE_MOMENTS: f64 = 1e-6;
 
+/// Under [`FrameRule::Geometry`], two moments closer than this (relative) are equal: their
+/// eigenvectors turn by about the moments' round-off over their gap, and a file written in
+/// single precision in another frame moves the moments by some 1e-7, which at a gap of 1e-5
+/// (a faceted ball) turns the axes by degrees; at this gap, by under 0.1°.
+const GEOMETRY_EQUAL_MOMENTS: f64 = 1e-4;
+
+/// Under [`FrameRule::Geometry`], how close to a tie two geometric measures may be and still
+/// decide (relative to their scale): a vertex this much nearer than the farthest counts as
+/// equally far, a third moment this small against its absolute counterpart, or ends this
+/// nearly level, decides no sense. Single precision in another frame moves them by some 1e-6.
+const GEOMETRY_TIE: f64 = 1e-4;
+
 /// Which principal axis becomes the grasp axis (aligned +Z), and in which sense.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 pub struct GraspAxis {
@@ -222,9 +234,15 @@ pub fn align_with_rule(
     which: GraspAxis,
     rule: FrameRule,
 ) -> AlignedObject {
+    let given = props;
     match rule {
         FrameRule::File => align_with(mesh, props, which),
         FrameRule::Geometry => {
+            // The frame from moments that turn with the mesh whatever its topology: for one
+            // closed shell they are `props`; for an open or a many-shell mesh `props` may be
+            // integrated about the file's bounding box or over slices in its frame.
+            let own = covariant_mass_properties(mesh).unwrap_or(*props);
+            let props = &own;
             let c = canonical_rotation(mesh, props);
             let mut turned_mesh = mesh.clone();
             turned_mesh.map_vertices(|p| c * p);
@@ -237,7 +255,7 @@ pub fn align_with_rule(
             let mut d = [turned[(0, 0)], turned[(1, 1)], turned[(2, 2)]];
             for (i, j) in [(0, 1), (1, 2), (0, 2)] {
                 let scale = d[i].abs().max(d[j].abs()).max(f64::MIN_POSITIVE);
-                if (d[i] - d[j]).abs() / scale <= DEGENERATE_MOMENTS {
+                if (d[i] - d[j]).abs() / scale <= GEOMETRY_EQUAL_MOMENTS {
                     let mean = 0.5 * (d[i] + d[j]);
                     d[i] = mean;
                     d[j] = mean;
@@ -253,10 +271,50 @@ pub fn align_with_rule(
                 Translation3::identity(),
                 UnitQuaternion::from_rotation_matrix(&c),
             );
-            a.original = *props;
+            a.original = *given;
             a
         }
     }
+}
+
+/// The mass properties (unit density) of the solid the triangles enclose as a fan of
+/// tetrahedra from the surface's area-weighted centroid: a point that moves with the mesh, so
+/// the moments turn with it exactly (to round-off) even where the surface is open, and every
+/// shell counts whole where shells overlap. `None` for no enclosed volume. For one closed
+/// shell, [`super::mass_properties`] to round-off.
+pub fn covariant_mass_properties(mesh: &Mesh) -> Option<MassProperties> {
+    let (mut area, mut first) = (0.0, Vector3::zeros());
+    for t in 0..mesh.triangles.len() {
+        let [a, b, c] = mesh.corners(t);
+        let w = 0.5 * (b - a).cross(&(c - a)).norm();
+        area += w;
+        first += w * (a.coords + b.coords + c.coords) / 3.0;
+    }
+    if area.is_nan() || area <= 0.0 {
+        return None;
+    }
+    let o = first / area;
+    let (mut vol, mut m1, mut m2) = (0.0, Vector3::zeros(), Matrix3::zeros());
+    for t in 0..mesh.triangles.len() {
+        let [a, b, c] = mesh.corners(t);
+        let (a, b, c) = (a.coords - o, b.coords - o, c.coords - o);
+        let v = a.dot(&b.cross(&c)) / 6.0;
+        let s = a + b + c;
+        vol += v;
+        m1 += v * s / 4.0;
+        m2 += v / 20.0
+            * (s * s.transpose() + a * a.transpose() + b * b.transpose() + c * c.transpose());
+    }
+    if !(vol > 0.0 && vol.is_finite()) {
+        return None;
+    }
+    let g = m1 / vol;
+    let cov = m2 - vol * g * g.transpose();
+    Some(MassProperties {
+        volume_mm3: vol,
+        centroid: Point3::from(o + g),
+        inertia: Matrix3::identity() * cov.trace() - cov,
+    })
 }
 
 /// A rotation into the object's canonical frame, from its geometry alone: its rows are the
@@ -264,15 +322,16 @@ pub fn align_with_rule(
 ///
 /// The rule (docs/FRAMES.md):
 /// 1. Z is the principal axis of least moment, X that of the middle, Y = Z × X.
-/// 2. Where two moments are equal (relative difference at most 1e-6: a square bar, a body of
-///    revolution), the axis within their plane is the direction, projected into the plane, of
-///    the vertex farthest from the centroid (a square bar's corner, one of a faceted
-///    cylinder's rim vertices: which one is a symmetry of the shape); all three equal, Z is
-///    that direction itself.
+/// 2. Where two moments are equal (relative difference at most 1e-4: a square bar, a body of
+///    revolution, a faceted ball), the axis within their plane is the direction, projected
+///    into the plane, of the vertex farthest from the centroid (a square bar's corner, one of
+///    a faceted cylinder's rim vertices), the first in the file's order of those within 1e-4
+///    of the farthest; all three equal, Z is that direction itself.
 /// 3. Each axis points the way its area-weighted third moment of the surface is positive
 ///    (the end with the longer tail of surface, a bottle's neck), else (a shape symmetric
-///    across the plane normal to it) towards the farther extreme point, else (symmetric in
-///    that too) as the eigen-solver gave it: then either sense gives the same shape.
+///    across the plane normal to it, to 1e-3 of the moment) towards the farther extreme point
+///    (to 1e-4 of the reach); X, where neither decides, the way that makes Y's decide; else
+///    towards the first vertex in the file's order that lies off the plane.
 pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64> {
     let eig = SymmetricEigen::new(props.inertia);
     let mut order = [0usize, 1, 2];
@@ -289,22 +348,9 @@ pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64>
     let c = props.centroid;
     let equal = |a: f64, b: f64| {
         let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
-        (b - a).abs() / scale <= DEGENERATE_MOMENTS
+        (b - a).abs() / scale <= GEOMETRY_EQUAL_MOMENTS
     };
-    // The vertex farthest from the centroid in the plane normal to `n` (all of space if `n` is
-    // zero), as a unit direction in that plane.
-    let farthest = |n: Vector3<f64>| -> Option<Vector3<f64>> {
-        let mut best: Option<(f64, Vector3<f64>)> = None;
-        for p in &mesh.vertices {
-            let d = p - c;
-            let d = d - n * n.dot(&d);
-            let r = d.norm_squared();
-            if best.is_none_or(|(b, _)| r > b) {
-                best = Some((r, d));
-            }
-        }
-        best.and_then(|(_, d)| d.try_normalize(1e-12))
-    };
+    let farthest = |n: Vector3<f64>| farthest_vertex(mesh, c, n);
     let (z, x) = match (equal(m[0], m[1]), equal(m[1], m[2])) {
         (false, false) => (e[0], e[1]),
         // Least and middle equal: Z within their plane, X the middle of what is left.
@@ -324,8 +370,16 @@ pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64>
         }
     };
     let x = (x - z * z.dot(&x)).normalize();
-    let z = geometric_sense(mesh, c, z);
-    let x = geometric_sense(mesh, c, x);
+    let z = match sense(mesh, c, z) {
+        Some(s) => s * z,
+        None => first_vertex_sense(mesh, c, z) * z,
+    };
+    // X's sense, else the sense it gives Y = Z × X, else the first vertex off the plane.
+    let y0 = z.cross(&x);
+    let x = match (sense(mesh, c, x), sense(mesh, c, y0)) {
+        (Some(s), _) | (None, Some(s)) => s * x,
+        (None, None) => first_vertex_sense(mesh, c, x) * x,
+    };
     let y = z.cross(&x);
     // Rows: the canonical frame's X (the middle axis), Y and Z (the least) in the file's frame.
     Rotation3::from_matrix_unchecked(Matrix3::from_rows(&[
@@ -335,9 +389,33 @@ pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64>
     ]))
 }
 
-/// `v` or `-v`, whichever the surface's third moment along it makes positive (rule 3 of
-/// [`canonical_rotation`]).
-fn geometric_sense(mesh: &Mesh, c: Point3<f64>, v: Vector3<f64>) -> Vector3<f64> {
+/// The direction from `c`, projected into the plane normal to `n` (all of space if `n` is
+/// zero), of the farthest vertex, unit length: of the vertices within [`GEOMETRY_TIE`] of the
+/// farthest distance, the first in the file's order (which a rigid motion keeps), so that
+/// round-off never picks among a faceted cylinder's equally far rim vertices.
+fn farthest_vertex(mesh: &Mesh, c: Point3<f64>, n: Vector3<f64>) -> Option<Vector3<f64>> {
+    let off = |p: &Point3<f64>| {
+        let d = p - c;
+        d - n * n.dot(&d)
+    };
+    let max = mesh
+        .vertices
+        .iter()
+        .map(|p| off(p).norm())
+        .fold(0.0f64, f64::max);
+    let near = max * (1.0 - GEOMETRY_TIE);
+    mesh.vertices
+        .iter()
+        .map(off)
+        .find(|d| d.norm() >= near)
+        .and_then(|d| d.try_normalize(1e-12))
+}
+
+/// The sign (±1) that points `v` the way the surface's area-weighted third moment along it is
+/// positive, else towards the farther extreme point (rule 3 of [`canonical_rotation`]); `None`
+/// where both are within [`GEOMETRY_TIE`] of a tie (a shape symmetric across the plane normal
+/// to `v`).
+fn sense(mesh: &Mesh, c: Point3<f64>, v: Vector3<f64>) -> Option<f64> {
     let (mut m3, mut abs3) = (0.0, 0.0);
     for t in 0..mesh.triangles.len() {
         let [a, b, d] = mesh.corners(t);
@@ -346,18 +424,31 @@ fn geometric_sense(mesh: &Mesh, c: Point3<f64>, v: Vector3<f64>) -> Vector3<f64>
         m3 += area * s * s * s;
         abs3 += area * (s * s * s).abs();
     }
-    if m3.abs() > 1e-6 * abs3 {
-        return if m3 > 0.0 { v } else { -v };
+    if m3.abs() > 10.0 * GEOMETRY_TIE * abs3 {
+        return Some(m3.signum());
     }
     let (lo, hi) = mesh.vertices.iter().fold((0.0f64, 0.0f64), |(lo, hi), p| {
         let s = (p - c).dot(&v);
         (lo.min(s), hi.max(s))
     });
     let scale = hi.max(-lo).max(f64::MIN_POSITIVE);
-    if (hi + lo).abs() > 1e-9 * scale {
-        return if hi + lo > 0.0 { v } else { -v };
-    }
-    v
+    ((hi + lo).abs() > GEOMETRY_TIE * scale).then(|| (hi + lo).signum())
+}
+
+/// The sign (±1) that puts the first vertex, in the file's order, that lies off the plane
+/// through `c` normal to `v` by more than [`GEOMETRY_TIE`] of the object's reach along `v`,
+/// on the positive side: the last resort of rule 3, for a shape symmetric across that plane.
+fn first_vertex_sense(mesh: &Mesh, c: Point3<f64>, v: Vector3<f64>) -> f64 {
+    let reach = mesh
+        .vertices
+        .iter()
+        .map(|p| (p - c).dot(&v).abs())
+        .fold(0.0f64, f64::max);
+    mesh.vertices
+        .iter()
+        .map(|p| (p - c).dot(&v))
+        .find(|s| s.abs() > GEOMETRY_TIE * reach)
+        .map_or(1.0, f64::signum)
 }
 
 /// Flips `v` so that its first non-negligible dot product with `hints` is positive.

@@ -202,6 +202,18 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
     cut(mesh, plane, 0..mesh.triangles.len(), |i| dist[i as usize])
 }
 
+/// The contours `plane` cuts from `mesh` as they come, as [`slice_indexed_raw`] gives them
+/// (not joined, united nor bridged), without an index: for a domain whose slices only need to
+/// show that nothing is graspable ([`crate::plan::domain::cannot_grade`]).
+pub fn slice_unrepaired(mesh: &Mesh, plane: &Plane) -> Slice {
+    let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
+    let d = |i: u32| dist[i as usize];
+    finish(
+        *plane,
+        raw_contours(mesh, plane, 0..mesh.triangles.len(), &d),
+    )
+}
+
 /// [`slice()`] with the triangles the plane may cut found through `index` (built once for the
 /// mesh): the same slice, bit for bit, at a cost that grows with the triangles cut rather than
 /// with the mesh (a search slices thousands of finger planes of one mesh).

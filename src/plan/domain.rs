@@ -13,13 +13,15 @@
 use super::PlannerParams;
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice, Contour, Plane, Slice};
+use crate::slice::{slice, slice_unrepaired, Contour, Plane, Slice};
 use nalgebra::Point2;
 
 /// The reduced search domain of stage 1.
 #[derive(Debug, Clone)]
 pub struct Domain {
-    /// Vertical slices, one per AngularStep in [0°, 180°).
+    /// Vertical slices, one per AngularStep in [0°, 180°), bridged as a finger meets them
+    /// ([`Slice::bridged_prepared`]), or only cut where [`cannot_grade`] shows that no slices
+    /// could make the object graspable.
     pub slices: Vec<Slice>,
     /// Their angles from +X `[deg]`.
     pub angles_deg: Vec<f64>,
@@ -36,7 +38,8 @@ pub struct Domain {
     pub slice_z_range_mm: Vec<[f64; 2]>,
     /// The outermost crossings of each indexed elevation with each slice, found once here for
     /// every stage that grades by them: `crossings[i][k]` is [`Domain::touches`]`(k,
-    /// elevations[i])`.
+    /// elevations[i])`, or `None` where the elevation is within [`SLICE_END_MM`] of the
+    /// slice's lowest or highest point.
     pub crossings: Vec<Vec<Option<(Touch, Touch)>>>,
     /// Outward directions of the object's large flat side faces, as angles from +X `[deg]`
     /// (see [`face_directions_deg`]); the palm approaching at such an angle lies flat on the face.
@@ -67,11 +70,16 @@ impl Domain {
         let step = params.angular_step_deg;
         let count = (180.0 / step).round().max(1.0) as usize;
         let angles_deg: Vec<f64> = (0..count).map(|k| k as f64 * step).collect();
+        let hopeless = cannot_grade(mesh, params, hand, &angles_deg);
         let slices: Vec<Slice> = angles_deg
             .iter()
             .map(|a| {
-                slice(mesh, &Plane::vertical(a.to_radians()))
-                    .bridged_prepared(hand.finger_width_mm(), hand.relief_mm())
+                let plane = Plane::vertical(a.to_radians());
+                if hopeless {
+                    slice_unrepaired(mesh, &plane)
+                } else {
+                    slice(mesh, &plane).bridged_prepared(hand.finger_width_mm(), hand.relief_mm())
+                }
             })
             .collect();
         Domain::from_slices(mesh, params, slices, angles_deg, shrink_mm)
@@ -113,7 +121,19 @@ impl Domain {
             .map(|&z| {
                 slices
                     .iter()
-                    .map(|s| outermost_crossings(&s.contours, z))
+                    .zip(&slice_z_range_mm)
+                    .map(|(s, &[a, b])| {
+                        // Within SLICE_END_MM of the slice's lowest or highest point the line
+                        // meets only its end: a flat bottom cut at its own height, whose
+                        // chord is all of it in the file's frame and a sliver or nothing in
+                        // another (issue 30). The extended rules' elevations may land there
+                        // exactly (the finger offset less the overlap, a whole number of steps).
+                        if z <= a + SLICE_END_MM || z >= b - SLICE_END_MM {
+                            None
+                        } else {
+                            outermost_crossings(&s.contours, z)
+                        }
+                    })
                     .collect()
             })
             .collect();
@@ -136,6 +156,64 @@ impl Domain {
         outermost_crossings(&self.slices[k].contours, z)
     }
 }
+
+/// Returns true if no palm position on `mesh` can have a finger that must sit on a graded
+/// elevation (every rule set's inner finger) on one, whatever its vertical slices at
+/// `angles_deg` turn out to be; false when that is not known without them (issue 30: a cheap necessary
+/// condition, before the slices are cut, united and bridged, which on a degenerate mesh can
+/// cost a minute in i_overlay). Two bounds, from the vertices alone:
+/// - the object is shorter than twice the finger offset: the thesis's Effective Elevation is
+///   empty, and under the extended rules so is the range the inner fingers must lie in
+///   (a slice spans at most the vertices' elevations);
+/// - the mean over the slice angles of the object's width across each slice plane (its
+///   vertices' extent along the plane's horizontal axis, which bounds every chord of that
+///   slice, bridged or not: the bridging stays within the cut's convex hull) is below the
+///   smallest graspable diameter: every Effective Diameter is too thin.
+///
+/// A hand whose fingers are all outer ones (at two heights only) is never rejected here: the
+/// extended rules place outer fingers on ungraded elevations. Neither bound depends on the
+/// shrink of the Effective Elevation, so [`Domain::reshrunk`] may reuse slices cut either way.
+pub fn cannot_grade(mesh: &Mesh, params: &PlannerParams, hand: &Hand, angles_deg: &[f64]) -> bool {
+    let offsets = super::palm_grade::finger_offsets(hand, params.height_step_mm);
+    let (hi, lo) = (
+        offsets.iter().copied().max().unwrap_or(0),
+        offsets.iter().copied().min().unwrap_or(0),
+    );
+    let has_inner = hi == lo || offsets.iter().any(|&o| o != hi && o != lo);
+    if !has_inner || mesh.vertices.is_empty() || angles_deg.is_empty() {
+        return false;
+    }
+    // A margin far above round-off and far below anything a hand can feel `[mm]`.
+    const MARGIN_MM: f64 = 1e-6;
+    let (z_lo, z_hi) = mesh
+        .vertices
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), p| {
+            (a.min(p.z), b.max(p.z))
+        });
+    if z_hi - z_lo + MARGIN_MM < 2.0 * hand.fingers.offset_mm {
+        return true;
+    }
+    let width = |a: f64| {
+        let (s, c) = a.to_radians().sin_cos();
+        let (l, r) = mesh
+            .vertices
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, r), p| {
+                let u = c * p.x + s * p.y;
+                (l.min(u), r.max(u))
+            });
+        r - l
+    };
+    let mean = angles_deg.iter().map(|&a| width(a)).sum::<f64>() / angles_deg.len() as f64;
+    let min = super::kinematics::graspable_range_with(hand, params.magnify_factor).used()[0];
+    mean + MARGIN_MM < min
+}
+
+/// How near a slice's lowest or highest point an elevation counts as missing that slice
+/// `[mm]`: far above the round-off of a file written in single precision in another frame
+/// (some 1e-5 mm on an object 500 mm from its origin), far below anything a finger feels.
+pub const SLICE_END_MM: f64 = 1e-4;
 
 /// The lowest and highest elevation of `contours`' points, `[lo, hi]` `[mm]` (`[∞, −∞]` when
 /// there are none).

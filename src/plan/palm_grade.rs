@@ -11,7 +11,7 @@
 //!   finger's is ungraspable or outside the Effective Elevation. (The thesis describes this as a
 //!   scan from the top that moves Finger_1 below each ungraspable elevation and marks the skipped
 //!   positions ungraspable; the set of positions that survive is exactly this one.)
-//! - Sorting (3.4.4.3): by palm grade, best first; equal grades (to 1e-9) from the higher
+//! - Sorting (3.4.4.3): by palm grade, best first; equal grades (to 1e-4) from the higher
 //!   elevation to the lower.
 
 use super::diameter::DiameterGrades;
@@ -107,12 +107,7 @@ pub fn rank_with(
         .map(|i| Some(sf * curv[i]? + (1.0 - sf) * diam[i]?))
         .collect();
 
-    let top = hand.finger_list[0].height_mm;
-    let finger_offsets: Vec<i64> = hand
-        .finger_list
-        .iter()
-        .map(|f| ((top - f.height_mm) / step).round() as i64)
-        .collect();
+    let finger_offsets = finger_offsets(hand, step);
     let spread = *finger_offsets.iter().max().unwrap_or(&0);
     let low = *finger_offsets.iter().min().unwrap_or(&0);
 
@@ -157,6 +152,15 @@ pub fn rank_with(
         reason,
         curvature_relaxed: vec![false; n],
     }
+}
+
+/// Each finger's index offset below Finger_1's, in hand order, for a HeightStep of `step_mm`.
+pub fn finger_offsets(hand: &Hand, step_mm: f64) -> Vec<i64> {
+    let top = hand.finger_list.first().map_or(0.0, |f| f.height_mm);
+    hand.finger_list
+        .iter()
+        .map(|f| ((top - f.height_mm) / step_mm).round() as i64)
+        .collect()
 }
 
 /// The number of steps of the Largest Span Height: the longest run between consecutive
@@ -241,14 +245,19 @@ fn thesis_palm_grades(combined: &[Grade], finger_offsets: &[i64]) -> Vec<Grade> 
     palm
 }
 
-/// The 1-based indices with a palm grade, best first (ties: the higher index first).
+/// Palm grades are sorted in units of one over this: grades closer than 1e-4 are equal.
+const GRADE_RESOLUTION: f64 = 1e4;
+
+/// The 1-based indices with a palm grade, best first (ties, to 1e-4: the higher index first).
 fn sorted_by_grade(palm: &[Grade]) -> Vec<usize> {
     let mut sorted: Vec<(i64, usize)> = palm
         .iter()
         .enumerate()
-        // Grades are compared at 1e-6: two elevations a symmetry makes equal differ by
-        // round-off (1e-13), which must not decide their order in one frame and not another.
-        .filter_map(|(i, g)| g.map(|g| ((g * 1e6).round() as i64, i + 1)))
+        // Grades are compared at 1e-4: two elevations a symmetry makes equal differ by
+        // round-off (1e-13), and a tapering handle's grades by 1e-7 a step, as much as a file
+        // written in single precision in another frame moves them; neither must decide their
+        // order in one frame and not another (issue 30).
+        .filter_map(|(i, g)| g.map(|g| ((g * GRADE_RESOLUTION).round() as i64, i + 1)))
         .collect();
     sorted.sort_by(|a, b| b.0.cmp(&a.0).then(b.1.cmp(&a.1)));
     sorted.into_iter().map(|(_, i)| i).collect()

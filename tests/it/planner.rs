@@ -284,3 +284,69 @@ fn the_candidate_budget_bounds_the_search_and_says_where_it_stopped() {
         assert!(reason.contains("candidate budget"), "{reason}");
     }
 }
+
+#[test]
+fn a_cheap_bound_rejects_objects_too_short_or_too_thin_before_bridging() {
+    // Issue 30: from the vertices alone, before any slice is cut and bridged. The D10 cylinder
+    // (10 mm wide on average across every slice plane, under the 17.4 mm eq. 3.2 bound), a
+    // 12 mm tall puck (shorter than twice the 7 mm finger offset) and the 60 s fuzz finding
+    // (11 mm on every axis) cannot place the inner finger on a graded elevation; the D40
+    // cylinder and a 14.5 mm puck may. A rejected domain's slices are the raw cut: for a closed
+    // single shell, the bridged slices bit for bit, so the grades and the reason are unchanged.
+    use grasp_sim::plan::domain::{cannot_grade, Domain};
+    let hand =
+        grasp_sim::hand::Hand::load(&crate::root().join("assets/hands/thesis.toml"), &[]).unwrap();
+    let params = grasp_sim::plan::PlannerParams::default();
+    let angles: Vec<f64> = (0..18)
+        .map(|k| k as f64 * params.angular_step_deg)
+        .collect();
+    let finding = grasp_sim::mesh::load_mesh(
+        &crate::root().join("tests/fuzz_findings/mesh_obj_timeout_d2f4331e.obj"),
+        grasp_sim::mesh::LengthUnit::Mm,
+    )
+    .unwrap()
+    .mesh;
+    let cases = [
+        (
+            "cylinder d10",
+            grasp_sim::objects::cylinder(10.0, 124.0),
+            true,
+        ),
+        (
+            "cylinder d40",
+            grasp_sim::objects::cylinder(40.0, 124.0),
+            false,
+        ),
+        ("puck 12 mm", grasp_sim::objects::cylinder(60.0, 12.0), true),
+        (
+            "puck 14.5 mm",
+            grasp_sim::objects::cylinder(60.0, 14.5),
+            false,
+        ),
+    ];
+    for (name, mesh, rejected) in &cases {
+        assert_eq!(
+            cannot_grade(mesh, &params, &hand, &angles),
+            *rejected,
+            "{name}"
+        );
+    }
+    for axis in grasp_sim::mesh::GraspAxis::SEARCH_ORDER {
+        let props = grasp_sim::mesh::mass_properties(&finding);
+        let a = grasp_sim::mesh::align_with_rule(
+            &finding,
+            &props,
+            axis,
+            grasp_sim::mesh::FrameRule::Geometry,
+        );
+        assert!(cannot_grade(&a.mesh, &params, &hand, &angles), "{axis:?}");
+    }
+    let d10 = &cases[0].1;
+    let built = Domain::build(d10, &params, &hand);
+    for (k, s) in built.slices.iter().enumerate() {
+        let plane = grasp_sim::slice::Plane::vertical(built.angles_deg[k].to_radians());
+        let bridged = grasp_sim::slice::slice(d10, &plane)
+            .bridged_prepared(hand.finger_width_mm(), hand.relief_mm());
+        assert_eq!(*s, bridged, "slice {k}");
+    }
+}
