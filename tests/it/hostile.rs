@@ -882,11 +882,10 @@ fn probe_findings_are_plain_errors() {
 /// Rings thinner than 1 µm are no material (`mesh::polygon_limits::MIN_RING_WIDTH_MM`), so each
 /// now ends at once with its one-line reason: no grasp, or, for the sliver, which encloses no
 /// volume once its empty rings are left out, the refusal of a surface that is not a solid.
-/// The third session's STLs (`mesh_stl_slow_*`, four triangles; 0.2 s and 9.6 s before, 0.07 s
-/// and 0.9 s now) cross themselves in
-/// its slices along near-collinear edges, where i_overlay's default snap radius cascades
+/// The third session's two STLs (`mesh_stl_slow_*`, four triangles each) cross themselves in
+/// their slices along near-collinear edges, where i_overlay's default snap radius cascades
 /// (`mesh::polygon_limits`, `a_self_crossing_near_collinear_ring_unites_without_a_cascade`);
-/// it plans to its reason: too short for the hand.
+/// each plans to its reason: too short for the hand.
 #[test]
 fn the_fuzzers_slow_findings_end_with_their_reason() {
     let dir = crate::root().join("tests/fuzz_findings");
