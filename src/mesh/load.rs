@@ -1022,7 +1022,8 @@ fn drop_collinear(mesh: &mut Mesh, diag2: f64) -> usize {
 /// Drops the triangles that repeat an earlier one's corners in the same cyclic order; how many.
 fn drop_duplicates(mesh: &mut Mesh) -> usize {
     let before = mesh.triangles.len();
-    let mut seen = std::collections::HashSet::with_capacity(before);
+    let mut seen: std::collections::HashSet<[u32; 3], super::FastHash> =
+        std::collections::HashSet::with_capacity_and_hasher(before, super::FastHash::default());
     mesh.triangles.retain(|t| {
         // The rotation that puts the smallest index first keeps the winding.
         let k = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);

@@ -11,6 +11,7 @@
 
 use super::Mesh;
 use nalgebra::{Matrix3, Point3, Vector3};
+use rayon::prelude::*;
 
 /// Mass properties of a solid of unit density.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -128,25 +129,36 @@ fn sliced_mass_properties_with(mesh: &Mesh, n: usize, join_mm: f64) -> MassPrope
     let dz = (hi.z - lo.z) / n as f64;
     // ∫1, ∫x, ∫y, ∫z, ∫x², ∫y², ∫z², ∫xy, ∫yz, ∫zx about `reference`.
     let mut m = [0.0f64; 10];
-    for k in 0..n {
-        let z_abs = lo.z + (k as f64 + 0.5) * dz;
-        let z = z_abs - reference.z;
-        let s = super::slice::slice(mesh, &super::slice::Plane::horizontal(z_abs)).joined(join_mm);
-        let (mut a, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
-        for c in s.contours.iter().filter(|c| c.is_closed) {
-            let np = c.points.len();
-            for i in 0..np {
-                let p = c.points[i] - reference.xy().coords;
-                let q = c.points[(i + 1) % np] - reference.xy().coords;
-                let cross = p.x * q.y - q.x * p.y;
-                a += cross / 2.0;
-                sx += (p.x + q.x) * cross / 6.0;
-                sy += (p.y + q.y) * cross / 6.0;
-                sxx += (p.x * p.x + p.x * q.x + q.x * q.x) * cross / 12.0;
-                syy += (p.y * p.y + p.y * q.y + q.y * q.y) * cross / 12.0;
-                sxy += (p.x * q.y + 2.0 * p.x * p.y + 2.0 * q.x * q.y + q.x * p.y) * cross / 24.0;
+    // The slices are independent: cut on rayon's pool, each slice's area moments summed in
+    // its own order, then added up in the slices' order, so the sum is the same bits whatever
+    // the thread count.
+    let moments: Vec<[f64; 6]> = (0..n)
+        .into_par_iter()
+        .map(|k| {
+            let z_abs = lo.z + (k as f64 + 0.5) * dz;
+            let plane = super::slice::Plane::horizontal(z_abs);
+            let s = super::slice::slice(mesh, &plane).joined(join_mm);
+            let (mut a, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
+            for c in s.contours.iter().filter(|c| c.is_closed) {
+                let np = c.points.len();
+                for i in 0..np {
+                    let p = c.points[i] - reference.xy().coords;
+                    let q = c.points[(i + 1) % np] - reference.xy().coords;
+                    let cross = p.x * q.y - q.x * p.y;
+                    a += cross / 2.0;
+                    sx += (p.x + q.x) * cross / 6.0;
+                    sy += (p.y + q.y) * cross / 6.0;
+                    sxx += (p.x * p.x + p.x * q.x + q.x * q.x) * cross / 12.0;
+                    syy += (p.y * p.y + p.y * q.y + q.y * q.y) * cross / 12.0;
+                    sxy +=
+                        (p.x * q.y + 2.0 * p.x * p.y + 2.0 * q.x * q.y + q.x * p.y) * cross / 24.0;
+                }
             }
-        }
+            [a, sx, sy, sxx, syy, sxy]
+        })
+        .collect();
+    for (k, &[a, sx, sy, sxx, syy, sxy]) in moments.iter().enumerate() {
+        let z = lo.z + (k as f64 + 0.5) * dz - reference.z;
         m[0] += a * dz;
         m[1] += sx * dz;
         m[2] += sy * dz;

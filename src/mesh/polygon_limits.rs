@@ -164,8 +164,9 @@ fn reduce(mut shapes: Vec<Vec<Ring>>) -> Vec<Ring> {
 /// snap radius that grows by [`UNION_PRECISION`]'s step. i_overlay's default step (1: the
 /// squared radius doubles each round) cascades on near-collinear, overlapping edges: a 6-point
 /// self-crossing ring from a 4-triangle STL fuzz input took 16 ms and came out as 899 shapes.
-/// Quadrupling instead (step 2, i_overlay's `MEDIUM`) took 2 ms there. The first round's
-/// radius is the default's, so a ring whose crossings settle in one round unites as before.
+/// Quadrupling (step 2, i_overlay's `MEDIUM`) took 2 ms there, but not on the next fuzz
+/// findings (below); the step is now 8. The first round's radius is the default's, so a ring
+/// whose crossings settle in one round unites as before.
 fn unite(rings: &Vec<Ring>) -> Shapes {
     let solver = Solver {
         precision: UNION_PRECISION,
@@ -174,9 +175,17 @@ fn unite(rings: &Vec<Ring>) -> Shapes {
     rings.simplify_shape_custom(FillRule::NonZero, Default::default(), solver)
 }
 
-/// The split solver's snap radius for [`unite`]: from the default's start, squared radius ×4 a
-/// round.
-const UNION_PRECISION: Precision = Precision::MEDIUM;
+/// The split solver's snap radius for [`unite`]: the default's first round (so a union that
+/// needs one round, every clean slice's, is what the default gives, bit for bit), then the
+/// squared radius ×256 a round. i_overlay's default doubles it, and `MEDIUM` (×4) was still
+/// not enough: on an 8-point ring crossing itself along near-collinear edges (the cut of a
+/// 4-triangle fuzz STL), `MEDIUM` ends after 37 ms in 1552 pieces, ×256 after 0.3 ms in 21, and
+/// the area agrees to 1e-8 (test `a_self_crossing_near_collinear_ring_unites_without_a_cascade`).
+/// The snap radius after the rounds that such a ring takes stays below 1e-4 mm.
+const UNION_PRECISION: Precision = Precision {
+    start: 0,
+    progression: 8,
+};
 
 fn flat(shapes: Shapes) -> Vec<Ring> {
     shapes.into_iter().flatten().collect()
@@ -395,6 +404,39 @@ mod tests {
             default.len() > 800,
             "i_overlay's default now gives {}",
             default.len()
+        );
+    }
+
+    #[test]
+    fn a_pinched_ring_of_near_overlapping_edges_unites_in_few_pieces() {
+        // One of the 400 mass-property slices of a 284-byte, 4-triangle fuzz STL
+        // (tests/fuzz_findings/mesh_stl_slow_b9d68fee.stl): 8 points, one of them twice, two
+        // edges into it from points 8 µm apart. i_overlay's `MEDIUM` step made 1552 pieces of it
+        // in 37 ms (the STL took 4 s); the ×256 step, 21 pieces in 0.3 ms.
+        let ring: Ring = vec![
+            [0.718413166018712, -1.6996855948534313],
+            [-1.4734563500096143, 1.6863494229174307],
+            [0.6080041621638516, 2.9950116132758513],
+            [-0.6276307640027234, 0.3797045555096943],
+            [0.714294350928001, -1.6933227835515334],
+            [-1.4734563500096143, 1.6863494229174307],
+            [2.069142937503205, -3.7863145079100518],
+            [-0.8960779905610662, 0.7944061163932428],
+        ];
+        let united = union_rings(vec![ring.clone()]);
+        let a = total_area(&united).abs();
+        assert!((a - 1.9133148582).abs() < 1e-6, "{a}");
+        assert!(united.len() < 60, "{} pieces", united.len());
+        let medium = Solver {
+            precision: Precision::MEDIUM,
+            ..Solver::AUTO
+        };
+        let before =
+            vec![ring].simplify_shape_custom(FillRule::NonZero, Default::default(), medium);
+        assert!(
+            before.len() > 1000,
+            "i_overlay's MEDIUM now gives {}",
+            before.len()
         );
     }
 }

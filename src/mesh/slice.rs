@@ -395,33 +395,10 @@ impl Slice {
     }
 }
 
-/// A multiplicative hash for the slicer's edge tables (FxHash's mixing): SipHash's protection
-/// against chosen keys is not needed for mesh edges, and it was a fifth of the search's time.
-/// Only lookups use these tables, never their iteration order, so results do not depend on it.
-#[derive(Default, Clone, Copy)]
-struct EdgeHasher(u64);
-
-impl std::hash::Hasher for EdgeHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(b as u64);
-        }
-    }
-    fn write_u32(&mut self, i: u32) {
-        self.write_u64(i as u64);
-    }
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0.rotate_left(5) ^ i).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_usize(&mut self, i: usize) {
-        self.write_u64(i as u64);
-    }
-}
-
-type EdgeBuild = std::hash::BuildHasherDefault<EdgeHasher>;
+/// The slicer's edge tables hash with [`super::FastHash`]: SipHash's protection against chosen
+/// keys is not needed for mesh edges, and it was a fifth of the search's time. Only lookups use
+/// these tables, never their iteration order, so results do not depend on the hasher.
+type EdgeBuild = super::FastHash;
 
 /// A bounding-volume hierarchy over a mesh's triangles: which triangles a plane may cut.
 ///

@@ -15,6 +15,7 @@ use crate::hand::Hand;
 use crate::mesh::Mesh;
 use crate::slice::{slice, slice_unrepaired, Contour, Plane, Slice};
 use nalgebra::Point2;
+use rayon::prelude::*;
 
 /// The reduced search domain of stage 1.
 #[derive(Debug, Clone)]
@@ -71,8 +72,10 @@ impl Domain {
         let count = (180.0 / step).round().max(1.0) as usize;
         let angles_deg: Vec<f64> = (0..count).map(|k| k as f64 * step).collect();
         let hopeless = cannot_grade(mesh, params, hand, &angles_deg);
+        // The vertical slices are independent, so they are cut and bridged on rayon's pool;
+        // `collect` keeps the angles' order, so the domain is the same whatever the thread count.
         let slices: Vec<Slice> = angles_deg
-            .iter()
+            .par_iter()
             .map(|a| {
                 let plane = Plane::vertical(a.to_radians());
                 if hopeless {

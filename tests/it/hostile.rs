@@ -885,7 +885,11 @@ fn probe_findings_are_plain_errors() {
 /// The third session's two STLs (`mesh_stl_slow_*`, four triangles each) cross themselves in
 /// their slices along near-collinear edges, where i_overlay's default snap radius cascades
 /// (`mesh::polygon_limits`, `a_self_crossing_near_collinear_ring_unites_without_a_cascade`);
-/// each plans to its reason: too short for the hand.
+/// each plans to its reason: too short for the hand. The fourth session's three
+/// (`mesh_stl_slow_{660abe42,b9d68fee,fb63b0b2}`, 4-5 s each, one of them libFuzzer's timeout
+/// under load) are the same class in the union-based mass properties' 400 slices, where
+/// i_overlay's `MEDIUM` step still cascaded (1552 pieces from an 8-point ring); with the ×256
+/// step each plans in about 0.05 s.
 #[test]
 fn the_fuzzers_slow_findings_end_with_their_reason() {
     let dir = crate::root().join("tests/fuzz_findings");
@@ -916,5 +920,5 @@ fn the_fuzzers_slow_findings_end_with_their_reason() {
         names.push(name);
     }
     names.sort();
-    assert_eq!(names.len(), 7, "{names:?}");
+    assert_eq!(names.len(), 10, "{names:?}");
 }
