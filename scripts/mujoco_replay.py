@@ -14,11 +14,11 @@ hold (its whole length: the replay is the full-length protocol).
 `--six`: the six gravity directions of `[sim] gravity = "six"`, each held from one closing.
 Perturbed samples (`[sim] samples`, issue 34) are exported as scenes of their own,
 DIR/<scenario>/samples/<k>/; scripts/compare_engines.py --robust replays them.
-`--trace`: the closing on stderr, to hold against grasp-sim's `sim.closing` (issue 33): every
-10 ms the object's shift from its start relative to the palm, each joint's bend minus its plan
-and the bodies touching the object; when each body first touches it; at the end of each phase, every contact with the object
-(point in the palm frame [mm], normal, normal and tangential force, depth). The result is the
-same with or without it.
+`--trace`: the closing on stderr, to hold against grasp-sim's `sim.closing` (issue 33): when
+each body first touches the object; every 10 ms the object's shift from its start relative to
+the palm, each joint's bend minus its plan and the bodies touching the object; at the end of
+each phase, every contact with the object (point in the palm frame [mm], normal, normal and
+tangential force, depth). The result is the same with or without it.
 Needs `pip install mujoco`.
 """
 import json
@@ -77,12 +77,13 @@ def trace_line(m, d, stamp, p0, palm, obj, planned, n, contacts=False):
             mujoco.mj_contactForce(m, d, i, f)
             normal = rp.T @ c.frame[:3] * (1.0 if b1 == obj else -1.0)
             at = rp.T @ (c.pos - d.xpos[palm]) * 1000.0
-            lines.append(f"    {m.body(other).name:20s} at {np.round(at, 1)} mm, normal (object to hand) "
-                         f"{np.round(normal, 2)}, {f[0]:.2f} N normal, {math.hypot(f[1], f[2]):.2f} N "
-                         f"tangential, depth {-c.dist * 1000.0:.3f} mm")
+            lines.append(f"    {m.body(other).name:20s} at {np.round(at, 1)} mm, "
+                         f"normal (object to hand) {np.round(normal, 2)}, {f[0]:.2f} N normal, "
+                         f"{math.hypot(f[1], f[2]):.2f} N tangential, "
+                         f"depth {-c.dist * 1000.0:.3f} mm")
     d_mm = pc - p0
-    print(f"{stamp}: shift {np.linalg.norm(d_mm):.2f} mm {np.round(d_mm, 2)}, bend - plan [deg] {err}, "
-          f"touching {sorted(touching)}", file=sys.stderr)
+    print(f"{stamp}: shift {np.linalg.norm(d_mm):.2f} mm {np.round(d_mm, 2)}, "
+          f"bend - plan [deg] {err}, touching {sorted(touching)}", file=sys.stderr)
     for line in lines:
         print(line, file=sys.stderr)
 
@@ -222,7 +223,8 @@ def replay(scene_dir, directions=None, trace=False):
             if trace:
                 for name in sorted(touching_bodies(m, d, obj) - first_touch):
                     first_touch.add(name)
-                    print(f"t={closed * dt:.4f} s: {name} first touches the object", file=sys.stderr)
+                    print(f"t={closed * dt:.4f} s: {name} first touches the object",
+                          file=sys.stderr)
             if trace and closed % round(0.01 / dt) == 0:
                 trace_line(m, d, f"t={closed * dt:.3f} s", p0, palm, obj, planned or target, n)
             if ramp is not None and ramp < ramp_steps:
