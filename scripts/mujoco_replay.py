@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Replay a grasp exported by `grasp-sim --export-mjcf DIR` in MuJoCo, with grasp-sim's protocol.
 
-    python3 scripts/mujoco_replay.py [--six] DIR/<scenario> [DIR/<scenario> ...]
+    python3 scripts/mujoco_replay.py [--six] [--trace] DIR/<scenario> [DIR/<scenario> ...]
 
 Prints one JSON object per scene: the verdict (hold / slip / drop) with the same thresholds as
 grasp-sim's rapier check, the object's translation and rotation relative to the palm during the
@@ -14,6 +14,11 @@ hold (its whole length: the replay is the full-length protocol).
 `--six`: the six gravity directions of `[sim] gravity = "six"`, each held from one closing.
 Perturbed samples (`[sim] samples`, issue 34) are exported as scenes of their own,
 DIR/<scenario>/samples/<k>/; scripts/compare_engines.py --robust replays them.
+`--trace`: the closing on stderr, to hold against grasp-sim's `sim.closing` (issue 33): when
+each body first touches the object; every 10 ms the object's shift from its start relative to
+the palm, each joint's bend minus its plan and the bodies touching the object; at the end of
+each phase, every contact with the object (point in the palm frame [mm], normal, normal and
+tangential force, depth). The result is the same with or without it.
 Needs `pip install mujoco`.
 """
 import json
@@ -42,12 +47,54 @@ def relative_pose(m, d, palm, obj):
 SIX = [[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]]
 
 
-def replay(scene_dir, directions=None):
+def touching_bodies(m, d, obj):
+    """The names of the bodies touching `obj` now."""
+    out = set()
+    for c in d.contact[: d.ncon]:
+        b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
+        if obj in (b1, b2):
+            out.add(m.body(b2 if b1 == obj else b1).name)
+    return out
+
+
+def trace_line(m, d, stamp, p0, palm, obj, planned, n, contacts=False):
+    """One `--trace` line on stderr: time, the object's shift from `p0` [mm], each joint's bend
+    minus its plan [deg], the bodies touching the object; with `contacts`, one line per contact."""
+    pc, _ = relative_pose(m, d, palm, obj)
+    bends = [float(d.qpos[m.jnt_qposadr[m.actuator_trnid[a, 0]]]) for a in range(2 * n)]
+    err = " ".join(f"{math.degrees(b - p):+.1f}" for b, p in zip(bends, planned))
+    touching = set()
+    lines = []
+    rp = d.xmat[palm].reshape(3, 3)
+    for i, c in enumerate(d.contact[: d.ncon]):
+        b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
+        if obj not in (b1, b2):
+            continue
+        other = b2 if b1 == obj else b1
+        touching.add(m.body(other).name)
+        if contacts:
+            f = np.zeros(6)
+            mujoco.mj_contactForce(m, d, i, f)
+            normal = rp.T @ c.frame[:3] * (1.0 if b1 == obj else -1.0)
+            at = rp.T @ (c.pos - d.xpos[palm]) * 1000.0
+            lines.append(f"    {m.body(other).name:20s} at {np.round(at, 1)} mm, "
+                         f"normal (object to hand) {np.round(normal, 2)}, {f[0]:.2f} N normal, "
+                         f"{math.hypot(f[1], f[2]):.2f} N tangential, "
+                         f"depth {-c.dist * 1000.0:.3f} mm")
+    d_mm = pc - p0
+    print(f"{stamp}: shift {np.linalg.norm(d_mm):.2f} mm {np.round(d_mm, 2)}, "
+          f"bend - plan [deg] {err}, touching {sorted(touching)}", file=sys.stderr)
+    for line in lines:
+        print(line, file=sys.stderr)
+
+
+def replay(scene_dir, directions=None, trace=False):
     """The replay of one exported scene. `directions`: None, the scene's gravity (the check as
     it has always been replayed); or a list of unit vectors (aligned object frame, as `[sim]
     gravity = "six"` gives them, e.g. `SIX`): the closing runs once and each direction holds
     from a copy of the closed state, as grasp-sim's `fast` protocol does; the result then has
-    `directions` (one verdict each) and the worst verdict."""
+    `directions` (one verdict each) and the worst verdict. `trace`: the closing on stderr
+    (`--trace`)."""
     scene_dir = pathlib.Path(scene_dir)
     proto = json.loads((scene_dir / "protocol.json").read_text())
     m = mujoco.MjModel.from_xml_path(str(scene_dir / "scene.xml"))
@@ -140,6 +187,7 @@ def replay(scene_dir, directions=None):
             m.actuator_biasprm[a, 1] = -10.0 * kp
             m.actuator_forcerange[a] = [-lock, lock]
 
+    first_touch = set()
     phases = [close_steps // 2, close_steps - close_steps // 2]
     if proto.get("reseat"):
         phases.append(close_steps // 2)
@@ -172,6 +220,13 @@ def replay(scene_dir, directions=None):
                         opened[2 * k] + (planned[2 * k] - opened[2 * k]) * s
             mujoco.mj_step(m, d)
             closed += 1
+            if trace:
+                for name in sorted(touching_bodies(m, d, obj) - first_touch):
+                    first_touch.add(name)
+                    print(f"t={closed * dt:.4f} s: {name} first touches the object",
+                          file=sys.stderr)
+            if trace and closed % round(0.01 / dt) == 0:
+                trace_line(m, d, f"t={closed * dt:.3f} s", p0, palm, obj, planned or target, n)
             if ramp is not None and ramp < ramp_steps:
                 quiet_steps = 0
                 continue
@@ -197,6 +252,9 @@ def replay(scene_dir, directions=None):
                     break
             else:
                 quiet_steps = 0
+        if trace:
+            trace_line(m, d, f"end of phase {phase} (t={closed * dt:.3f} s)", p0, palm, obj,
+                       planned or target, n, contacts=True)
     pc, rc = relative_pose(m, d, palm, obj)
     # What the closing did (issue 33): a hold that needed the object pushed farther than
     # `max_closing_shift_mm` is not a hold of the planned grasp, as in grasp-sim's check.
@@ -290,8 +348,9 @@ def main(argv):
         print(__doc__, file=sys.stderr)
         return 2
     six = "--six" in argv
-    for scene_dir in [a for a in argv[1:] if a != "--six"]:
-        print(json.dumps(replay(scene_dir, SIX if six else None)))
+    trace = "--trace" in argv
+    for scene_dir in [a for a in argv[1:] if a not in ("--six", "--trace")]:
+        print(json.dumps(replay(scene_dir, SIX if six else None, trace)))
     return 0
 
 
