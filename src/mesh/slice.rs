@@ -1232,8 +1232,12 @@ impl Contour {
 }
 
 /// How far off a straight line a point may be dropped on the outer side of a contour `[mm]`:
-/// the vertices of a finely divided flat face, written in any frame, are this close to it.
-pub const COLLINEAR_MM: f64 = 1e-6;
+/// the vertices of a finely divided flat face, written in any frame, are this close to it. A
+/// file in single precision moves a vertex by up to 2⁻²⁴ of its distance from the origin, 3e-5
+/// mm at 500 mm; at 1e-6 mm, a flat panel's cut kept a point in one frame and dropped it in
+/// another, which moved the join tolerance of an open ball's slices (twice the upper quartile
+/// of their segment lengths) across a gap between its panels (issue 30).
+pub const COLLINEAR_MM: f64 = 1e-4;
 
 /// The signed distance of `q` from the line through `a` and `b`, positive on the right of the
 /// direction `a → b` (outside the material) `[mm]`; the distance to `a` when `a = b`.
