@@ -1141,8 +1141,87 @@ impl Slice {
                 }
             };
         }
+        if pieces_touch(&contours) {
+            // Pieces that touch to round-off (two shells meeting face to face) are one piece,
+            // as the union makes them where their edges coincide: merged, not bridged.
+            return finish(plane, close_gaps(contours, TOUCH_MM));
+        }
         finish(plane, close_gaps(contours, 0.5 * gap_mm))
     }
+}
+
+/// Two closed pieces of a slice this close `[mm]` touch: one piece. Shells that meet face to
+/// face cut pieces whose shared edges coincide to round-off, which i_overlay's union merges in
+/// one frame and leaves as two in another (single precision at 500 mm from the origin is 3e-5
+/// mm); one piece was left as it is and two were bridged, with bevels a finger's width wide
+/// at every concave corner (mw_golf_club, issue 30).
+const TOUCH_MM: f64 = 1e-3;
+
+/// Returns true if and only if the closed outer contours are two or more and each touches
+/// another (within [`TOUCH_MM`]) so that together they are one connected piece.
+fn pieces_touch(contours: &[Contour]) -> bool {
+    let outers: Vec<(&Contour, (Point2<f64>, Point2<f64>))> = contours
+        .iter()
+        .filter(|c| c.is_closed && c.signed_area() > 0.0)
+        .map(|c| (c, c.bounds()))
+        .collect();
+    let n = outers.len();
+    if n < 2 {
+        return false;
+    }
+    let near = |(a, ab): &(&Contour, (Point2<f64>, Point2<f64>)),
+                (b, bb): &(&Contour, (Point2<f64>, Point2<f64>))| {
+        let t = TOUCH_MM;
+        if ab.0.x > bb.1.x + t || bb.0.x > ab.1.x + t || ab.0.y > bb.1.y + t || bb.0.y > ab.1.y + t
+        {
+            return false;
+        }
+        // A point of one within TOUCH_MM of a segment of the other (each tested only near
+        // the other's bounds).
+        let close = |p: &Contour, q: &Contour, (lo, hi): (Point2<f64>, Point2<f64>)| {
+            p.points
+                .iter()
+                .filter(|x| {
+                    x.x >= lo.x - t && x.x <= hi.x + t && x.y >= lo.y - t && x.y <= hi.y + t
+                })
+                .any(|&x| {
+                    (0..q.segment_count()).any(|i| {
+                        let (s, e) = q.segment(i);
+                        x.x >= s.x.min(e.x) - t
+                            && x.x <= s.x.max(e.x) + t
+                            && x.y >= s.y.min(e.y) - t
+                            && x.y <= s.y.max(e.y) + t
+                            && point_segment_distance(x, s, e) <= t
+                    })
+                })
+        };
+        close(a, b, *bb) || close(b, a, *ab)
+    };
+    // Connected components by a flood from the first piece.
+    let mut reached = vec![false; n];
+    reached[0] = true;
+    let mut stack = vec![0];
+    while let Some(i) = stack.pop() {
+        for j in 0..n {
+            if !reached[j] && near(&outers[i], &outers[j]) {
+                reached[j] = true;
+                stack.push(j);
+            }
+        }
+    }
+    reached.iter().all(|&r| r)
+}
+
+/// The distance from `p` to the segment `a`–`b` `[mm]`.
+fn point_segment_distance(p: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> f64 {
+    let d = b - a;
+    let l2 = d.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + d * t)).norm()
 }
 
 impl Slice {
