@@ -1062,6 +1062,10 @@ fn map_closed(
                 true,
             )
         })
+        // A ring thinner than TOUCH_MM on average is a sliver of round-off, which the union
+        // leaves in one frame and not in another (rs_milk's fin, issue 30): it would count as
+        // a piece to bridge.
+        .filter(|c| c.signed_area().abs() > TOUCH_MM * c.length())
         .collect();
     out.extend(open);
     out
