@@ -1161,10 +1161,13 @@ impl Slice {
 /// at every concave corner (mw_golf_club, issue 30).
 const TOUCH_MM: f64 = 1e-3;
 
+/// Axis-aligned bounds `(min, max)` of a contour.
+type Bounds = (Point2<f64>, Point2<f64>);
+
 /// Returns true if and only if the closed outer contours are two or more and each touches
 /// another (within [`TOUCH_MM`]) so that together they are one connected piece.
 fn pieces_touch(contours: &[Contour]) -> bool {
-    let outers: Vec<(&Contour, (Point2<f64>, Point2<f64>))> = contours
+    let outers: Vec<(&Contour, Bounds)> = contours
         .iter()
         .filter(|c| c.is_closed && c.signed_area() > 0.0)
         .map(|c| (c, c.bounds()))
@@ -1173,8 +1176,7 @@ fn pieces_touch(contours: &[Contour]) -> bool {
     if n < 2 {
         return false;
     }
-    let near = |(a, ab): &(&Contour, (Point2<f64>, Point2<f64>)),
-                (b, bb): &(&Contour, (Point2<f64>, Point2<f64>))| {
+    let near = |(a, ab): &(&Contour, Bounds), (b, bb): &(&Contour, Bounds)| {
         let t = TOUCH_MM;
         if ab.0.x > bb.1.x + t || bb.0.x > ab.1.x + t || ab.0.y > bb.1.y + t || bb.0.y > ab.1.y + t
         {
@@ -1182,7 +1184,7 @@ fn pieces_touch(contours: &[Contour]) -> bool {
         }
         // A point of one within TOUCH_MM of a segment of the other (each tested only near
         // the other's bounds).
-        let close = |p: &Contour, q: &Contour, (lo, hi): (Point2<f64>, Point2<f64>)| {
+        let close = |p: &Contour, q: &Contour, (lo, hi): Bounds| {
             p.points
                 .iter()
                 .filter(|x| {
@@ -1351,6 +1353,47 @@ mod tests {
     use super::*;
     use crate::objects::{cylinder, prism};
     use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn pieces_that_touch_are_merged_not_bridged_and_slivers_dropped() {
+        // An L of two closed pieces that share an edge to 1e-5 mm (two shells meeting face to
+        // face, as the union leaves them in one frame and merges them in another): one piece,
+        // its concave corner kept, not bevelled by the 14 mm closing. Apart by 2 mm, they are
+        // bridged: the 2 mm gap filled (20 mm²) and the concave corner bevelled.
+        let square = |x0: f64, y0: f64, w: f64, h: f64| {
+            Contour::from_polyline(
+                vec![
+                    Point2::new(x0, y0),
+                    Point2::new(x0 + w, y0),
+                    Point2::new(x0 + w, y0 + h),
+                    Point2::new(x0, y0 + h),
+                ],
+                true,
+            )
+        };
+        let l_shape = |gap: f64| {
+            finish(
+                Plane::horizontal(0.0),
+                vec![
+                    square(0.0, 0.0, 10.0, 30.0),
+                    square(10.0 + gap, 0.0, 30.0, 10.0),
+                ],
+            )
+        };
+        let area = |s: &Slice| s.contours.iter().map(Contour::signed_area).sum::<f64>();
+        let touching = l_shape(1e-5).bridged(14.0);
+        assert_eq!(touching.contours.len(), 1, "{touching:?}");
+        assert!((area(&touching) - 600.0).abs() < 0.1, "{}", area(&touching));
+        let apart = l_shape(2.0).bridged(14.0);
+        assert_eq!(apart.contours.len(), 1);
+        assert!(area(&apart) > 620.0, "{}", area(&apart));
+        // A ring thinner than TOUCH_MM on average is not a piece.
+        let sliver = finish(
+            Plane::horizontal(0.0),
+            vec![square(0.0, 0.0, 10.0, 30.0), square(50.0, 0.0, 20.0, 1e-5)],
+        );
+        assert_eq!(union_closed(sliver.contours).len(), 1);
+    }
 
     #[test]
     fn planes_map_points_both_ways() {
