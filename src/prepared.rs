@@ -39,7 +39,17 @@ impl PreparedObject {
         let loaded = mesh::load_mesh(&object.mesh, object.units)?;
         timings.load = ms(t0);
         let t1 = Instant::now();
-        let props = mesh::mass_properties(&loaded.mesh);
+        // An open surface encloses no volume of its own: integrated about the file's bounding
+        // box it depends on the frame the file was written in (libero_black_book's was
+        // negative in two frames of six, its mass then too, and the physics check met NaN), so
+        // it is the covariant fan's, about the surface's own centroid, which also decided its
+        // winding (issue 30).
+        let props = if loaded.topology.boundary_edges > 0 {
+            mesh::covariant_mass_properties(&loaded.mesh)
+                .unwrap_or_else(|| mesh::mass_properties(&loaded.mesh))
+        } else {
+            mesh::mass_properties(&loaded.mesh)
+        };
         let aligned = mesh::align_with_rule(&loaded.mesh, &props, GraspAxis::THESIS, object.frame);
         timings.align = ms(t1);
         let mass_kg = object.mass.mass_kg(props.volume_mm3, loaded.mass_kg);

@@ -1070,7 +1070,14 @@ pub(super) fn build(
     } else {
         0
     };
-    let volume = super::mass_properties(&mesh).volume_mm3;
+    // Of an open surface, the volume about the bounding box's centre depends on the frame the
+    // file was written in, and so would whether it is turned inside-out: its sign is taken from
+    // the fan about the surface's own centroid, which moves with it (issue 30).
+    let volume = if topology.boundary_edges > 0 {
+        super::align::covariant_signed_volume(&mesh)
+    } else {
+        super::mass_properties(&mesh).volume_mm3
+    };
     let mut was_inverted = false;
     // A closed surface of any real size encloses a volume well above rounding noise.
     let noise = 1e-9 * diag2.powf(1.5);

@@ -21,8 +21,8 @@ pub mod slice;
 pub mod urdf;
 
 pub use align::{
-    align, align_about, align_with, align_with_rule, canonical_rotation, AlignedObject, FrameRule,
-    GraspAxis,
+    align, align_about, align_with, align_with_rule, canonical_rotation, covariant_mass_properties,
+    AlignedObject, FrameRule, GraspAxis,
 };
 pub use load::{
     check_planner_work, load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh,

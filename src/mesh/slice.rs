@@ -1039,6 +1039,10 @@ fn map_closed(
                 true,
             )
         })
+        // A ring thinner than TOUCH_MM on average is a sliver of round-off, which the union
+        // leaves in one frame and not in another (rs_milk's fin, issue 30): it would count as
+        // a piece to bridge.
+        .filter(|c| c.signed_area().abs() > TOUCH_MM * c.length())
         .collect();
     out.extend(open);
     out
@@ -1118,8 +1122,89 @@ impl Slice {
                 }
             };
         }
+        if pieces_touch(&contours) {
+            // Pieces that touch to round-off (two shells meeting face to face) are one piece,
+            // as the union makes them where their edges coincide: merged, not bridged.
+            return finish(plane, close_gaps(contours, TOUCH_MM));
+        }
         finish(plane, close_gaps(contours, 0.5 * gap_mm))
     }
+}
+
+/// Two closed pieces of a slice this close `[mm]` touch: one piece. Shells that meet face to
+/// face cut pieces whose shared edges coincide to round-off, which i_overlay's union merges in
+/// one frame and leaves as two in another (single precision at 500 mm from the origin is 3e-5
+/// mm); one piece was left as it is and two were bridged, with bevels a finger's width wide
+/// at every concave corner (mw_golf_club, issue 30).
+const TOUCH_MM: f64 = 1e-3;
+
+/// Axis-aligned bounds `(min, max)` of a contour.
+type Bounds = (Point2<f64>, Point2<f64>);
+
+/// Returns true if and only if the closed outer contours are two or more and each touches
+/// another (within [`TOUCH_MM`]) so that together they are one connected piece.
+fn pieces_touch(contours: &[Contour]) -> bool {
+    let outers: Vec<(&Contour, Bounds)> = contours
+        .iter()
+        .filter(|c| c.is_closed && c.signed_area() > 0.0)
+        .map(|c| (c, c.bounds()))
+        .collect();
+    let n = outers.len();
+    if n < 2 {
+        return false;
+    }
+    let near = |(a, ab): &(&Contour, Bounds), (b, bb): &(&Contour, Bounds)| {
+        let t = TOUCH_MM;
+        if ab.0.x > bb.1.x + t || bb.0.x > ab.1.x + t || ab.0.y > bb.1.y + t || bb.0.y > ab.1.y + t
+        {
+            return false;
+        }
+        // A point of one within TOUCH_MM of a segment of the other (each tested only near
+        // the other's bounds).
+        let close = |p: &Contour, q: &Contour, (lo, hi): Bounds| {
+            p.points
+                .iter()
+                .filter(|x| {
+                    x.x >= lo.x - t && x.x <= hi.x + t && x.y >= lo.y - t && x.y <= hi.y + t
+                })
+                .any(|&x| {
+                    (0..q.segment_count()).any(|i| {
+                        let (s, e) = q.segment(i);
+                        x.x >= s.x.min(e.x) - t
+                            && x.x <= s.x.max(e.x) + t
+                            && x.y >= s.y.min(e.y) - t
+                            && x.y <= s.y.max(e.y) + t
+                            && point_segment_distance(x, s, e) <= t
+                    })
+                })
+        };
+        close(a, b, *bb) || close(b, a, *ab)
+    };
+    // Connected components by a flood from the first piece.
+    let mut reached = vec![false; n];
+    reached[0] = true;
+    let mut stack = vec![0];
+    while let Some(i) = stack.pop() {
+        for j in 0..n {
+            if !reached[j] && near(&outers[i], &outers[j]) {
+                reached[j] = true;
+                stack.push(j);
+            }
+        }
+    }
+    reached.iter().all(|&r| r)
+}
+
+/// The distance from `p` to the segment `a`–`b` `[mm]`.
+fn point_segment_distance(p: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> f64 {
+    let d = b - a;
+    let l2 = d.norm_squared();
+    let t = if l2 > 0.0 {
+        ((p - a).dot(&d) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p - (a + d * t)).norm()
 }
 
 impl Slice {
@@ -1209,8 +1294,12 @@ impl Contour {
 }
 
 /// How far off a straight line a point may be dropped on the outer side of a contour `[mm]`:
-/// the vertices of a finely divided flat face, written in any frame, are this close to it.
-pub const COLLINEAR_MM: f64 = 1e-6;
+/// the vertices of a finely divided flat face, written in any frame, are this close to it. A
+/// file in single precision moves a vertex by up to 2⁻²⁴ of its distance from the origin, 3e-5
+/// mm at 500 mm; at 1e-6 mm, a flat panel's cut kept a point in one frame and dropped it in
+/// another, which moved the join tolerance of an open ball's slices (twice the upper quartile
+/// of their segment lengths) across a gap between its panels (issue 30).
+pub const COLLINEAR_MM: f64 = 1e-4;
 
 /// The signed distance of `q` from the line through `a` and `b`, positive on the right of the
 /// direction `a → b` (outside the material) `[mm]`; the distance to `a` when `a = b`.
@@ -1241,6 +1330,47 @@ mod tests {
     use super::*;
     use crate::objects::{cylinder, prism};
     use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn pieces_that_touch_are_merged_not_bridged_and_slivers_dropped() {
+        // An L of two closed pieces that share an edge to 1e-5 mm (two shells meeting face to
+        // face, as the union leaves them in one frame and merges them in another): one piece,
+        // its concave corner kept, not bevelled by the 14 mm closing. Apart by 2 mm, they are
+        // bridged: the 2 mm gap filled (20 mm²) and the concave corner bevelled.
+        let square = |x0: f64, y0: f64, w: f64, h: f64| {
+            Contour::from_polyline(
+                vec![
+                    Point2::new(x0, y0),
+                    Point2::new(x0 + w, y0),
+                    Point2::new(x0 + w, y0 + h),
+                    Point2::new(x0, y0 + h),
+                ],
+                true,
+            )
+        };
+        let l_shape = |gap: f64| {
+            finish(
+                Plane::horizontal(0.0),
+                vec![
+                    square(0.0, 0.0, 10.0, 30.0),
+                    square(10.0 + gap, 0.0, 30.0, 10.0),
+                ],
+            )
+        };
+        let area = |s: &Slice| s.contours.iter().map(Contour::signed_area).sum::<f64>();
+        let touching = l_shape(1e-5).bridged(14.0);
+        assert_eq!(touching.contours.len(), 1, "{touching:?}");
+        assert!((area(&touching) - 600.0).abs() < 0.1, "{}", area(&touching));
+        let apart = l_shape(2.0).bridged(14.0);
+        assert_eq!(apart.contours.len(), 1);
+        assert!(area(&apart) > 620.0, "{}", area(&apart));
+        // A ring thinner than TOUCH_MM on average is not a piece.
+        let sliver = finish(
+            Plane::horizontal(0.0),
+            vec![square(0.0, 0.0, 10.0, 30.0), square(50.0, 0.0, 20.0, 1e-5)],
+        );
+        assert_eq!(union_closed(sliver.contours).len(), 1);
+    }
 
     #[test]
     fn planes_map_points_both_ways() {
