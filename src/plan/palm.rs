@@ -282,29 +282,42 @@ pub fn penetration_depth(
     back: Vector2<f64>,
     band: [f64; 2],
 ) -> f64 {
+    let segments = s
+        .contours
+        .iter()
+        .flat_map(|c| (0..c.segment_count()).map(|i| c.segment(i)));
+    penetration_depth_of(segments, origin, up, back, band)
+}
+
+/// [`penetration_depth`] over loose segments (a cut not chained into contours,
+/// [`crate::slice::cut_segments_indexed`]): the maximum is the same whatever their order.
+pub fn penetration_depth_of(
+    segments: impl IntoIterator<Item = (Point2<f64>, Point2<f64>)>,
+    origin: Point2<f64>,
+    up: Vector2<f64>,
+    back: Vector2<f64>,
+    band: [f64; 2],
+) -> f64 {
     let mut depth = f64::NEG_INFINITY;
-    for c in &s.contours {
-        for i in 0..c.segment_count() {
-            let (a, b) = c.segment(i);
-            let (ua, ub) = ((a - origin).dot(&up), (b - origin).dot(&up));
-            let (da, db) = ((a - origin).dot(&back), (b - origin).dot(&back));
-            // Clip the segment's parameter range to the band.
-            let (mut t0, mut t1) = (0.0f64, 1.0f64);
-            if (ub - ua).abs() < 1e-12 {
-                if ua < band[0] || ua > band[1] {
-                    continue;
-                }
-            } else {
-                let ta = (band[0] - ua) / (ub - ua);
-                let tb = (band[1] - ua) / (ub - ua);
-                t0 = t0.max(ta.min(tb));
-                t1 = t1.min(ta.max(tb));
-                if t0 > t1 {
-                    continue;
-                }
+    for (a, b) in segments {
+        let (ua, ub) = ((a - origin).dot(&up), (b - origin).dot(&up));
+        let (da, db) = ((a - origin).dot(&back), (b - origin).dot(&back));
+        // Clip the segment's parameter range to the band.
+        let (mut t0, mut t1) = (0.0f64, 1.0f64);
+        if (ub - ua).abs() < 1e-12 {
+            if ua < band[0] || ua > band[1] {
+                continue;
             }
-            depth = depth.max(da + (db - da) * t0).max(da + (db - da) * t1);
+        } else {
+            let ta = (band[0] - ua) / (ub - ua);
+            let tb = (band[1] - ua) / (ub - ua);
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+            if t0 > t1 {
+                continue;
+            }
         }
+        depth = depth.max(da + (db - da) * t0).max(da + (db - da) * t1);
     }
     depth
 }

@@ -5,14 +5,14 @@
 
 use super::finger::{place_finger, FingerPlacement, FingerRejection};
 use super::palm::{
-    penetration_depth, place_palm_on, vertical_slice, PalmPlacement, PalmRejection,
+    penetration_depth_of, place_palm_on, vertical_slice, PalmPlacement, PalmRejection,
     PENETRATION_TOL_MM,
 };
 use super::PlannerParams;
 use super::{GradedDomain, Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice_indexed_raw, Slice, SliceIndex};
+use crate::slice::{cut_segments_indexed, Slice, SliceIndex};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::OnceLock;
@@ -383,7 +383,9 @@ fn finger_indices(graded: &GradedDomain, index: usize) -> impl Iterator<Item = u
 /// How far the palm must move back along its normal so that its outline touches but does not
 /// take in the object in any finger slice plane (the three ALS planes of every finger) `[mm]`.
 ///
-/// Measured on the planes' exact cuts ([`slice_indexed_raw`]), not on the bridged slices the
+/// Measured on the planes' exact cuts (their segments, [`cut_segments_indexed`], not chained:
+/// the maximum needs no contours, and chaining them was half of a many-candidate search), not
+/// on the bridged slices the
 /// fingers are then placed on (issue 30): the bridging of a many-shell or open mesh was most of
 /// an extended candidate's cost, and it reaches no further towards the palm than the cut except
 /// where a bridge or a joint crosses the edge of the palm's band. A candidate whose palm then
@@ -400,10 +402,10 @@ fn palm_backoff_in_finger_planes(
     let mut depth = f64::NEG_INFINITY;
     for f in &hand.finger_list {
         for dz in [-o, 0.0, o] {
-            let s = slice_indexed_raw(mesh, index, &palm.finger_plane(f.height_mm + dz));
+            let cut = cut_segments_indexed(mesh, index, &palm.finger_plane(f.height_mm + dz));
             // Finger-plane coordinates: x away from the object (contact surface at 0), y sideways.
-            depth = depth.max(penetration_depth(
-                &s,
+            depth = depth.max(penetration_depth_of(
+                cut,
                 nalgebra::Point2::origin(),
                 nalgebra::Vector2::y(),
                 nalgebra::Vector2::x(),

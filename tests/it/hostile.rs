@@ -889,15 +889,19 @@ fn probe_findings_are_plain_errors() {
 /// (`mesh_stl_slow_{660abe42,b9d68fee,fb63b0b2}`, 4-5 s each, one of them libFuzzer's timeout
 /// under load) are the same class in the union-based mass properties' 400 slices, where
 /// i_overlay's `MEDIUM` step still cascaded (1552 pieces from an 8-point ring); with the ×256
-/// step each plans in about 0.05 s.
+/// step each plans in about 0.05 s. Since an open surface's volume is taken about its area
+/// centroid (issue 30's frame rule, session 43), the 135-byte OBJ of faces flattened onto a
+/// line (`mesh_obj_timeout_4d16f9e5`) encloses 0 mm³ and is refused, and the sliver STL
+/// (`mesh_stl_timeout_333e974d`) encloses 0.0013 mm³ and plans to its reason, too short.
 #[test]
 fn the_fuzzers_slow_findings_end_with_their_reason() {
     let dir = crate::root().join("tests/fuzz_findings");
+    let refused = ["mesh_obj_timeout_4d16f9e5.obj"];
     let mut names = Vec::new();
     for e in std::fs::read_dir(&dir).unwrap() {
         let path = e.unwrap().path();
         let name = path.file_name().unwrap().to_string_lossy().into_owned();
-        if name.starts_with("mesh_stl_timeout") {
+        if refused.contains(&name.as_str()) {
             let out = grasp_sim()
                 .args(["--no-sim", "--json"])
                 .arg(&path)
