@@ -1064,7 +1064,21 @@ pub(super) fn build(
         });
     }
 
-    let topology = mesh.topology();
+    let mut topology = mesh.topology();
+    // Faces written the wrong way round on a shell would each subtract their share of the
+    // volume (a 40 mm cube with one of its 12 triangles turned read as 32 cm³ and was then
+    // flipped whole): they are turned to agree with their neighbours first.
+    let mut notes = Vec::new();
+    if topology.misoriented_edges > 0 {
+        let turned = mesh.orient_consistently();
+        let before = topology.misoriented_edges;
+        topology = mesh.topology();
+        notes.push(format!(
+            "{turned} of {} triangles were wound against their neighbours ({before} edges walked \
+             the same way by both triangles); turned to agree with them",
+            mesh.triangles.len()
+        ));
+    }
     let holes_filled = if topology.boundary_edges > 0 {
         mesh.fill_small_holes(SMALL_HOLE_MM)
     } else {
@@ -1102,7 +1116,7 @@ pub(super) fn build(
         is_binary,
         format,
         unit,
-        notes: Vec::new(),
+        notes,
         mass_kg: None,
     })
 }

@@ -555,6 +555,76 @@ impl Mesh {
         }
     }
 
+    /// Turns the triangles wound against their neighbours, so that every edge that exactly two
+    /// triangles share is walked once each way, as on a closed, outward-wound shell; returns how
+    /// many were turned. Each piece (triangles joined through such edges, walked breadth-first
+    /// from its first triangle) keeps the winding of most of its triangles, the first
+    /// triangle's on a tie: a shell with a few faces written the wrong way round is mended, not
+    /// turned inside out (the volume's sign decides that afterwards). A piece that cannot be
+    /// wound consistently (a Möbius strip) keeps the winding the walk gives it. A mesh with no
+    /// misoriented edge is left as it is.
+    pub fn orient_consistently(&mut self) -> usize {
+        let n = self.triangles.len();
+        let mut users: HashMap<(u32, u32), Vec<u32>, FastHash> =
+            HashMap::with_capacity_and_hasher(n * 2, FastHash::default());
+        for (t, tri) in self.triangles.iter().enumerate() {
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                users
+                    .entry((a.min(b), a.max(b)))
+                    .or_default()
+                    .push(t as u32);
+            }
+        }
+        let walks_up = |tri: &[u32; 3], lo: u32, hi: u32| {
+            (0..3).any(|k| tri[k] == lo && tri[(k + 1) % 3] == hi)
+        };
+        let mut flip = vec![false; n];
+        let mut seen = vec![false; n];
+        let mut queue = std::collections::VecDeque::new();
+        for first in 0..n {
+            if seen[first] {
+                continue;
+            }
+            seen[first] = true;
+            let mut piece = vec![first];
+            queue.push_back(first);
+            while let Some(t) = queue.pop_front() {
+                let tri = self.triangles[t];
+                for k in 0..3 {
+                    let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                    let (lo, hi) = (a.min(b), a.max(b));
+                    let [u, v] = users[&(lo, hi)][..] else {
+                        continue;
+                    };
+                    let m = if u as usize == t { v } else { u } as usize;
+                    if seen[m] {
+                        continue;
+                    }
+                    // The neighbour must walk the shared edge the other way from `t` as wound.
+                    let t_up = walks_up(&tri, lo, hi) != flip[t];
+                    flip[m] = walks_up(&self.triangles[m], lo, hi) == t_up;
+                    seen[m] = true;
+                    piece.push(m);
+                    queue.push_back(m);
+                }
+            }
+            if 2 * piece.iter().filter(|&&t| flip[t]).count() > piece.len() {
+                for &t in &piece {
+                    flip[t] = !flip[t];
+                }
+            }
+        }
+        let mut turned = 0;
+        for (tri, f) in self.triangles.iter_mut().zip(flip) {
+            if f {
+                tri.swap(1, 2);
+                turned += 1;
+            }
+        }
+        turned
+    }
+
     /// Reverses the winding of every triangle (turns the surface inside out).
     pub fn flip(&mut self) {
         for t in &mut self.triangles {
@@ -636,6 +706,44 @@ mod tests {
             }
         }
         (vertices, triangles)
+    }
+
+    #[test]
+    fn faces_wound_against_their_neighbours_are_turned_to_agree() {
+        // A 40 × 30 × 20 mm box (12 triangles, 24,000 mm³, outward), away from the origin so
+        // that every face's term of the surface integral counts.
+        let mut good = primitives::prism(40.0, 30.0, 20.0);
+        good.map_vertices(|p| p + Vector3::new(100.0, 100.0, 100.0));
+        let volume = |m: &Mesh| surface_mass_properties(m).volume_mm3;
+        assert!((volume(&good) - 24_000.0).abs() < 1e-6);
+        let mut m = good.clone();
+        assert_eq!(m.orient_consistently(), 0);
+        assert_eq!(m.triangles, good.triangles);
+        // One triangle turned (a side face's: the volume integral takes the x-components):
+        // 3 misoriented edges and a volume that is not the box's. Mended, it is the box again,
+        // triangle for triangle.
+        let side = (0..good.triangles.len())
+            .max_by(|&a, &b| {
+                let x = |t: usize| good.area_normal(t).x.abs();
+                x(a).total_cmp(&x(b)).then(b.cmp(&a))
+            })
+            .unwrap();
+        let mut one = good.clone();
+        one.triangles[side].swap(1, 2);
+        assert_eq!(one.topology().misoriented_edges, 3);
+        assert!((volume(&one) - 24_000.0).abs() > 1.0, "{}", volume(&one));
+        assert_eq!(one.orient_consistently(), 1);
+        assert_eq!(one.triangles, good.triangles);
+        assert_eq!(one.topology().misoriented_edges, 0);
+        // All but three turned: the piece keeps the winding of most of its triangles (now
+        // inward), so the three are turned and the volume is the box's with its sign turned.
+        let mut most = good.clone();
+        for tri in most.triangles.iter_mut().skip(3) {
+            tri.swap(1, 2);
+        }
+        assert_eq!(most.orient_consistently(), 3);
+        assert_eq!(most.topology().misoriented_edges, 0);
+        assert!((volume(&most) + 24_000.0).abs() < 1e-6, "{}", volume(&most));
     }
 
     #[test]

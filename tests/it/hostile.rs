@@ -438,6 +438,52 @@ fn duplicated_faces_are_counted_once_and_warned_about() {
     );
 }
 
+/// A closed shell with some faces written the wrong way round (session 43's own probe): a
+/// 40 mm cube with one of its 12 triangles turned read as 32 cm³ and half the mass, with only a
+/// warning about misoriented edges. The turned faces are now wound as their neighbours are,
+/// the volume is the cube's, and a warning says how many were turned; a cube with all but two
+/// turned keeps the winding of most (inward) and is then turned outward whole, as before.
+#[test]
+fn faces_wound_against_their_neighbours_are_mended_not_subtracted() {
+    let dir = tempfile::tempdir().unwrap();
+    let good = cube([10.0, 20.0, 30.0], 40.0);
+    let mut one = good.clone();
+    one[9].swap(1, 2); // on the face x = 10: the volume integral takes the x-components
+    let mut most = good.clone();
+    for t in most.iter_mut().skip(2) {
+        t.swap(1, 2);
+    }
+    let run = |name: &str, tris: &[[[f32; 3]; 3]]| {
+        let p = dir.path().join(name);
+        std::fs::write(&p, binary_stl(tris)).unwrap();
+        let out = crate::grasp_sim()
+            .args(["--json", "--no-sim"])
+            .arg(&p)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(0));
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let volume = v["object"]["volume_mm3"].as_f64().unwrap();
+        (volume, String::from_utf8_lossy(&out.stderr).to_string())
+    };
+    let (v_good, err_good) = run("good.stl", &good);
+    assert!((v_good - 64_000.0).abs() < 1e-6, "{v_good}");
+    assert!(!err_good.contains("wound against"), "{err_good}");
+    let (v_one, err_one) = run("one.stl", &one);
+    assert!((v_one - 64_000.0).abs() < 1e-6, "{v_one}");
+    assert!(
+        err_one.contains("1 of 12 triangles were wound against their neighbours"),
+        "{err_one}"
+    );
+    let (v_most, err_most) = run("most.stl", &most);
+    assert!((v_most - 64_000.0).abs() < 1e-6, "{v_most}");
+    assert!(
+        err_most.contains("2 of 12 triangles were wound against their neighbours")
+            && err_most.contains("wound inside-out"),
+        "{err_most}"
+    );
+}
+
 /// A `batch --template` need not carry a placeholder `[object] mesh` (each mesh replaces it):
 /// one with only its density, or with no `[object]` at all, runs; a typo in it is still refused.
 #[test]
