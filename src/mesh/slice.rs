@@ -202,8 +202,8 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
     cut(mesh, plane, 0..mesh.triangles.len(), |i| dist[i as usize])
 }
 
-/// The contours `plane` cuts from `mesh` as they come, as [`slice_indexed_raw`] gives them
-/// (not joined, united nor bridged), without an index: for a domain whose slices only need to
+/// The contours `plane` cuts from `mesh` as they come (chained, but not joined, united nor
+/// bridged: open chains stay open, overlapping shells overlap), without an index: for a domain whose slices only need to
 /// show that nothing is graspable ([`crate::plan::domain::cannot_grade`]).
 pub fn slice_unrepaired(mesh: &Mesh, plane: &Plane) -> Slice {
     let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
@@ -237,17 +237,6 @@ pub fn slice_indexed_within(mesh: &Mesh, index: &SliceIndex, plane: &Plane, tol_
         |i| plane.distance(&mesh.vertices[i as usize]),
         tol_mm,
     )
-}
-
-/// The contours `plane` cuts from `mesh` (through `index`) as they come: not joined, united,
-/// simplified nor bridged (open chains stay open, overlapping shells overlap). Its points are
-/// the exact cut's, at the cost of the triangles cut: what a test of how far the object reaches
-/// needs, where the repairs would only cost (they add no point beyond the cut's but where a
-/// joint or a bridge spans a gap).
-pub fn slice_indexed_raw(mesh: &Mesh, index: &SliceIndex, plane: &Plane) -> Slice {
-    let tris = index.candidates(plane);
-    let dist = |i: u32| plane.distance(&mesh.vertices[i as usize]);
-    finish(*plane, raw_contours(mesh, plane, tris.into_iter(), &dist))
 }
 
 /// [`slice_indexed_within`]`(mesh, index, plane, tol_mm)`, then [`Slice::bridged_within`]`(gap_mm,
@@ -655,9 +644,9 @@ fn edge_point(mesh: &Mesh, e: Edge, dist: &impl Fn(u32) -> f64) -> Point3<f64> {
 /// The segments `plane` cuts from `mesh` (the triangles `index` finds), each from its crossing
 /// of one edge to its crossing of another in the plane's 2D coordinates, in no particular
 /// order and not chained: what a maximum over the cut needs (the palm's penetration), at a
-/// fraction of the cost of [`slice_indexed_raw`]'s contours. The points are the raw cut's, bit
-/// for bit; the raw cut's contours also drop segments under [`TINY_SEGMENT_MM`] (1e-9 mm)
-/// and pieces of a single point, which these keep.
+/// fraction of the cost of chaining them into contours. The points are the raw cut's, bit for
+/// bit; the raw cut's contours also drop segments under [`TINY_SEGMENT_MM`] (1e-9 mm) and
+/// pieces of a single point, which these keep.
 pub fn cut_segments_indexed(
     mesh: &Mesh,
     index: &SliceIndex,
@@ -1595,22 +1584,37 @@ mod tests {
     }
 
     #[test]
-    fn a_raw_slice_is_the_cut_unrepaired() {
+    fn a_cut_as_loose_segments_is_the_raw_cut_unrepaired() {
         // Through the three shells at mid-height: the boxes' two rectangles and the cylinder's
-        // circle, overlapping and apart as cut; the repaired slice unites the cross.
+        // circle, overlapping and apart as cut; the repaired slice unites the cross. The loose
+        // segments the palm's backoff takes are the raw contours' segments, bit for bit.
         let mesh = three_shells();
         let index = SliceIndex::new(&mesh);
         let plane = Plane::horizontal(40.0);
-        let raw = slice_indexed_raw(&mesh, &index, &plane);
-        assert_eq!(raw.contours.len(), 3);
-        assert!(raw.contours.iter().all(|c| c.is_closed));
-        let areas: Vec<f64> = raw.contours.iter().map(|c| c.signed_area()).collect();
+        let dist = |i: u32| plane.distance(&mesh.vertices[i as usize]);
+        let tris = index.candidates(&plane);
+        let raw = raw_contours(&mesh, &plane, tris.into_iter(), &dist);
+        assert_eq!(raw.len(), 3);
+        assert!(raw.iter().all(|c| c.is_closed));
+        let areas: Vec<f64> = raw.iter().map(|c| c.signed_area()).collect();
         assert!((areas[0] - 1200.0).abs() < 1e-6 && (areas[1] - 1200.0).abs() < 1e-6);
         let circle = std::f64::consts::PI * 64.0;
         assert!(areas[2] < circle && areas[2] > 0.98 * circle, "{areas:?}");
         let repaired = slice_indexed(&mesh, &index, &plane);
         assert_eq!(repaired.contours.len(), 2);
         assert!((repaired.contours[0].signed_area() - 2000.0).abs() < 1e-3);
+        let key = |(a, b): (Point2<f64>, Point2<f64>)| [a.x, a.y, b.x, b.y].map(f64::to_bits);
+        let mut from_contours: Vec<[u64; 4]> = raw
+            .iter()
+            .flat_map(|c| (0..c.segment_count()).map(|i| key(c.segment(i))))
+            .collect();
+        let mut loose: Vec<[u64; 4]> = cut_segments_indexed(&mesh, &index, &plane)
+            .into_iter()
+            .map(key)
+            .collect();
+        from_contours.sort_unstable();
+        loose.sort_unstable();
+        assert_eq!(loose, from_contours);
     }
 
     #[test]
