@@ -19,6 +19,8 @@
 //! Orientation: seen from the plane's normal side, an outer boundary runs counter-clockwise
 //! (positive signed area, outward normals on its right) and a hole clockwise.
 
+mod fill;
+
 use crate::mesh::Mesh;
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 use std::collections::{HashMap, HashSet};

@@ -58,6 +58,12 @@
 //! - Near the ends of the object (thesis 5.1): a walk that reaches the slice's top within reach is
 //!   graded as thinning above (Cat_6 behaviour), one that reaches its bottom as a ridge below
 //!   (Cat_3 behaviour), at least as strongly as a 90° turn at that distance.
+//! - The contour graded is the hand's (issue 30, beyond the thesis): stage 1's vertical slices
+//!   with dents shallower than the hand's relief filled and vertical gaps narrower than a finger
+//!   filled ([`crate::slice::Slice::filled_vertically`]), so a finger is not graded on teeth,
+//!   threads or grooves it cannot enter. The thesis objects have no such gap but the chapter 4
+//!   object's acute wedge above its base step and under its ridge (grades move by at most
+//!   0.011, the grasp by 1e-7 mm); the thesis table is unchanged.
 //! - An elevation is ungraspable if it is ungraspable in any slice (the palm may approach from
 //!   any angle, and the search must not waste time on a level with a sharp edge somewhere).
 

@@ -81,7 +81,14 @@ impl Domain {
                 if hopeless {
                     slice_unrepaired(mesh, &plane)
                 } else {
-                    slice(mesh, &plane).bridged_prepared(hand.finger_width_mm(), hand.relief_mm())
+                    // The slice as the hand meets it (issue 30): pieces closer than a finger
+                    // bridged, dents shallower than the relief filled, gaps narrower than a
+                    // finger filled; curvature is graded on this contour.
+                    let (w, relief) = (hand.finger_width_mm(), hand.relief_mm());
+                    slice(mesh, &plane)
+                        .bridged_prepared(w, relief)
+                        .simplified(relief)
+                        .filled_vertically(w)
                 }
             })
             .collect();

@@ -350,3 +350,74 @@ fn a_cheap_bound_rejects_objects_too_short_or_too_thin_before_bridging() {
         assert_eq!(*s, bridged, "slice {k}");
     }
 }
+
+#[test]
+fn grooves_narrower_than_a_finger_are_graded_as_the_plain_side() {
+    // Issue 30: a D40 cylinder 124 mm tall with six grooves 1.5 mm deep and 8 mm tall (a
+    // ribbed can, a knurl seen along the axis), 8 mm apart. A finger 14 mm wide cannot enter an
+    // 8 mm groove, so the planner's vertical slices (the hand-scale contour) fill them, and
+    // every indexed elevation grades as on the plain cylinder. On the exact cut, the groove
+    // edges are sharp curve changes and some elevation is ungraspable.
+    use grasp_sim::objects::{radial_solid, uniform_angles, Ring};
+    use grasp_sim::plan::curvature::{grade_elevations, grade_side, SliceSide};
+    use grasp_sim::plan::domain::Domain;
+    use grasp_sim::plan::{CurvatureParams, PlannerParams};
+    let hand =
+        grasp_sim::hand::Hand::load(&crate::root().join("assets/hands/thesis.toml"), &[]).unwrap();
+    let params = PlannerParams::default();
+    let angles = uniform_angles(48);
+    let ring = |z: f64, r: f64| Ring {
+        z,
+        radii: vec![r; angles.len()],
+    };
+    let mut rings = vec![ring(0.0, 20.0)];
+    for k in 0..6 {
+        let z0 = 20.0 + 16.0 * k as f64;
+        rings.extend([
+            ring(z0, 20.0),
+            ring(z0, 18.5),
+            ring(z0 + 8.0, 18.5),
+            ring(z0 + 8.0, 20.0),
+        ]);
+    }
+    rings.push(ring(124.0, 20.0));
+    let grooved = radial_solid(&angles, &rings);
+    let plain = radial_solid(&angles, &[ring(0.0, 20.0), ring(124.0, 20.0)]);
+    let cp = CurvatureParams::from_planner(&params, &hand, 0.3);
+    let dg = Domain::build(&grooved, &params, &hand);
+    let dp = Domain::build(&plain, &params, &hand);
+    assert_eq!(dg.elevations, dp.elevations);
+    let (gg, gp) = (grade_elevations(&dg, &cp), grade_elevations(&dp, &cp));
+    for (i, (g, p)) in gg.iter().zip(&gp).enumerate() {
+        let (g, p) = (g.expect("graded"), p.expect("graded"));
+        assert!((g - p).abs() < 1e-9, "index {}: {g} vs {p}", i + 1);
+    }
+    // The exact cut at 0°: some elevation crossing a groove edge is ungraspable.
+    let exact = grasp_sim::slice::slice(&grooved, &grasp_sim::slice::Plane::vertical(0.0));
+    let c = &exact.contours[0];
+    let mut ungraspable = 0;
+    for &z in &dg.elevations {
+        // The right side's crossing of the exact cut at z.
+        let Some(seg) = (0..c.segment_count()).find(|&s| {
+            let (a, b) = c.segment(s);
+            a.x > 0.0 && b.x > 0.0 && (a.y - z) * (b.y - z) < 0.0
+        }) else {
+            continue;
+        };
+        let (a, b) = c.segment(seg);
+        let x = a.x + (z - a.y) / (b.y - a.y) * (b.x - a.x);
+        let touch = grasp_sim::plan::Touch {
+            contour: 0,
+            segment: seg,
+            point: nalgebra::Point2::new(x, z),
+        };
+        let g = grade_side(c, &touch, SliceSide::Right, (0.0, 124.0), &cp);
+        if g.grade.is_err() {
+            ungraspable += 1;
+        }
+    }
+    assert!(
+        ungraspable > 0,
+        "no elevation of the exact cut is ungraspable"
+    );
+}

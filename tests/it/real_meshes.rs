@@ -427,7 +427,10 @@ fn a_60_mm_sphere_is_held_under_the_extended_rules() {
 #[test]
 fn a_rounded_figurine_is_held_under_the_extended_rules() {
     // A solid of revolution like a figurine: a body and a head, 90 mm tall, 24 to 46 mm across,
-    // with no wall within the Vertical Deviation Range: graded by curvature, not rejected.
+    // with no wall within the Vertical Deviation Range. Its waist is a cusp, a sharp curve
+    // change by the thesis's rules; the deepest 4 mm of it are narrower than a finger, which
+    // the hand-scale contour fills (issue 30), so the extended rules hold it without grading
+    // a rejected touch point.
     let profile: Vec<(f64, f64)> = (0..=60)
         .map(|i| {
             let z = i as f64 * 1.5;
@@ -440,7 +443,12 @@ fn a_rounded_figurine_is_held_under_the_extended_rules() {
         .collect();
     let fig = soup_of(&grasp_sim::objects::revolved(&profile));
     let r = run_soup(&fig, true);
-    held_beyond_the_thesis(&r, RuleSet::Extended, &[Relaxation::CurvatureGraded]);
+    let g = held_beyond_the_thesis(&r, RuleSet::Extended, &[]);
+    assert!(
+        !g.relaxations.contains(&Relaxation::CurvatureGraded),
+        "{:?}",
+        g.relaxations
+    );
 }
 
 #[test]
