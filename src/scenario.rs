@@ -397,6 +397,12 @@ pub const MAX_DENSITY_KG_M3: f64 = 100_000.0;
 /// # Errors
 /// The key and the problem, for [`ScenarioError::Invalid`].
 fn validate_object(o: &RawObject) -> Result<MassSpec, (&'static str, String)> {
+    if o.mesh.as_os_str().is_empty() {
+        return Err((
+            "object.mesh",
+            "is empty: give the mesh file's path (STL, OBJ, PLY or URDF)".to_string(),
+        ));
+    }
     let mass = match (o.density_kg_m3, o.mass_kg) {
         (Some(_), Some(_)) => {
             return Err((

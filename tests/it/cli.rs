@@ -189,6 +189,7 @@ fn bad_scenarios_name_the_file_and_key() {
         ("[object\nmesh = \"m.stl\"\n", "line 1"),
         ("name = \"t\"\n[hand]\nfile = \"hand.toml\"\n", "missing section `[object]`"),
         ("[object]\nunits = \"mm\"\n", "`mesh`"),
+        ("[object]\nmesh = \"\"\n", "`object.mesh` is empty"),
         ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"bh9\"\n", "bh9"),
     ];
     for (body, needle) in cases {
