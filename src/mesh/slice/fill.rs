@@ -37,6 +37,9 @@ impl Edge {
     }
 }
 
+/// The sweep's table of open pieces (foldhash's fixed-seed hasher, as the mesh code's tables).
+type HashMap<K, V> = std::collections::HashMap<K, V, crate::mesh::FastHash>;
+
 /// How far a filling piece reaches into the material it lies between `[mm]`.
 const OVERLAP_MM: f64 = 1e-3;
 
@@ -98,7 +101,9 @@ fn vertical_gaps(slice: &Slice, w: f64) -> Vec<Vec<[f64; 2]>> {
     // Filled pieces as (lower edge, upper edge, x from, x to); a piece that continues one of
     // the previous slab with the same two edges is extended.
     let mut pieces: Vec<(usize, usize, f64, f64)> = Vec::new();
-    let mut open: Vec<usize> = Vec::new();
+    // The pieces that reach the current slab's left end, by their two edges (looked up, never
+    // iterated: the pieces' order is their creation's).
+    let mut open: HashMap<(usize, usize), usize> = HashMap::default();
     let mut active: Vec<usize> = Vec::new();
     let mut next = 0;
     let mut order: Vec<(f64, usize)> = Vec::new();
@@ -113,7 +118,7 @@ fn vertical_gaps(slice: &Slice, w: f64) -> Vec<Vec<[f64; 2]>> {
         order.clear();
         order.extend(active.iter().map(|&e| (edges[e].z_at(xm), e)));
         order.sort_by(|p, q| p.0.total_cmp(&q.0).then(p.1.cmp(&q.1)));
-        let mut still_open = Vec::new();
+        let mut still_open = HashMap::default();
         let mut winding = 0i32;
         for k in 0..order.len() {
             let e = order[k].1;
@@ -139,22 +144,21 @@ fn vertical_gaps(slice: &Slice, w: f64) -> Vec<Vec<[f64; 2]>> {
             if to <= from {
                 continue;
             }
-            match open
-                .iter()
-                .find(|&&i| pieces[i].0 == e && pieces[i].1 == f && pieces[i].3 == from)
-            {
-                Some(&i) => {
+            let i = match open.get(&(e, f)) {
+                Some(&i) if pieces[i].3 == from => {
                     pieces[i].3 = to;
-                    still_open.push(i);
+                    i
                 }
-                None => {
+                _ => {
                     pieces.push((e, f, from, to));
-                    still_open.push(pieces.len() - 1);
+                    pieces.len() - 1
                 }
+            };
+            // Only a piece reaching this slab's right end can go on into the next.
+            if to == x1 {
+                still_open.insert((e, f), i);
             }
         }
-        // Only a piece reaching this slab's right end can go on into the next.
-        still_open.retain(|&i| pieces[i].3 == x1);
         open = still_open;
     }
     pieces
@@ -291,5 +295,14 @@ mod tests {
         assert!((area(&joined) - 600.0).abs() < 1e-9);
         let far = finish(Plane::vertical(0.0), vec![block(0.0), block(25.0)]);
         assert_eq!(far.clone().filled_vertically(14.0), far);
+        // 400 plates 1 mm thick, 1 mm apart (a heat sink's fins seen edge-on): one piece.
+        let plate = |z0: f64| ring(&[(0.0, z0), (20.0, z0), (20.0, z0 + 1.0), (0.0, z0 + 1.0)]);
+        let fins = finish(
+            Plane::vertical(0.0),
+            (0..400).map(|k| plate(2.0 * k as f64)).collect(),
+        );
+        let one = fins.filled_vertically(14.0);
+        assert_eq!(one.contours.len(), 1);
+        assert!((area(&one) - 20.0 * 799.0).abs() < 1e-6, "{}", area(&one));
     }
 }
