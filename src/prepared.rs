@@ -43,8 +43,12 @@ impl PreparedObject {
         // box it depends on the frame the file was written in (libero_black_book's was
         // negative in two frames of six, its mass then too, and the physics check met NaN), so
         // it is the covariant fan's, about the surface's own centroid, which also decided its
-        // winding (issue 30).
-        let props = if loaded.topology.boundary_edges > 0 {
+        // winding (issue 30). So is a surface with edges shared by more than two triangles: its
+        // edges do not cancel in pairs either, and rs_bottle's (6 such edges) came out 264,255
+        // to 294,271 mm³ in six frames, its mass with it, and its collider a hull in three and
+        // a decomposition in the others (the hull test is against this volume).
+        let props = if loaded.topology.boundary_edges > 0 || loaded.topology.non_manifold_edges > 0
+        {
             mesh::covariant_mass_properties(&loaded.mesh)
                 .unwrap_or_else(|| mesh::mass_properties(&loaded.mesh))
         } else {

@@ -313,6 +313,12 @@ fn grasp_report(
             verdict: o.verdict,
             translation_mm: o.translation_mm,
             rotation_deg: o.rotation_deg,
+            robust: o.robust.as_ref().map(|r| report::CandidateRobust {
+                held: r.counts.hold,
+                samples: r.samples,
+                hold_probability: r.hold_probability,
+                interval: r.interval,
+            }),
         }),
         quality: None,
     }

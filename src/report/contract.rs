@@ -261,6 +261,24 @@ pub struct CandidateCheck {
     pub translation_mm: f64,
     /// Worst direction's rotation relative to the palm `[deg]`.
     pub rotation_deg: f64,
+    /// With `[sim] choose = "robust"`, which samples every candidate it checks: the samples
+    /// that held, of how many, and the 95 % Wilson interval of the hold probability.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub robust: Option<CandidateRobust>,
+}
+
+/// A checked candidate's hold probability under perturbation, in brief (`sim.robust` has the
+/// chosen grasp's in full).
+#[derive(Debug, Clone, Serialize)]
+pub struct CandidateRobust {
+    /// Samples that held (in every direction).
+    pub held: usize,
+    /// Samples checked.
+    pub samples: usize,
+    /// `held / samples`.
+    pub hold_probability: f64,
+    /// 95 % Wilson score interval of the hold probability.
+    pub interval: [f64; 2],
 }
 
 /// What the planner found about one principal axis under one rule set.

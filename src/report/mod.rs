@@ -16,10 +16,11 @@ pub mod json;
 pub mod summary;
 
 pub use contract::{
-    AlsReport, AxisReport, BatchView, CandidateCheck, DiameterBasis, DirectionView, ErrorView,
-    ExpectReport, ExpectView, FingerReport, GradesReport, GraspQuality, GraspReport, GraspSource,
-    HoldLimits, IndexScale, ObjectReport, PlanReport, PlanStatus, PlanView, PoseReport, RecordView,
-    RobustView, RunReport, SimReport, SimVerdict, SimView, StageTimings,
+    AlsReport, AxisReport, BatchView, CandidateCheck, CandidateRobust, DiameterBasis,
+    DirectionView, ErrorView, ExpectReport, ExpectView, FingerReport, GradesReport, GraspQuality,
+    GraspReport, GraspSource, HoldLimits, IndexScale, ObjectReport, PlanReport, PlanStatus,
+    PlanView, PoseReport, RecordView, RobustView, RunReport, SimReport, SimVerdict, SimView,
+    StageTimings,
 };
 pub use json::{
     round_significant, to_rounded_json, to_rounded_json_pretty, JSON_SIGNIFICANT_DIGITS,

@@ -1,6 +1,20 @@
 //! Frame invariance (issue 30): every real-object mesh written in five random rigid frames
 //! (a fixed seed) must plan with the same status, the same grasp in the object's own (aligned)
-//! frame within 0.5 mm and 0.5°, and the same verdict.
+//! frame within 0.5 mm and 0.5°, and with the physics check the same verdict wherever the
+//! verdict is decided by the physics and not by round-off.
+//!
+//! With the physics check (the ignored test without `GRASP_SIM_FRAMES_NO_SIM`), a run checks
+//! candidates in search order until one holds. It must load the same object in every frame
+//! (volume, mass and kind of collider) and check the same candidates in the same order, each
+//! the same grasp. Where a candidate's verdict differs between two frames, it is sampled under
+//! perturbation in both (`choose = "robust"`, every candidate sampled
+//! `GRASP_SIM_FRAMES_SAMPLES` times, 16 by default): if every sample held in both frames, both
+//! verdicts must be `hold`; if none held in either, neither may be (a slip and a drop, which
+//! the hold probability does not tell apart, may differ); anything between is a coin toss.
+//! A verdict is a single sample of a chaotic check: a 1 ppm change of the contact stiffness,
+//! every other input bit for bit the same, flips such candidates as another frame does
+//! (docs/FRAMES.md, "Measured (issue 30, session 44)"). The runs that differ only by coin
+//! tosses are listed, not failed; the grasp chosen then differs too.
 //!
 //! `cargo test` runs the comparison, plan only, on eight committed real meshes chosen for the
 //! rule each exercises (`eight_real_objects_plan_alike_in_five_random_frames`) and on synthetic
@@ -15,8 +29,9 @@
 //! join it after `python3 scripts/real_objects.py`). docs/FRAMES.md gives the rule and what it
 //! measures.
 
-use grasp_sim::report::{PlanStatus, RunReport};
+use grasp_sim::report::{GraspReport, PlanStatus, RunReport};
 use grasp_sim::scenario::Scenario;
+use grasp_sim::sim::Verdict;
 use grasp_sim::{run, RunOptions};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 
@@ -54,25 +69,52 @@ fn frames() -> Vec<Isometry3<f64>> {
         .collect()
 }
 
-/// Plans (and with `sim`, checks) the scenario's mesh written in `frame` as binary STL in mm.
-fn plan_in(base: &Scenario, frame: &Isometry3<f64>, dir: &std::path::Path, sim: bool) -> RunReport {
+/// How a frame's run goes.
+#[derive(Clone, Copy, PartialEq)]
+enum Mode {
+    /// The planner alone.
+    Plan,
+    /// The planner and the physics check, candidates in search order until one holds.
+    Check,
+    /// As `Check`, every candidate checked also sampled this many times under perturbation
+    /// (`choose = "robust"` with a bound no candidate reaches, so that the search checks as
+    /// many candidates as the scenario's `max_checked` allows, each with its hold probability).
+    Sampled(usize),
+}
+
+/// Plans (and checks, as `mode` says) the scenario's mesh written in `frame` as binary STL in
+/// mm.
+fn plan_in(
+    base: &Scenario,
+    frame: &Isometry3<f64>,
+    dir: &std::path::Path,
+    mode: Mode,
+) -> RunReport {
     let loaded = grasp_sim::mesh::load_mesh(&base.object.mesh, base.object.units).unwrap();
     let mut mesh = loaded.mesh;
     mesh.map_vertices(|p| frame * p);
     let path = dir.join(format!("{}.stl", base.name));
     std::fs::write(&path, mesh.to_binary_stl()).unwrap();
     let dump = std::env::var_os("GRASP_SIM_FRAMES_DUMP").map(std::path::PathBuf::from);
-    let tag = format!("{}_{:.0}", base.name, frame.translation.vector.x);
+    let mut tag = format!("{}_{:.0}", base.name, frame.translation.vector.x);
+    if let Mode::Sampled(n) = mode {
+        tag += &format!("_sampled{n}");
+    }
     if let Some(d) = &dump {
         std::fs::write(d.join(format!("{tag}.stl")), mesh.to_binary_stl()).unwrap();
     }
     let mut s = base.clone();
     s.object.mesh = path;
     s.object.units = grasp_sim::mesh::LengthUnit::Mm;
+    if let Mode::Sampled(n) = mode {
+        s.sim.robust.samples = n;
+        s.sim.robust.choose = grasp_sim::sim::params::Choose::Robust;
+        s.sim.robust.choose_min_lower_bound = 1.0;
+    }
     let r = run(
         &s,
         &RunOptions {
-            no_sim: !sim,
+            no_sim: mode == Mode::Plan,
             ..RunOptions::default()
         },
     )
@@ -95,6 +137,19 @@ fn differences(a: &RunReport, b: &RunReport) -> Vec<String> {
         return out;
     }
     if let (Some(g), Some(h)) = (&a.plan.grasp, &b.plan.grasp) {
+        out.extend(grasp_differences(g, h));
+    }
+    if a.sim.verdict != b.sim.verdict {
+        out.push(format!("verdict {:?} / {:?}", a.sim.verdict, b.sim.verdict));
+    }
+    out
+}
+
+/// What differs between two grasps in the object's frame, in words (empty when the palms are
+/// within 0.5 mm and 0.5° and every joint angle within 0.5°).
+fn grasp_differences(g: &GraspReport, h: &GraspReport) -> Vec<String> {
+    let mut out = Vec::new();
+    {
         let p = Point3::from(g.palm_pose_aligned.position_mm);
         let q = Point3::from(h.palm_pose_aligned.position_mm);
         let rot = |w: [f64; 4]| {
@@ -124,10 +179,96 @@ fn differences(a: &RunReport, b: &RunReport) -> Vec<String> {
             }
         }
     }
-    if a.sim.verdict != b.sim.verdict {
-        out.push(format!("verdict {:?} / {:?}", a.sim.verdict, b.sim.verdict));
+    out
+}
+
+/// The candidates a run checked, in search order (`plan.grasps`, or its one grasp).
+fn checked(r: &RunReport) -> Vec<&GraspReport> {
+    if r.plan.grasps.is_empty() {
+        r.plan.grasp.iter().collect()
+    } else {
+        r.plan.grasps.iter().collect()
+    }
+}
+
+/// A candidate in words: axis, elevation index, approach angle.
+fn named(g: &GraspReport) -> String {
+    format!(
+        "{} #{} {:.0} deg",
+        g.axis_name, g.elevation_index, g.approach_angle_deg
+    )
+}
+
+/// The physics check's inputs that must not depend on the frame: the enclosed volume, the
+/// mass, and the kind of collider (the convex hull, or a decomposition).
+fn input_differences(a: &RunReport, b: &RunReport) -> Vec<String> {
+    let mut out = Vec::new();
+    let rel = |x: f64, y: f64| (x - y).abs() / x.abs().max(y.abs()).max(f64::MIN_POSITIVE);
+    if rel(a.object.volume_mm3, b.object.volume_mm3) > 1e-4 {
+        out.push(format!(
+            "volume {:.1} / {:.1} mm3",
+            a.object.volume_mm3, b.object.volume_mm3
+        ));
+    }
+    if let (Some(m), Some(n)) = (a.sim.mass_kg, b.sim.mass_kg) {
+        if rel(m, n) > 1e-4 {
+            out.push(format!("mass {m:.6} / {n:.6} kg"));
+        }
+    }
+    let kind = |r: &RunReport| r.sim.collider.map(|c| c.kind);
+    if kind(a) != kind(b) {
+        out.push(format!("collider {:?} / {:?}", kind(a), kind(b)));
     }
     out
+}
+
+/// The candidates, by index in search order, whose verdicts differ between two checked runs
+/// that checked the same candidates; or what else differs, in words.
+fn verdict_flips(a: &RunReport, b: &RunReport) -> Result<Vec<usize>, Vec<String>> {
+    if a.plan.status != b.plan.status {
+        return Err(vec![format!(
+            "status {:?} / {:?}",
+            a.plan.status, b.plan.status
+        )]);
+    }
+    let mut out = input_differences(a, b);
+    let (ca, cb) = (checked(a), checked(b));
+    let mut flips = Vec::new();
+    for (i, (g, h)) in ca.iter().zip(&cb).enumerate() {
+        let d = grasp_differences(g, h);
+        if !d.is_empty() {
+            out.push(format!(
+                "candidate {i} ({} / {}): {}",
+                named(g),
+                named(h),
+                d.join("; ")
+            ));
+            break;
+        }
+        let verdict = |g: &GraspReport| g.check.as_ref().map(|c| c.verdict);
+        if verdict(g) != verdict(h) {
+            flips.push(i);
+        }
+    }
+    if out.is_empty() && flips.is_empty() && ca.len() != cb.len() {
+        out.push(format!(
+            "{} / {} candidates checked, the same verdicts",
+            ca.len(),
+            cb.len()
+        ));
+    }
+    if out.is_empty() {
+        Ok(flips)
+    } else {
+        Err(out)
+    }
+}
+
+/// The `i`-th candidate a sampled run checked: its samples held, of how many.
+fn held(sampled: &RunReport, i: usize) -> Option<(usize, usize)> {
+    let g = checked(sampled).get(i).copied()?;
+    let r = g.check.as_ref()?.robust.as_ref()?;
+    Some((r.held, r.samples))
 }
 
 /// Every real-object scenario whose mesh is present.
@@ -146,45 +287,117 @@ fn real_scenarios() -> Vec<Scenario> {
         .collect()
 }
 
-fn check_frames(names: Option<&[&str]>, sim: bool) -> (usize, Vec<String>) {
+/// Compares every object (or those `names` names) in its own frame and five others: returns
+/// the objects compared, the differences that fail, and (with the physics check) the coin
+/// tosses, verdicts that differ on candidates whose hold probability is not decisive.
+fn check_frames(names: Option<&[&str]>, mode: Mode) -> (usize, Vec<String>, Vec<String>) {
     let dir = tempfile::tempdir().unwrap();
     let frames = frames();
+    let samples = std::env::var("GRASP_SIM_FRAMES_SAMPLES")
+        .ok()
+        .map_or(16, |n| n.parse().unwrap());
     let mut failures = Vec::new();
+    let mut tosses = Vec::new();
     let mut objects = 0;
     for s in real_scenarios() {
         if names.is_some_and(|n| !n.contains(&s.name.as_str())) {
             continue;
         }
         objects += 1;
-        let reference = plan_in(&s, &Isometry3::identity(), dir.path(), sim);
+        let own = Isometry3::identity();
+        let reference = plan_in(&s, &own, dir.path(), mode);
+        let mut reference_sampled = None;
         for (k, f) in frames.iter().enumerate() {
-            let other = plan_in(&s, f, dir.path(), sim);
-            let d = differences(&reference, &other);
-            if !d.is_empty() {
-                failures.push(format!("{} frame {k}: {}", s.name, d.join("; ")));
+            let other = plan_in(&s, f, dir.path(), mode);
+            if mode == Mode::Plan {
+                let d = differences(&reference, &other);
+                if !d.is_empty() {
+                    failures.push(format!("{} frame {k}: {}", s.name, d.join("; ")));
+                }
+                continue;
+            }
+            let flips = match verdict_flips(&reference, &other) {
+                Ok(f) => f,
+                Err(d) => {
+                    failures.push(format!("{} frame {k}: {}", s.name, d.join("; ")));
+                    continue;
+                }
+            };
+            if flips.is_empty() {
+                continue;
+            }
+            // Verdicts differ: sample every candidate in both frames.
+            let a = reference_sampled
+                .get_or_insert_with(|| plan_in(&s, &own, dir.path(), Mode::Sampled(samples)));
+            let b = plan_in(&s, f, dir.path(), Mode::Sampled(samples));
+            let cands = checked(&reference);
+            for i in flips {
+                let g = cands[i];
+                let verdict = |r: &RunReport| checked(r)[i].check.as_ref().map(|c| c.verdict);
+                let (va, vb) = (verdict(&reference), verdict(&other));
+                let what = format!(
+                    "{} frame {k}: candidate {i} ({}) {va:?} / {vb:?}",
+                    s.name,
+                    named(g)
+                );
+                let same_grasp = |r: &RunReport| {
+                    checked(r)
+                        .get(i)
+                        .is_some_and(|x| grasp_differences(x, g).is_empty())
+                };
+                match (held(a, i), held(&b, i)) {
+                    (Some((ha, n)), Some((hb, m))) if same_grasp(a) && same_grasp(&b) => {
+                        // The hold probability tells hold from not hold: all samples held in
+                        // both frames decides `hold`, none held decides "not hold" (a slip and
+                        // a drop it does not tell apart).
+                        let hold = Some(Verdict::Hold);
+                        let decisive_wrong = (ha == n && hb == m && (va != hold || vb != hold))
+                            || (ha == 0 && hb == 0 && (va == hold || vb == hold));
+                        let line = format!("{what}, held {ha} of {n} / {hb} of {m} samples");
+                        if decisive_wrong {
+                            failures.push(format!("{line}: decisive, yet the verdicts differ"));
+                        } else {
+                            tosses.push(line);
+                        }
+                    }
+                    _ => failures.push(format!("{what}: not sampled")),
+                }
             }
         }
         if reference.plan.status == PlanStatus::Feasible {
             eprintln!("{}: checked in 5 frames", s.name);
         }
     }
-    (objects, failures)
+    (objects, failures, tosses)
 }
 
 #[test]
 #[ignore = "long: every real-object mesh in five frames; see the module docs"]
 fn every_real_object_plans_alike_in_five_random_frames() {
-    let sim = std::env::var_os("GRASP_SIM_FRAMES_NO_SIM").is_none();
+    let mode = if std::env::var_os("GRASP_SIM_FRAMES_NO_SIM").is_some() {
+        Mode::Plan
+    } else {
+        Mode::Check
+    };
     let only = std::env::var("GRASP_SIM_FRAMES_ONLY").ok();
     let names: Option<Vec<&str>> = only.as_deref().map(|o| o.split(',').collect());
-    let (objects, failures) = check_frames(names.as_deref(), sim);
-    eprintln!(
-        "{} of {objects} objects differ in some frame:\n{}",
-        failures
+    let (objects, failures, tosses) = check_frames(names.as_deref(), mode);
+    let count = |lines: &[String]| {
+        lines
             .iter()
             .map(|f| f.split(' ').next().unwrap_or(""))
             .collect::<std::collections::BTreeSet<_>>()
-            .len(),
+            .len()
+    };
+    eprintln!(
+        "{} of {objects} objects differ in some frame only by coin tosses (verdicts on \
+         candidates whose hold probability is not decisive):\n{}",
+        count(&tosses),
+        tosses.join("\n")
+    );
+    eprintln!(
+        "{} of {objects} objects differ in some frame otherwise:\n{}",
+        count(&failures),
         failures.join("\n")
     );
     assert!(failures.is_empty(), "{} differences", failures.len());
@@ -212,7 +425,7 @@ fn eight_real_objects_plan_alike_in_five_random_frames() {
         "rs_can",
         "rs_milk",
     ];
-    let (objects, failures) = check_frames(Some(&names), false);
+    let (objects, failures, _) = check_frames(Some(&names), Mode::Plan);
     assert_eq!(objects, names.len());
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -254,6 +254,19 @@ fn robust_choice_passes_over_a_marginal_hold_for_a_later_robust_grasp() {
         passed_over.check.as_ref().map(|c| c.verdict),
         Some(Verdict::Hold)
     );
+    // Every candidate checked carries its own samples (`plan.grasps[].check.robust`): the one
+    // passed over held 6 of 8, as under `choose = "first"`, the one chosen 8 of 8, as
+    // `sim.robust` says; under `choose = "first"` no candidate carries any.
+    let held = |g: &grasp_sim::report::GraspReport| {
+        g.check
+            .as_ref()
+            .and_then(|c| c.robust.as_ref())
+            .map(|r| (r.held, r.samples))
+    };
+    assert_eq!(held(passed_over), Some((6, 8)));
+    assert_eq!(held(&r.plan.grasps[k]), Some((8, 8)));
+    assert!(r.plan.grasps[..=k].iter().all(|g| held(g).is_some()));
+    assert!(f.plan.grasps.iter().all(|g| held(g).is_none()));
 }
 
 #[test]
