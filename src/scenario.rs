@@ -314,7 +314,7 @@ impl Scenario {
             // The mesh is there (or `object` is not a table): the first error stands.
             _ => return scenario,
         }
-        Scenario::parse(&table.to_string(), path)
+        Scenario::parse_as(&table.to_string(), path, true)
     }
 
     /// Parses scenario TOML; relative paths resolve against `path`'s folder.
@@ -322,6 +322,12 @@ impl Scenario {
     /// # Errors
     /// As [`Scenario::load`].
     pub fn parse(text: &str, path: &Path) -> Result<Scenario, ScenarioError> {
+        Scenario::parse_as(text, path, false)
+    }
+
+    /// [`Scenario::parse`]; a template (`template`) may leave `[object] mesh` empty, since each
+    /// mesh of the batch replaces it.
+    fn parse_as(text: &str, path: &Path, template: bool) -> Result<Scenario, ScenarioError> {
         let raw: RawScenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
             path: path.to_path_buf(),
             message: crate::messages::toml_message(&e, text),
@@ -334,6 +340,12 @@ impl Scenario {
         };
         let dir = path.parent().unwrap_or(Path::new("."));
         let o = raw.object;
+        if o.mesh.as_os_str().is_empty() && !template {
+            return Err(invalid(
+                "object.mesh",
+                "is empty: give the mesh file's path (STL, OBJ, PLY or URDF)".to_string(),
+            ));
+        }
         let mass = validate_object(&o).map_err(|(key, problem)| invalid(key, problem))?;
         let (hand_file, hand) = load_hand(raw.hand, dir, path)?;
 
@@ -397,12 +409,6 @@ pub const MAX_DENSITY_KG_M3: f64 = 100_000.0;
 /// # Errors
 /// The key and the problem, for [`ScenarioError::Invalid`].
 fn validate_object(o: &RawObject) -> Result<MassSpec, (&'static str, String)> {
-    if o.mesh.as_os_str().is_empty() {
-        return Err((
-            "object.mesh",
-            "is empty: give the mesh file's path (STL, OBJ, PLY or URDF)".to_string(),
-        ));
-    }
     let mass = match (o.density_kg_m3, o.mass_kg) {
         (Some(_), Some(_)) => {
             return Err((
