@@ -46,11 +46,17 @@ impl PreparedObject {
         // winding (issue 30). So is a surface with edges shared by more than two triangles: its
         // edges do not cancel in pairs either, and rs_bottle's (6 such edges) came out 264,255
         // to 294,271 mm³ in six frames, its mass with it, and its collider a hull in three and
-        // a decomposition in the others (the hull test is against this volume).
-        let props = if loaded.topology.boundary_edges > 0 || loaded.topology.non_manifold_edges > 0
-        {
-            mesh::covariant_mass_properties(&loaded.mesh)
-                .unwrap_or_else(|| mesh::mass_properties(&loaded.mesh))
+        // a decomposition in the others (the hull test is against this volume). Its shells may
+        // still overlap (thirty stacked cubes sharing faces): then the union's, as for any
+        // closed surface ([`mesh::mass_properties_from`]).
+        let covariant = || mesh::covariant_mass_properties(&loaded.mesh);
+        let props = if loaded.topology.boundary_edges > 0 {
+            covariant().unwrap_or_else(|| mesh::mass_properties(&loaded.mesh))
+        } else if loaded.topology.non_manifold_edges > 0 {
+            match covariant() {
+                Some(c) => mesh::mass_properties_from(&loaded.mesh, c),
+                None => mesh::mass_properties(&loaded.mesh),
+            }
         } else {
             mesh::mass_properties(&loaded.mesh)
         };

@@ -26,7 +26,13 @@ pub struct MassProperties {
 
 /// Computes the mass properties of `mesh` (which should be closed and outward-wound).
 pub fn mass_properties(mesh: &Mesh) -> MassProperties {
-    let exact = surface_mass_properties(mesh);
+    mass_properties_from(mesh, surface_mass_properties(mesh))
+}
+
+/// [`mass_properties`] with `exact` standing for the surface integral (the covariant fan's,
+/// for a surface whose integral about the file's origin depends on the frame): the union's
+/// where several shells overlap, else `exact`.
+pub fn mass_properties_from(mesh: &Mesh, exact: MassProperties) -> MassProperties {
     if mesh.shell_count() < 2 || exact.volume_mm3 <= 0.0 {
         return exact;
     }

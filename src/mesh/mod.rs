@@ -28,7 +28,10 @@ pub use load::{
     check_planner_work, load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh,
     MeshFormat,
 };
-pub use mass::{mass_properties, sliced_mass_properties, surface_mass_properties, MassProperties};
+pub use mass::{
+    mass_properties, mass_properties_from, sliced_mass_properties, surface_mass_properties,
+    MassProperties,
+};
 
 use nalgebra::{Point3, Vector3};
 use std::collections::HashMap;
