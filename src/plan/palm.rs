@@ -108,10 +108,7 @@ pub fn place_palm_on(
 
     // Palm domain: right-side points in range, plus crossings of the range's ends.
     let domain = palm_domain(vslice, z_lo, z_hi);
-    let first = *domain
-        .iter()
-        .max_by(|a, b| a.x.total_cmp(&b.x).then(b.y.total_cmp(&a.y)))
-        .ok_or(PalmRejection::NoContact)?;
+    let first = outermost(domain.iter()).ok_or(PalmRejection::NoContact)?;
 
     let (second, pitch) = second_contact(&domain, first, centre_z);
     let (second, pitch) = if pitch.abs() > pitch_range_rad + 1e-12 {
@@ -194,6 +191,27 @@ fn palm_domain(vslice: &Slice, z_lo: f64, z_hi: f64) -> Vec<Point2<f64>> {
     domain
 }
 
+/// Points this close to the outermost `[mm]` are as far out as it for the palm's contacts: a
+/// face the aligned frame makes vertical has its vertices at the same x to round-off, which the
+/// file's own frame sets (1e-5 to 4e-3 mm, docs/FRAMES.md); comparing them exactly let the
+/// round-off pick the face's top in one frame and its bottom in another, the palm pivoting on
+/// another point (issue 30). A fifth of [`PENETRATION_TOL_MM`], so that the true outermost
+/// point stays within the tolerance of the palm line.
+const OUTERMOST_TIE_MM: f64 = 0.01;
+
+/// The outermost of `points` (the largest x), and of those within [`OUTERMOST_TIE_MM`] of it
+/// the lowest (then the outermost): the palm's first contact. `None` when there are none.
+fn outermost<'a>(points: impl Iterator<Item = &'a Point2<f64>> + Clone) -> Option<Point2<f64>> {
+    let max_x = points
+        .clone()
+        .map(|p| p.x)
+        .fold(f64::NEG_INFINITY, f64::max);
+    points
+        .filter(|p| p.x >= max_x - OUTERMOST_TIE_MM)
+        .min_by(|a, b| a.y.total_cmp(&b.y).then(b.x.total_cmp(&a.x)))
+        .copied()
+}
+
 /// The palm's second contact and its pitch `[rad]` about the first contact `first`, among the
 /// `domain` points (the palm centre at height `centre_z`): with the first at the midpoint, the
 /// second-outermost point; else the point on the other half the palm line reaches first.
@@ -209,14 +227,11 @@ fn second_contact(
     let eps = 1e-9;
     if (first.y - centre_z).abs() <= eps {
         // Midpoint: the second-outermost point, either half.
-        let second = domain
-            .iter()
-            .filter(|p| (**p - first).norm() > eps)
-            .max_by(|a, b| a.x.total_cmp(&b.x).then(b.y.total_cmp(&a.y)));
+        let second = outermost(domain.iter().filter(|p| (**p - first).norm() > eps));
         match second {
             Some(p) => {
-                let phi = angle_to(p);
-                (Some(*p), if p.y < centre_z { -phi } else { phi })
+                let phi = angle_to(&p);
+                (Some(p), if p.y < centre_z { -phi } else { phi })
             }
             None => (None, 0.0),
         }
@@ -329,6 +344,25 @@ mod tests {
     use std::f64::consts::FRAC_PI_2;
 
     use crate::hand::thesis_for_tests as thesis_hand;
+
+    #[test]
+    fn round_off_does_not_pick_the_end_of_a_vertical_face_the_palm_pivots_on() {
+        // A face from y = 100 to 130 at x = 13, its ends apart by a file's round-off (1e-5 mm)
+        // either way, and a point further in: the palm pivots on the face's lower end in both
+        // (the golf club's head, issue 30: its top in three frames of six, backed 3.5 mm off).
+        for tilt in [1e-5, -1e-5] {
+            let points = [
+                Point2::new(13.0 + tilt, 130.0),
+                Point2::new(13.0, 100.0),
+                Point2::new(3.4, 63.0),
+            ];
+            assert_eq!(outermost(points.iter()), Some(Point2::new(13.0, 100.0)));
+        }
+        // A point further out than the tie wins however high it is.
+        let points = [Point2::new(13.02, 130.0), Point2::new(13.0, 100.0)];
+        assert_eq!(outermost(points.iter()), Some(Point2::new(13.02, 130.0)));
+        assert_eq!(outermost([].iter()), None);
+    }
 
     #[test]
     fn the_palm_lies_flat_on_a_cylinder_from_any_side() {

@@ -663,32 +663,40 @@ fn penetration_after_closing_is_reported_and_bounded() {
 
 #[test]
 fn the_hand_starts_clear_of_the_collider() {
-    // The golf club's convex decomposition bulges past the mesh the planner used: at the
-    // planned palm pose the palm starts inside one part, and with every joint 20° open a finger
-    // starts inside the club's head (at commit e4d7c31's grasp, finger 1 by 11 mm: MuJoCo then
-    // threw the club 3 m; today's first candidate, a fingertip pinch, has the thumb inside). The
-    // check backs the palm off and opens the fingers that need it further, so everything
-    // starts clear, and leaves the others at the default 20°.
-    let out = crate::succeed(crate::grasp_sim().args([
-        "--json",
-        "--max-checked",
-        "1",
-        "assets/real/scenarios/mw_golf_club.toml",
-    ]));
-    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    let start = &v["sim"]["start"];
-    assert_eq!(start["penetration_mm"], 0.0, "{start}");
-    let backoff = start["palm_backoff_mm"].as_f64().unwrap();
-    assert!(backoff > 0.1 && backoff < 2.0, "{start}");
-    let margins: Vec<f64> = start["open_margin_deg"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|m| m.as_f64().unwrap())
-        .collect();
+    // The golf club's convex decomposition bulges past the mesh the planner used: at this
+    // grasp's palm pose (the planner's first candidate from commit e4d7c31 to b824394, given
+    // here as it was printed, the club's file frame) the palm starts inside one part, and with
+    // every joint 20° open two fingers start inside the club's head (at e4d7c31's grasp, finger 1
+    // by 11 mm: MuJoCo then threw the club 3 m). The check backs the palm off and opens the
+    // fingers that need it further, so everything starts clear, and leaves the others at the
+    // default 20°.
+    let path = crate::root().join("assets/real/scenarios/mw_golf_club.toml");
+    let s = Scenario::load(&path).unwrap();
+    let mut o = with_sim();
+    o.given = Some(grasp_sim::GivenGrasp {
+        position_mm: [-34.5629737295, -22.7024680009, 24.2449363556],
+        quaternion_wxyz: [
+            0.562978744406,
+            -0.284356757566,
+            0.109749091789,
+            -0.768213059395,
+        ],
+        theta_deg: vec![
+            [78.9998904911, 65.9922225],
+            [80.607800964, 134.445403941],
+            [76.1553219703, 108.176912221],
+        ],
+        axis_name: Some("least".into()),
+    });
+    let r = run(&s, &o).unwrap();
+    let start = r.sim.start.as_ref().expect("the check ran");
+    assert_eq!(start.penetration_mm, 0.0, "{start:?}");
+    let backoff = start.palm_backoff_mm;
+    assert!(backoff > 0.1 && backoff < 2.0, "{start:?}");
+    let margins = &start.open_margin_deg;
     assert_eq!(margins.len(), 3);
-    assert!(margins.iter().any(|&m| m > 20.0), "{start}");
-    assert!(margins.contains(&20.0), "{start}");
+    assert!(margins.iter().any(|&m| m > 20.0), "{start:?}");
+    assert!(margins.contains(&20.0), "{start:?}");
 }
 
 #[test]
