@@ -51,6 +51,55 @@ pub struct ObjectShape {
     /// For a convex hull that parry would merge into bent faces, rebuilt from its face planes
     /// (see `coarsened_hull`): the full hull's vertex count.
     pub coarsened_from: Option<usize>,
+    /// A mass distribution the check gives the object's body instead of its collider's (see
+    /// [`object_mass_properties`]): the hull's own, where parry's polyhedron of it misweighs it
+    /// and cannot be rebuilt; `None` (every other collider): the collider's, scaled to the mass.
+    pub mesh_mass: Option<MeshMass>,
+}
+
+/// A solid's mass distribution, aligned frame, unit density, integrated from its triangles
+/// in double precision. parry's polyhedron of a hull can carry another than the hull's own:
+/// `rs_cereal`'s, a box of 15 hull vertices, weighed 489,308 mm³ in two frames of six against
+/// the hull's 449,898 and put the centre of mass 5 mm off (docs/FRAMES.md, issue 30).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MeshMass {
+    /// Enclosed volume `[mm³]`.
+    pub volume_mm3: f64,
+    /// Centroid, aligned frame `[mm]`.
+    pub centroid_mm: nalgebra::Point3<f64>,
+    /// Inertia tensor about the centroid, aligned frame, unit density `[mm⁵]`.
+    pub inertia_mm5: nalgebra::Matrix3<f64>,
+}
+
+/// The object's centre of mass as the check has it, aligned frame `[m]`:
+/// [`ObjectShape::mesh_mass`]'s where set, else its collider's.
+pub fn object_com_m(object: &ObjectShape) -> Vector {
+    match object.mesh_mass {
+        Some(m) => {
+            let c = m.centroid_mm.coords * convert::M_PER_MM;
+            Vector::new(c.x as f32, c.y as f32, c.z as f32)
+        }
+        None => object.shape.mass_properties(1.0).local_com,
+    }
+}
+
+/// The mass properties the check gives the object's body, `mass_kg` in all:
+/// [`ObjectShape::mesh_mass`]'s where set, else its collider's scaled to the mass.
+pub fn object_mass_properties(object: &ObjectShape, mass_kg: f64) -> MassProperties {
+    if let Some(m) = object.mesh_mass {
+        // kg per mm³, then mm² to m².
+        let scale = mass_kg / m.volume_mm3 * 1e-6;
+        let i = m.inertia_mm5 * scale;
+        let cols: [f32; 9] = std::array::from_fn(|k| i[(k % 3, k / 3)] as f32);
+        return MassProperties::with_inertia_matrix(
+            object_com_m(object),
+            mass_kg as f32,
+            rapier3d::math::Matrix::from_cols_array(&cols),
+        );
+    }
+    let unit = object.shape.mass_properties(1.0);
+    let density = mass_kg / f64::from(unit.mass()).max(f64::MIN_POSITIVE);
+    object.shape.mass_properties(density as f32)
 }
 
 /// The object's collider as the report gives it (`sim.collider`): how it was made and its part
@@ -174,11 +223,22 @@ impl ObjectShape {
         let is_revolution = (ixx - iyy).abs() <= 1e-3 * ixx.abs().max(iyy.abs());
         let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
         if let Some(hull) = SharedShape::convex_hull(&points) {
-            let hull_mm3 = f64::from(hull.mass_properties(1.0).mass()) * 1e9;
+            let parry_mm3 = f64::from(hull.mass_properties(1.0).mass()) * 1e9;
+            // The hull's own volume, from its triangles in double precision: parry's
+            // polyhedron of the same hull can carry another (rs_cereal's, a box of 15 hull
+            // vertices: 449,764 mm³ in four frames of six, 489,308 in two, its centre of mass
+            // 5 mm off; docs/FRAMES.md), so the test takes this one, and a polyhedron whose
+            // volume is not it is rebuilt from its planes.
+            let own = hull_mass(&points);
+            let hull_mm3 = own.map_or(parry_mm3, |m| m.volume_mm3);
             if hull_mm3 <= volume_mm3 * 1.02 {
-                let rebuilt = (bent_shape_m(&hull) > MERGED_FACE_TOLERANCE_M)
+                let misweighed = (parry_mm3 - hull_mm3).abs() > MISWEIGHED_FRACTION * hull_mm3;
+                let rebuilt = (misweighed || bent_shape_m(&hull) > MERGED_FACE_TOLERANCE_M)
                     .then(|| coarsened_hull(&points))
                     .flatten();
+                // A polyhedron that misweighs the hull and cannot be rebuilt keeps its contact
+                // geometry, and the body takes the hull's own mass distribution.
+                let mesh_mass = (misweighed && rebuilt.is_none()).then_some(own).flatten();
                 let (shape, coarsened_from) = match rebuilt {
                     Some((coarse, from)) => (coarse, Some(from)),
                     None => (hull, None),
@@ -189,6 +249,7 @@ impl ObjectShape {
                     parts: 1,
                     is_revolution,
                     coarsened_from,
+                    mesh_mass,
                 };
             }
         }
@@ -205,8 +266,41 @@ impl ObjectShape {
             parts,
             is_revolution,
             coarsened_from: None,
+            mesh_mass: None,
         }
     }
+}
+
+/// parry's polyhedron of a hull whose volume differs from the hull's own by more than this
+/// fraction is rebuilt from its planes ([`coarsened_hull`]).
+const MISWEIGHED_FRACTION: f64 = 1e-3;
+
+/// The mass distribution of the convex hull of `points` (metres, aligned frame), from its
+/// triangles in double precision ([`crate::mesh::mass_properties`]); `None` where there is no
+/// hull with a volume.
+fn hull_mass(points: &[Vector]) -> Option<MeshMass> {
+    use rapier3d::parry::transformation::try_convex_hull;
+    let (vertices, mut triangles) = try_convex_hull(points).ok()?;
+    let mm = |v: &Vector| {
+        nalgebra::Point3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z)) / convert::M_PER_MM
+    };
+    let mut mesh = Mesh {
+        vertices: vertices.iter().map(mm).collect(),
+        triangles: triangles.clone(),
+    };
+    let mut props = crate::mesh::mass_properties(&mesh);
+    if props.volume_mm3 < 0.0 {
+        for t in &mut triangles {
+            t.swap(1, 2);
+        }
+        mesh.triangles = triangles;
+        props = crate::mesh::mass_properties(&mesh);
+    }
+    (props.volume_mm3 > 0.0 && props.volume_mm3.is_finite()).then_some(MeshMass {
+        volume_mm3: props.volume_mm3,
+        centroid_mm: props.centroid,
+        inertia_mm5: props.inertia,
+    })
 }
 
 /// How far a vertex of a merged hull face may lie off that face's plane `[m]`: rapier's allowed
@@ -394,14 +488,12 @@ fn holds_all(poly: &rapier3d::parry::shape::ConvexPolyhedron, v64: &[Vector3<f64
 }
 
 /// The object's centre of mass `[m]` and inertia tensor about it `[kg·m²]`, aligned frame, as the
-/// rapier check has them: its collider's mass distribution scaled to `mass_kg`.
+/// rapier check has them ([`object_mass_properties`]).
 pub fn collider_inertia(
     object: &ObjectShape,
     mass_kg: f64,
 ) -> (nalgebra::Vector3<f64>, nalgebra::Matrix3<f64>) {
-    let unit = object.shape.mass_properties(1.0);
-    let density = mass_kg / f64::from(unit.mass()).max(f64::MIN_POSITIVE);
-    let props = object.shape.mass_properties(density as f32);
+    let props = object_mass_properties(object, mass_kg);
     let m = props.reconstruct_inertia_matrix();
     let c = props.local_com;
     let cols = m.to_cols_array();
@@ -414,6 +506,42 @@ pub fn collider_inertia(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_hulls_own_mass_is_parrys_where_parry_weighs_it_right() {
+        // The D40 cylinder and the prism: parry's polyhedron weighs their hulls right, so they
+        // keep it (no `mesh_mass`), and the hull's own mass distribution, which the body takes
+        // where parry's misweighs it, is the same to f32.
+        for mesh in [
+            crate::objects::cylinder(40.0, 124.0),
+            crate::objects::prism(30.0, 40.0, 100.0),
+        ] {
+            let aligned = crate::mesh::align(&mesh);
+            let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
+            let mut shape = ObjectShape::from_mesh(&aligned.mesh, volume);
+            assert_eq!(shape.kind, ColliderKind::ConvexHull);
+            assert_eq!(shape.mesh_mass, None);
+            let parrys = object_mass_properties(&shape, 0.2);
+            let points: Vec<Vector> = aligned.mesh.vertices.iter().map(convert::point_m).collect();
+            shape.mesh_mass = hull_mass(&points);
+            let own = shape.mesh_mass.expect("a hull");
+            assert!((own.volume_mm3 - volume).abs() < 1e-6 * volume, "{own:?}");
+            let owns = object_mass_properties(&shape, 0.2);
+            assert!((parrys.mass() - owns.mass()).abs() < 1e-6);
+            assert!(
+                (parrys.local_com - owns.local_com).length() < 1e-6,
+                "{parrys:?} {owns:?}"
+            );
+            let (a, b) = (
+                parrys.reconstruct_inertia_matrix(),
+                owns.reconstruct_inertia_matrix(),
+            );
+            let scale = a.to_cols_array().iter().fold(0f32, |m, v| m.max(v.abs()));
+            for (x, y) in a.to_cols_array().iter().zip(b.to_cols_array()) {
+                assert!((x - y).abs() < 1e-4 * scale, "{a:?} against {b:?}");
+            }
+        }
+    }
 
     #[test]
     fn a_convex_decomposition_is_made_once_per_mesh() {

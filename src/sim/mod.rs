@@ -53,7 +53,9 @@ pub mod robust;
 pub mod scene;
 
 pub use closing::{Stall, RAMP_S, RESEAT_RAD_S, STALL};
-pub use collider::{collider_inertia, ColliderKind, ColliderReport, ObjectShape};
+pub use collider::{
+    collider_inertia, object_mass_properties, ColliderKind, ColliderReport, MeshMass, ObjectShape,
+};
 pub use early::EarlyDecision;
 pub use outcome::{
     ClosingOutcome, DecidedBy, DirectionOutcome, FingerClosing, FirstTouch, SimOutcome, Verdict,

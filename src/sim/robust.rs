@@ -135,10 +135,9 @@ impl Perturbed {
     }
 }
 
-/// The object collider's centre of mass, aligned frame `[mm]`.
+/// The object's centre of mass as the check has it, aligned frame `[mm]`.
 fn object_com_mm(case: &Case) -> Vector3<f64> {
-    let mp = case.object.shape.mass_properties(1.0);
-    let c = mp.local_com;
+    let c = super::collider::object_com_m(case.object);
     Vector3::new(f64::from(c.x), f64::from(c.y), f64::from(c.z)) / super::convert::M_PER_MM
 }
 

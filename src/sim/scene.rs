@@ -462,13 +462,18 @@ pub fn build(case: &Case) -> Scene {
     let object_body = world
         .bodies
         .insert(RigidBodyBuilder::dynamic().can_sleep(false));
-    let object_collider = world.colliders.insert_with_parent(
-        ColliderBuilder::new(object.shape.clone())
-            .mass(mass_kg as f32)
-            .friction(friction as f32),
-        object_body,
-        &mut world.bodies,
-    );
+    let collider = ColliderBuilder::new(object.shape.clone()).friction(friction as f32);
+    // The mesh's mass distribution where known, else the collider's scaled to the mass.
+    let collider = match object.mesh_mass {
+        Some(_) => {
+            collider.mass_properties(super::collider::object_mass_properties(object, mass_kg))
+        }
+        None => collider.mass(mass_kg as f32),
+    };
+    let object_collider =
+        world
+            .colliders
+            .insert_with_parent(collider, object_body, &mut world.bodies);
     Scene {
         world,
         palm,
@@ -694,7 +699,7 @@ fn reach_mm(hand: &Hand) -> f64 {
 /// Radius about the object's centre of mass of a sphere that holds the object `[m]`.
 fn object_radius_m(object: &ObjectShape) -> f64 {
     let sphere = object.shape.compute_local_bounding_sphere();
-    let com = object.shape.mass_properties(1.0).local_com;
+    let com = super::collider::object_com_m(object);
     f64::from(sphere.radius() + (sphere.center() - com).length())
 }
 
