@@ -24,11 +24,13 @@ use grasp_sim::sim::{EarlyDecision, Verdict};
 use grasp_sim::{run, RunOptions};
 
 /// (window `[s]`, margin) pairs studied.
-const RULES: [(f64, f64); 9] = [
+const RULES: [(f64, f64); 11] = [
     (0.1, 1.0),
     (0.2, 1.0),
     (0.3, 1.0),
     (0.5, 1.0),
+    (0.05, 0.8),
+    (0.075, 0.8),
     (0.1, 0.8),
     (0.15, 0.8),
     (0.2, 0.8),

@@ -332,7 +332,7 @@ pub struct EarlyParams {
 impl Default for EarlyParams {
     fn default() -> Self {
         EarlyParams {
-            rest_window_s: 0.1,
+            rest_window_s: 0.05,
             rest_safety: 2.0,
             rest_margin: 0.8,
         }
@@ -851,7 +851,7 @@ mod tests {
         let debug = format!("{:?}", SimParams::default());
         assert!(
             debug.starts_with(
-                "SimParams { gravity: Down, protocol: Fast, rest_window_s: 0.1, rest_safety: 2.0,"
+                "SimParams { gravity: Down, protocol: Fast, rest_window_s: 0.05, rest_safety: 2.0,"
             ),
             "{debug}"
         );

@@ -47,20 +47,37 @@ fn the_holds_substeps_leave_the_closing_bit_for_bit() {
 
 #[test]
 fn a_shorter_rest_window_decides_a_still_grasp_sooner_with_the_same_numbers() {
-    // D40 hardly moves in its hold: the 0.1 s window (the default) decides every direction at
-    // rest 0.125 s in (six samples of 1/48 s), the old 0.2 s window at 0.229 s, and the
-    // verdicts and translations agree within 0.05 mm.
+    // D40 hardly moves in its hold: the 0.05 s window (the default since session 45) decides
+    // every direction at rest 0.0625 s in (three samples of 1/48 s), the 0.1 s window (the
+    // default before) at 0.125 s, the 0.2 s window at 0.229 s, and the verdicts and
+    // translations agree within 0.05 mm.
     let mut s = d40_six();
     let short = run(&s, &RunOptions::default()).unwrap().sim;
     s.sim.early.rest_window_s = 0.2;
     let long = run(&s, &RunOptions::default()).unwrap().sim;
-    for (a, b) in short.directions.iter().zip(&long.directions) {
+    s.sim.early.rest_window_s = 0.1;
+    let middle = run(&s, &RunOptions::default()).unwrap().sim;
+    for ((a, b), m) in short
+        .directions
+        .iter()
+        .zip(&long.directions)
+        .zip(&middle.directions)
+    {
         assert_eq!(a.decided_by, DecidedBy::Rest);
         assert_eq!(b.decided_by, DecidedBy::Rest);
-        assert!(a.decided_at_s < 0.15, "decided at {} s", a.decided_at_s);
+        assert_eq!(m.decided_by, DecidedBy::Rest);
+        assert!(a.decided_at_s < 0.07, "decided at {} s", a.decided_at_s);
+        assert!(
+            (0.1..0.15).contains(&m.decided_at_s),
+            "decided at {} s",
+            m.decided_at_s
+        );
         assert!(b.decided_at_s > 0.2, "decided at {} s", b.decided_at_s);
+        assert_eq!(a.verdict, m.verdict);
+        assert!((a.translation_mm - m.translation_mm).abs() < 0.05);
         assert_eq!(a.verdict, b.verdict);
         assert!((a.translation_mm - b.translation_mm).abs() < 0.05);
     }
-    assert!(short.steps.unwrap() < long.steps.unwrap());
+    assert!(short.steps.unwrap() < middle.steps.unwrap());
+    assert!(middle.steps.unwrap() < long.steps.unwrap());
 }

@@ -382,7 +382,7 @@ fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
     use grasp_sim::sim::protocol::{RestFrame, SAMPLE_S};
     use grasp_sim::sim::{EarlyDecision, Verdict};
     use nalgebra::{UnitQuaternion, Vector3};
-    // The rule at a 0.2 s window (ten samples; the default is 0.1 s since issue 35).
+    // The rule at a 0.2 s window (ten samples; the default is 0.05 s since session 45).
     let mut params = SimParams::default();
     params.early.rest_window_s = 0.2;
     let rule = EarlyDecision::from_params(&params);
