@@ -53,6 +53,10 @@
 //!   Cat_1 into Cat_5 with the demerit of eq. 3.1 scaled so that the grade at the friction-cone
 //!   limit stays just above Cat_3; beyond the friction cone (atan μ, 17° for μ = 0.3) the touch
 //!   point is ungraspable.
+//! - The slope graded is the touched segment's, blended with the next segment's within 0.05 mm
+//!   in height of their shared vertex (their mean at the vertex), so that a touch height on a
+//!   vertex grades the same slope a micrometre above or below it (issue 30: round-off put the
+//!   book's touch on one side or the other in two frames; [`blended_slope`]).
 //! - A sharp curve change is ungraspable: a vertex turning by more than 45° within half a
 //!   HeightStep of the touch point, or a touched segment that is itself that steep.
 //! - Near the ends of the object (thesis 5.1): a walk that reaches the slice's top within reach is
@@ -290,7 +294,13 @@ pub fn grade_side(
     // Which way along the contour is up on this segment.
     let forward_is_up = dz > 0.0;
     let up_dir = if forward_is_up { b - a } else { a - b };
-    let slope = angle_of(up_dir, side, Vertical::Up);
+    let slope = blended_slope(
+        c,
+        touch,
+        forward_is_up,
+        side,
+        angle_of(up_dir, side, Vertical::Up),
+    );
     let slope_deg = slope.to_degrees();
     let mut out = SideGrade {
         grade: Err(Ungraspable::SharpChange),
@@ -394,6 +404,46 @@ fn blended_grade(
         Category::from_signs(da, db)
     };
     (grade, category)
+}
+
+/// A touch height closer than this to an end of its segment `[mm]` grades a slope blended with
+/// the neighbouring segment's (see [`blended_slope`]).
+const VERTEX_BLEND_MM: f64 = 0.05;
+
+/// The slope at `touch` (`own`, its segment's `[rad]`), made continuous across the segment's
+/// ends: within [`VERTEX_BLEND_MM`] in height of an end, the mean of the two segments' slopes
+/// at the vertex itself, fading to the segment's own at that distance. A touch height on a
+/// vertex otherwise took the segment above in one frame and the one below in another, by 1 µm
+/// of round-off (the book's #52: 26.8° or 13.8°, issue 30). An end where the contour turns
+/// back down (an extremum) keeps the segment's own slope.
+fn blended_slope(
+    c: &Contour,
+    touch: &Touch,
+    forward_is_up: bool,
+    side: SliceSide,
+    own: f64,
+) -> f64 {
+    let k = touch.segment;
+    let Some(k1) = next_vertex(c, k, true) else {
+        return own;
+    };
+    let (upper, lower) = if forward_is_up { (k1, k) } else { (k, k1) };
+    let z = touch.point.y;
+    let (d_up, d_low) = (c.points[upper].y - z, z - c.points[lower].y);
+    // The nearer end, and the upward direction of the segment beyond it.
+    let (d, beyond) = if d_up <= d_low {
+        let next = next_vertex(c, upper, forward_is_up);
+        (d_up, next.map(|n| c.points[n] - c.points[upper]))
+    } else {
+        let prev = next_vertex(c, lower, !forward_is_up);
+        (d_low, prev.map(|n| c.points[lower] - c.points[n]))
+    };
+    let d = d.max(0.0);
+    let Some(dir) = beyond.filter(|v| v.y > 0.0 && d < VERTEX_BLEND_MM) else {
+        return own;
+    };
+    let w = 0.5 * (1.0 - d / VERTEX_BLEND_MM);
+    (1.0 - w) * own + w * angle_of(dir, side, Vertical::Up)
 }
 
 /// Angle of a direction from "straight on" along the walk, outward positive: `atan2(ds, dz)`
@@ -615,6 +665,38 @@ mod tests {
 
     // Profiles span z = 0..100 with the feature near z = 50, far from both ends.
     const STRAIGHT: &[(f64, f64)] = &[(0.0, 0.0), (20.0, 0.0), (20.0, 100.0), (0.0, 100.0)];
+
+    #[test]
+    fn a_touch_on_a_vertex_grades_the_same_slope_a_micrometre_either_side() {
+        // The right side leans out 10° below z = 50 and 30° above it (the friction cone is
+        // 17°). A touch 1 µm below or above the vertex grades the same slope, the two
+        // segments' mean (20°: ungraspable both ways), not 10° on one side and 30° on the
+        // other; 0.05 mm away and beyond, each its own segment's.
+        let (t10, t30) = (10f64.to_radians().tan(), 30f64.to_radians().tan());
+        let p = [
+            (0.0, 0.0),
+            (20.0, 0.0),
+            (20.0 + 50.0 * t10, 50.0),
+            (20.0 + 50.0 * t10 + 50.0 * t30, 100.0),
+            (0.0, 100.0),
+        ];
+        let slope_at = |z: f64| grade_at(&p, z).slope_deg;
+        let (below, above) = (slope_at(50.0 - 1e-6), slope_at(50.0 + 1e-6));
+        assert!((below - above).abs() < 1e-3, "{below} against {above}");
+        assert!((below.abs() - 20.0).abs() < 1e-3, "{below}");
+        assert!(grade_at(&p, 50.0 - 1e-6).grade.is_err());
+        assert!(grade_at(&p, 50.0 + 1e-6).grade.is_err());
+        assert!((slope_at(49.9).abs() - 10.0).abs() < 1e-9);
+        assert!(grade_at(&p, 49.9).grade.is_ok());
+        assert!((slope_at(50.1).abs() - 30.0).abs() < 1e-9);
+        // Halfway into the blend, three quarters its own: 15°, graspable.
+        assert!(
+            (slope_at(49.975).abs() - 15.0).abs() < 1e-6,
+            "{}",
+            slope_at(49.975)
+        );
+        assert!(grade_at(&p, 49.975).grade.is_ok());
+    }
 
     #[test]
     fn straight_vertical_is_cat_1() {
