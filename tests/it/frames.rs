@@ -101,6 +101,7 @@ fn plan_in(
         tag += &format!("_sampled{n}");
     }
     if let Some(d) = &dump {
+        std::fs::create_dir_all(d).unwrap();
         std::fs::write(d.join(format!("{tag}.stl")), mesh.to_binary_stl()).unwrap();
     }
     let mut s = base.clone();
