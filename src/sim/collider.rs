@@ -222,19 +222,25 @@ impl ObjectShape {
         let (ixx, iyy) = (props.inertia[(0, 0)], props.inertia[(1, 1)]);
         let is_revolution = (ixx - iyy).abs() <= 1e-3 * ixx.abs().max(iyy.abs());
         let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
-        if let Some(hull) = SharedShape::convex_hull(&points) {
+        // The hull once: parry's polyhedron of it (`SharedShape::convex_hull` is this and
+        // `convex_mesh`), its own mass, and its planes where it is rebuilt.
+        let hull_mesh = rapier3d::parry::transformation::try_convex_hull(&points).ok();
+        let polyhedron = hull_mesh
+            .as_ref()
+            .and_then(|(v, t)| SharedShape::convex_mesh(v.clone(), t).map(|h| (h, v, t)));
+        if let Some((hull, vertices, triangles)) = polyhedron {
             let parry_mm3 = f64::from(hull.mass_properties(1.0).mass()) * 1e9;
             // The hull's own volume, from its triangles in double precision: parry's
             // polyhedron of the same hull can carry another (rs_cereal's, a box of 15 hull
             // vertices: 449,764 mm³ in four frames of six, 489,308 in two, its centre of mass
             // 5 mm off; docs/FRAMES.md), so the test takes this one, and a polyhedron whose
             // volume is not it is rebuilt from its planes.
-            let own = hull_mass(&points);
+            let own = hull_mass(vertices, triangles);
             let hull_mm3 = own.map_or(parry_mm3, |m| m.volume_mm3);
             if hull_mm3 <= volume_mm3 * 1.02 {
                 let misweighed = (parry_mm3 - hull_mm3).abs() > MISWEIGHED_FRACTION * hull_mm3;
                 let rebuilt = (misweighed || bent_shape_m(&hull) > MERGED_FACE_TOLERANCE_M)
-                    .then(|| coarsened_hull(&points))
+                    .then(|| coarsened_hull(vertices, triangles))
                     .flatten();
                 // A polyhedron that misweighs the hull and cannot be rebuilt keeps its contact
                 // geometry, and the body takes the hull's own mass distribution.
@@ -275,12 +281,11 @@ impl ObjectShape {
 /// fraction is rebuilt from its planes ([`coarsened_hull`]).
 const MISWEIGHED_FRACTION: f64 = 1e-3;
 
-/// The mass distribution of the convex hull of `points` (metres, aligned frame), from its
-/// triangles in double precision ([`crate::mesh::mass_properties`]); `None` where there is no
+/// The mass distribution of a convex hull (`vertices` in metres, aligned frame, and
+/// `triangles`, as `try_convex_hull` gives them), from its triangles in double precision ([`crate::mesh::mass_properties`]); `None` where there is no
 /// hull with a volume.
-fn hull_mass(points: &[Vector]) -> Option<MeshMass> {
-    use rapier3d::parry::transformation::try_convex_hull;
-    let (vertices, mut triangles) = try_convex_hull(points).ok()?;
+fn hull_mass(vertices: &[Vector], triangles: &[[u32; 3]]) -> Option<MeshMass> {
+    let mut triangles = triangles.to_vec();
     let mm = |v: &Vector| {
         nalgebra::Point3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z)) / convert::M_PER_MM
     };
@@ -344,8 +349,8 @@ const SUPPORT_TOLERANCE_M: f64 = 1e-7;
 /// The rebuilt hull may stand off the true one by at most this `[m]` (0.05 mm) or it is not used.
 const MAX_OUTER_STANDOFF_M: f64 = 5e-5;
 
-/// The convex hull of `points` (metres), rebuilt where parry would merge curved faces into
-/// non-planar ones ([`bent_face_m`]): the hull's face planes are taken largest
+/// The convex hull `vertices` (metres) and `triangles`, rebuilt where parry would merge curved
+/// faces into non-planar ones ([`bent_face_m`]): the hull's face planes are taken largest
 /// face first, each kept only if its normal is at least [`MIN_FACE_ANGLE_RAD`] from every plane
 /// kept (a plane split into triangles is one plane, kept once), and the hull is rebuilt as the
 /// intersection of the kept half-spaces (its vertices found through the polar dual: the convex
@@ -355,9 +360,7 @@ const MAX_OUTER_STANDOFF_M: f64 = 5e-5;
 /// two of its faces meet at 2° or more, so parry keeps them apart. Returns it with the full
 /// hull's vertex count, or `None` where the full hull needs no rebuilding (every thesis object)
 /// or the rebuilt one would stand off by more than [`MAX_OUTER_STANDOFF_M`].
-fn coarsened_hull(points: &[Vector]) -> Option<(SharedShape, usize)> {
-    use rapier3d::parry::transformation::try_convex_hull;
-    let (vertices, triangles) = try_convex_hull(points).ok()?;
+fn coarsened_hull(vertices: &[Vector], triangles: &[[u32; 3]]) -> Option<(SharedShape, usize)> {
     let v64: Vec<Vector3<f64>> = vertices
         .iter()
         .map(|v| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z)))
@@ -523,7 +526,8 @@ mod tests {
             assert_eq!(shape.mesh_mass, None);
             let parrys = object_mass_properties(&shape, 0.2);
             let points: Vec<Vector> = aligned.mesh.vertices.iter().map(convert::point_m).collect();
-            shape.mesh_mass = hull_mass(&points);
+            let (v, t) = rapier3d::parry::transformation::try_convex_hull(&points).unwrap();
+            shape.mesh_mass = hull_mass(&v, &t);
             let own = shape.mesh_mass.expect("a hull");
             assert!((own.volume_mm3 - volume).abs() < 1e-6 * volume, "{own:?}");
             let owns = object_mass_properties(&shape, 0.2);
