@@ -155,8 +155,8 @@ mod tests {
 
     #[test]
     fn the_impulse_hand_closes_where_the_multibody_hand_does_on_d40() {
-        // Same bodies, limits and motors: on D40 the fingers stop within a degree of each other
-        // and both hold (docs/SIM.md, "The impulse-joint hand": elsewhere they part).
+        // Same bodies, limits and motors: on D40 the fingers stop within 2° of each other (within
+        // a degree under the 10° squeeze before session 46's closing) and both hold (docs/SIM.md, "The impulse-joint hand": elsewhere they part).
         let [mb, imp] = [HandJoints::Multibody, HandJoints::Impulse]
             .map(|k| d40(&with_joints(k), crate::sim::protocol::check));
         assert_eq!(mb.verdict, Verdict::Hold);
@@ -164,7 +164,7 @@ mod tests {
         for (a, b) in mb.closing.fingers.iter().zip(&imp.closing.fingers) {
             for j in 0..2 {
                 let d = (a.final_deg[j] - b.final_deg[j]).abs();
-                assert!(d < 1.5, "{} joint {}: {d} deg", a.name, j + 1);
+                assert!(d < 2.0, "{} joint {}: {d} deg", a.name, j + 1);
             }
         }
         // Neither pushes a finger into the object.

@@ -196,7 +196,8 @@ impl Default for SolverParams {
 /// How the fingers are driven (motor torques, gains, squeeze) and how heavy they are.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FingerParams {
-    /// Joint 1's motor target closes this far past its planned angle `[deg]`.
+    /// Joint 1's motor target closes this far past its planned angle `[deg]` (3°, 10° before
+    /// session 46: docs/SIM.md "The closing, adopted").
     pub squeeze_deg: f64,
     /// Joint 2's motor target closes this far past its planned angle `[deg]`.
     pub squeeze2_deg: f64,
@@ -221,8 +222,8 @@ pub struct FingerParams {
 impl Default for FingerParams {
     fn default() -> Self {
         FingerParams {
-            squeeze_deg: 10.0,
-            squeeze2_deg: 10.0,
+            squeeze_deg: 3.0,
+            squeeze2_deg: 3.0,
             torque_limit_nm: 1.0,
             joint1_lock_torque_nm: 10.0,
             motor_stiffness_nm_per_rad: 20.0,
@@ -245,9 +246,9 @@ pub struct ClosingParams {
     pub close_until_stalled: bool,
     /// The fingers start this much more open than planned at each joint `[deg]`.
     pub open_margin_deg: f64,
-    /// How joint 1 closes: `squeeze` (each finger straight to its target, the check before
-    /// issue 33), `together` (a finger that touches the object stops there until every
-    /// finger has touched, or the others have stopped, then all squeeze at once) or `timed`
+    /// How joint 1 closes: `squeeze` (each finger straight to its target, the default before
+    /// session 46), `together` (the default: a finger that touches the object stops there until
+    /// every finger has touched, or the others have stopped, then all squeeze at once) or `timed`
     /// (every finger's target ramps to its planned bend in the same time, then the squeeze).
     pub approach: Approach,
     /// Refine the planned joint angles by the real contact before closing (`sim::refine`,
@@ -259,10 +260,11 @@ pub struct ClosingParams {
     /// scenario that does not use it keeps its batch input hash.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub refine_contacts: bool,
-    /// After joint 2 has closed, joint 1 closes again (its motor, its torque limit) until the
-    /// hand and the object stop, then locks where it stopped (docs/SIM.md "What the closing
-    /// does"): phalanx 1 comes back onto an object that joint 2 seated away from it. Left out of
-    /// the serialised parameters when off.
+    /// After joint 2 has closed, each locked joint 1 whose phalanx 1 does not touch the object
+    /// moves on under its lock until it touches or reaches its squeeze target (`sim::closing`,
+    /// docs/SIM.md "Why the phalanges miss their plan"): phalanx 1 comes back onto an object
+    /// that joint 2 seated away from it. On by default since session 46. Left out of the
+    /// serialised parameters when off.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub reseat: bool,
 }
@@ -273,9 +275,9 @@ impl Default for ClosingParams {
             close_duration_s: 0.5,
             close_until_stalled: true,
             open_margin_deg: 20.0,
-            approach: Approach::Squeeze,
+            approach: Approach::Together,
             refine_contacts: false,
-            reseat: false,
+            reseat: true,
         }
     }
 }
@@ -369,10 +371,10 @@ pub struct InputParams {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Approach {
-    /// Every finger closes straight to its squeeze target.
+    /// Every finger closes straight to its squeeze target (the default before session 46).
     Squeeze,
     /// A finger stops where it touches until every finger has touched (or the hand has
-    /// stopped), then all squeeze together.
+    /// stopped), then all squeeze together (the default).
     Together,
     /// Every finger's joint 1 target moves from its open bend to its planned bend in the same
     /// time (`sim::closing::RAMP_S`), so the fingers arrive together, each at a speed set by
@@ -856,7 +858,7 @@ mod tests {
             "{debug}"
         );
         assert!(
-            debug.contains("balanced_squeeze: true, approach: Squeeze, samples: 1, seed: 0,"),
+            debug.contains("balanced_squeeze: true, approach: Together, samples: 1, seed: 0,"),
             "{debug}"
         );
     }

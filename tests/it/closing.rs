@@ -71,7 +71,7 @@ fn equal_torques_push_the_d40_towards_the_thumb() {
     // With every finger at the full torque limit, finger_1 and finger_3 squeeze twice as hard
     // as the thumb opposite them: the object goes across by about 4 mm and the thumb's
     // phalanx 2 closes through its whole squeeze without meeting it.
-    let mut params = SimParams::default();
+    let mut params = crate::squeeze_closing();
     params.fingers.balanced_squeeze = false;
     let out = d40_backed_off(0.0, &params);
     let c = &out.closing;
@@ -200,7 +200,8 @@ fn a_push_beyond_the_bound_moves_the_search_on() {
     // The chapter 4 object's first candidate holds only after the closing pushed it about 6 mm:
     // the search moves on to the next, which holds where it was planned.
     let path = crate::root().join("scenarios/chapter4.toml");
-    let s = grasp_sim::scenario::Scenario::load(&path).unwrap();
+    let mut s = grasp_sim::scenario::Scenario::load(&path).unwrap();
+    s.sim = crate::squeeze_closing();
     let r = grasp_sim::run(&s, &grasp_sim::RunOptions::default()).unwrap();
     let c = r.sim.closing.as_ref().unwrap();
     assert_eq!(
@@ -216,19 +217,18 @@ fn a_push_beyond_the_bound_moves_the_search_on() {
 
 #[test]
 fn reseated_every_phalanx_of_the_d40_ends_on_its_plan() {
-    // As planned, joint 1 locks where phalanx 1 met the cylinder, then joint 2's squeeze seats
+    // Closed straight with a 10° squeeze and no reseat (the closing before the default
+    // changed), joint 1 locks where phalanx 1 met the cylinder, then joint 2's squeeze seats
     // the object on the palm and phalanx 2, and the outer fingers' phalanx 1 are left just clear
-    // of it (4 of 6 phalanges on the object within 5° of their plan). With `[sim] reseat` (and
-    // a 3° squeeze, the setting studied in docs/SIM.md) the locked joint 1s move on, under their
+    // of it (4 of 6 phalanges on the object within 5° of their plan). With the default (a 3°
+    // squeeze, `reseat`, `approach = "together"`) the locked joint 1s move on, under their
     // lock, until their phalanx touches again: all 6 end on the object within 5°, and the
     // cylinder moves by less than a millimetre.
-    let plain = d40_backed_off(0.0, &SimParams::default()).closing;
+    let plain = d40_backed_off(0.0, &crate::squeeze_closing()).closing;
     assert_eq!(plain.phalanges_on_plan, 4, "{plain:?}");
     assert!(plain.fingers.iter().any(|f| !f.touching[0]), "{plain:?}");
-    let mut params = SimParams::default();
-    params.closing.reseat = true;
-    params.fingers.squeeze_deg = 3.0;
-    params.fingers.squeeze2_deg = 3.0;
+    let params = SimParams::default();
+    assert!(params.closing.reseat && params.fingers.squeeze_deg == 3.0);
     let out = d40_backed_off(0.0, &params);
     let c = &out.closing;
     assert_eq!(out.verdict, Verdict::Hold, "{c:?}");
@@ -242,8 +242,8 @@ fn reseated_every_phalanx_of_the_d40_ends_on_its_plan() {
 
 #[test]
 fn a_bounded_squeeze_keeps_every_joint_within_it_of_its_command() {
-    // The palm 10 mm off the D40, refined by the contact (the test above): with the default 10°
-    // squeeze the phalanx 2s close through all of it as the object is pulled to the palm. With a
+    // The palm 10 mm off the D40, refined by the contact (the test above): with a 10° squeeze
+    // (the closing before the default changed) the phalanx 2s close through all of it as the object is pulled to the palm. With a
     // 3° squeeze no joint can end more than about 3° past its commanded bend (a position motor
     // pulls back beyond its target), so a phalanx more than 5° off its plan is one the object
     // pushed back, not one that closed through its squeeze.
@@ -253,7 +253,7 @@ fn a_bounded_squeeze_keeps_every_joint_within_it_of_its_command() {
             .flat_map(|f| f.error_deg)
             .fold(f64::NEG_INFINITY, f64::max)
     };
-    let mut params = SimParams::default();
+    let mut params = crate::squeeze_closing();
     params.closing.refine_contacts = true;
     let wide = d40_backed_off(10.0, &params).closing;
     assert!(past(&wide) > 9.0, "{wide:?}");

@@ -35,6 +35,18 @@ pub fn grasp_sim() -> std::process::Command {
 }
 
 /// The repository root.
+/// The closing before the default changed in session 46 (docs/SIM.md "The closing,
+/// adopted"): each finger straight at its planned bend plus a 10° squeeze, joint 1 locked where
+/// it stopped, no reseat. Tests of mechanisms measured under it use it.
+pub fn squeeze_closing() -> grasp_sim::scenario::SimParams {
+    let mut params = grasp_sim::scenario::SimParams::default();
+    params.closing.approach = grasp_sim::scenario::Approach::Squeeze;
+    params.closing.reseat = false;
+    params.fingers.squeeze_deg = 10.0;
+    params.fingers.squeeze2_deg = 10.0;
+    params
+}
+
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }

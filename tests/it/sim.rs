@@ -309,8 +309,9 @@ fn cylinder_case<R>(
 #[test]
 fn the_closing_ends_when_the_hand_and_the_object_stop() {
     // With `close_until_stalled` (the default) each closing phase ends once every joint and the
-    // object have stopped; the fixed schedule closes for the whole 0.5 s. On D40 both end in
-    // the same grip: joint angles within a tenth of a degree, and both hold.
+    // object have stopped; the fixed schedule closes for the whole 0.5 s and the reseat for
+    // another 0.25 s. On D40 both end in the same grip: joint angles within 0.2° (0.11° apart
+    // at most), and both hold.
     use grasp_sim::scenario::SimParams;
     let mut fixed = SimParams::default();
     fixed.closing.close_until_stalled = false;
@@ -319,17 +320,17 @@ fn the_closing_ends_when_the_hand_and_the_object_stop() {
         d40_case(fixed, grasp_sim::sim::check),
     );
     let (a, b) = (&stalled.directions[0], &fixed.directions[0]);
-    assert_eq!(b.closed_at_s, 0.5);
-    // Joint 1 stops within 50 ms, joint 2 within about 100 ms of its release, each followed by
-    // the 20 ms the rule waits.
+    assert_eq!(b.closed_at_s, 0.75);
+    // Joint 1 stops within 50 ms, joint 2 within about 100 ms of its release, the reseat within
+    // about 50 ms, each followed by the 20 ms the rule waits.
     assert!(
-        a.closed_at_s > 0.1 && a.closed_at_s < 0.2,
+        a.closed_at_s > 0.1 && a.closed_at_s < 0.3,
         "{}",
         a.closed_at_s
     );
     for (s, f) in a.joint_errors_deg.iter().zip(&b.joint_errors_deg) {
         for j in 0..2 {
-            assert!((s[j] - f[j]).abs() < 0.1, "{s:?} against {f:?}");
+            assert!((s[j] - f[j]).abs() < 0.2, "{s:?} against {f:?}");
         }
     }
     assert_eq!(a.verdict, Verdict::Hold);
@@ -619,16 +620,17 @@ fn penetration_after_closing_is_reported_and_bounded() {
         r.sim
     );
     assert!(depth < 0.5, "{depth} mm");
-    // Soft contacts (150 Hz) let the motors drive the fingers about 4 mm into it (6 mm at
-    // 300 Hz before the balanced squeeze halved finger_1's and finger_3's torque). The object
-    // does not move, but a grasp made by fingers inside the object is not a hold ...
+    // Soft contacts (150 Hz) let the motors drive the fingers about 1.6 mm into it (the 3°
+    // squeeze bounds it: 2 mm at 50 Hz; the 10° squeeze before session 46 went 4 mm in). The
+    // object does not move, but a grasp made by fingers that far inside the object is not a
+    // hold when the bound is 1 mm ...
     let (_d, s) = scenario_with(
         "cylinder_d40.stl",
-        "max_checked = 1\ncontact_stiffness_hz = 150.0",
+        "max_checked = 1\ncontact_stiffness_hz = 150.0\nmax_penetration_mm = 1.0",
     );
     let r = run(&s, &with_sim()).unwrap();
     let dir = &r.sim.directions[0];
-    assert!(dir.closing_penetration_mm > 3.0, "{dir:?}");
+    assert!(dir.closing_penetration_mm > 1.2, "{dir:?}");
     assert!(dir.translation_mm < 1.0, "{dir:?}");
     assert_eq!(
         r.sim.verdict,
@@ -641,16 +643,16 @@ fn penetration_after_closing_is_reported_and_bounded() {
     let sentence = r.result_sentence();
     assert!(
         sentence.contains(&format!(
-            "a finger ended the closing {:.2} mm inside the object, more than max_penetration_mm (2 mm)",
+            "a finger ended the closing {:.2} mm inside the object, more than max_penetration_mm (1 mm)",
             dir.closing_penetration_mm
         )),
         "{sentence}"
     );
     assert!(!sentence.contains("beyond the hold limits"), "{sentence}");
-    // ... unless the bound is raised past the depth.
+    // ... and is one at the default bound, 2 mm, past the depth.
     let (_d, s) = scenario_with(
         "cylinder_d40.stl",
-        "max_checked = 1\ncontact_stiffness_hz = 150.0\nmax_penetration_mm = 10.0",
+        "max_checked = 1\ncontact_stiffness_hz = 150.0",
     );
     let r = run(&s, &with_sim()).unwrap();
     assert_eq!(
@@ -709,7 +711,7 @@ fn friction_use_tells_a_sticking_grip_from_a_sliding_one() {
     // μ 0.02 still holds.)
     use grasp_sim::sim::contacts::friction_use;
     use grasp_sim::sim::scene::build;
-    d40_case(Default::default(), |case| {
+    d40_case(crate::squeeze_closing(), |case| {
         let measured = |friction: f64| {
             let case = grasp_sim::sim::Case { friction, ..*case };
             let mut scene = build(&case);
