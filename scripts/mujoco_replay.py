@@ -124,8 +124,8 @@ def replay(scene_dir, directions=None, trace=False):
     hinge_dofs = [m.jnt_dofadr[m.actuator_trnid[a, 0]] for a in range(2 * n)]
     od = m.jnt_dofadr[m.body_jntadr[obj]]
 
-    def quiet():
-        joint = max(abs(float(d.qvel[i])) for i in hinge_dofs)
+    def quiet(joints=True):
+        joint = max(abs(float(d.qvel[i])) for i in hinge_dofs) if joints else 0.0
         v = float(np.linalg.norm(d.qvel[od:od + 3])) * 1000.0
         w = float(np.linalg.norm(d.qvel[od + 3:od + 6]))
         return joint < stall["joint_rad_s"] and v < stall["object_mm_s"] and w < stall["object_rad_s"]
@@ -169,13 +169,13 @@ def replay(scene_dir, directions=None, trace=False):
     reseat_step = proto.get("reseat_rad_s", 0.0) * dt
     phalanx1 = [m.body(f"{f}_phalanx_1").id for f in proto["fingers"]]
 
-    def phalanx1_touching():
+    def phalanx_touching(bodies):
         out = [False] * n
         for c in d.contact[: d.ncon]:
             b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
             other = b2 if b1 == obj else b1 if b2 == obj else None
             for k in range(n):
-                out[k] = out[k] or other == phalanx1[k]
+                out[k] = out[k] or other == bodies[k]
         return out
 
     def lock_joint1():
@@ -208,7 +208,7 @@ def replay(scene_dir, directions=None, trace=False):
         for _ in range(max_steps):
             moving = False
             if phase == 2:
-                for k, t1 in enumerate(phalanx1_touching()):
+                for k, t1 in enumerate(phalanx_touching(phalanx1)):
                     if not t1 and d.ctrl[2 * k] < target[2 * k]:
                         d.ctrl[2 * k] = min(d.ctrl[2 * k] + reseat_step, target[2 * k])
                         moving = True
@@ -241,7 +241,9 @@ def replay(scene_dir, directions=None, trace=False):
                     quiet_steps = 0
             if stall is None:
                 continue
-            if quiet() and not moving:
+            # The reseat ends on the object's speeds alone (as grasp-sim's: a seated finger's
+            # joint 2 chatters at about the joint threshold).
+            if quiet(joints=phase != 2) and not moving:
                 quiet_steps += 1
                 if quiet_steps * dt >= stall["window_s"]:
                     if waiting:
