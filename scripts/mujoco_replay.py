@@ -9,8 +9,10 @@ hold, and whether it still touches the hand. Protocol (docs/SIM.md), read from p
 fingers start at the `open` keyframe; gravity off; joint 1 closes towards its target (planned
 bend plus squeeze) while joint 2 is held open; when the hand and the object have stopped
 (`close_until_stalled`), or at the latest halfway through the closing time, joint 1 locks where
-it stopped (a TorqueSwitch) and joint 2 closes, again until they stop; then gravity on for the
-hold (its whole length: the replay is the full-length protocol).
+it stopped (a TorqueSwitch) and joint 2 closes, again until they stop; with `reseat` (the
+default since session 46) each locked joint 1 whose phalanx 1 is off the object moves on until it
+touches, until no joint 1 moves and the object has stopped; then gravity on for the hold (its
+whole length: the replay is the full-length protocol).
 `--six`: the six gravity directions of `[sim] gravity = "six"`, each held from one closing.
 Perturbed samples (`[sim] samples`, issue 34) are exported as scenes of their own,
 DIR/<scenario>/samples/<k>/; scripts/compare_engines.py --robust replays them.
@@ -193,6 +195,10 @@ def replay(scene_dir, directions=None, trace=False):
         phases.append(close_steps // 2)
     closed = 0
     for phase, max_steps in enumerate(phases):
+        if phase == 2:
+            # Each joint 1 moves on from where it is now, not from where it was locked (joint 2's
+            # squeeze may have moved it): as grasp-sim's.
+            reseat_at = [float(d.qpos[joint1_qpos[k]]) for k in range(n)]
         if phase == 1:
             if waiting:
                 release()
@@ -209,8 +215,9 @@ def replay(scene_dir, directions=None, trace=False):
             moving = False
             if phase == 2:
                 for k, t1 in enumerate(phalanx_touching(phalanx1)):
-                    if not t1 and d.ctrl[2 * k] < target[2 * k]:
-                        d.ctrl[2 * k] = min(d.ctrl[2 * k] + reseat_step, target[2 * k])
+                    if not t1 and reseat_at[k] < target[2 * k]:
+                        reseat_at[k] = min(reseat_at[k] + reseat_step, target[2 * k])
+                        d.ctrl[2 * k] = reseat_at[k]
                         moving = True
             if ramp is not None and ramp < ramp_steps:
                 ramp += 1

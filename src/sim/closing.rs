@@ -1,6 +1,7 @@
 //! Closing the hand on the object, gravity off (docs/SIM.md, "What the closing does"): joint 1
 //! first, then joint 2, each until the hand and the object stop ([`STALL`]) or for its share of
-//! `close_duration_s`; and what the closing did: the object's shift, the joints' errors against
+//! `close_duration_s`, then with `reseat` the locked joint 1s that are off the object, until
+//! they touch and the object stops (at most another half); and what the closing did: the object's shift, the joints' errors against
 //! the plan, which phalanx touched first, the penetration left. Units: millimetres and degrees in
 //! what it reports, SI inside rapier.
 
@@ -232,7 +233,8 @@ pub const RESEAT_RAD_S: f64 = 0.349_065_850_398_865_9;
 /// touch the object moves on, position-controlled by its lock (its stiffness, its torque), at
 /// [`RESEAT_RAD_S`] until its phalanx touches or it reaches its squeeze target. The phase ends
 /// when no joint moves on any more and the object has stopped ([`STALL`]'s object speeds, for
-/// its window), or after `max_steps`.
+/// its window), or after `max_steps`: a joint 2 whose phase ended at its time cap rather than
+/// stalled may still be moving then.
 fn reseat(scene: &mut Scene, case: &Case, run: &mut Phases, max_steps: usize) {
     let (k, d) = motor_gains(case);
     let lock = Some(case.params.fingers.joint1_lock_torque_nm as f32);

@@ -238,11 +238,12 @@ impl Default for FingerParams {
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct ClosingParams {
     /// Time the fingers get to close before gravity is turned on `[s]`: with
-    /// `close_until_stalled`, the longest they get.
+    /// `close_until_stalled`, the longest they get; `reseat` adds at most another half.
     pub close_duration_s: f64,
     /// Each closing phase (joint 1, then joint 2) ends as soon as the hand and the object have
-    /// stopped (`sim::STALL`), at most at half `close_duration_s`; `false`: each phase takes
-    /// its half of `close_duration_s` (the check before issue 15).
+    /// stopped (`sim::STALL`), at most at half `close_duration_s`, and the reseat once no
+    /// joint 1 moves on and the object has stopped; `false`: each phase takes its half of
+    /// `close_duration_s` (the check before issue 15).
     pub close_until_stalled: bool,
     /// The fingers start this much more open than planned at each joint `[deg]`.
     pub open_margin_deg: f64,

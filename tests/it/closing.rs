@@ -267,8 +267,8 @@ fn a_bounded_squeeze_keeps_every_joint_within_it_of_its_command() {
 fn timed_fingers_arrive_together_when_the_ramp_ends() {
     // `[sim] approach = "timed"`: every joint 1 target moves from its open bend to its planned
     // bend in `RAMP_S` (0.1 s), so on the D40, planned on the object, every phalanx 1 first
-    // touches within a few steps of 0.1 s; driven straight at its target (the default) each
-    // touches within 30 ms.
+    // touches within a few steps of 0.1 s; driven straight at its target until it touches (the
+    // default `together`) each touches within 30 ms.
     let first = |params: &SimParams| -> Vec<f64> {
         d40_backed_off(0.0, params)
             .closing

@@ -34,7 +34,6 @@ pub fn grasp_sim() -> std::process::Command {
     c
 }
 
-/// The repository root.
 /// The closing before the default changed in session 46 (docs/SIM.md "The closing,
 /// adopted"): each finger straight at its planned bend plus a 10° squeeze, joint 1 locked where
 /// it stopped, no reseat. Tests of mechanisms measured under it use it.
@@ -47,6 +46,7 @@ pub fn squeeze_closing() -> grasp_sim::scenario::SimParams {
     params
 }
 
+/// The repository root.
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }

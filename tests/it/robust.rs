@@ -8,8 +8,6 @@ use grasp_sim::scenario::Scenario;
 use grasp_sim::sim::Verdict;
 use grasp_sim::{run, RunOptions};
 
-/// A bundled scenario with absolute asset paths, `sim` added to its `[sim]` table and
-/// `expect` to its `[expect]` table, written to a temporary folder and loaded.
 /// The closing before the default changed (a straight approach with a 10° squeeze, no
 /// reseat): chapter 4's first candidates and the slippery D40 are marginal under it, which the
 /// tests of the samples need. Under the default closing chapter 4's first candidate holds in
@@ -17,6 +15,8 @@ use grasp_sim::{run, RunOptions};
 const SQUEEZE_CLOSING: &str =
     "approach = \"squeeze\"\nreseat = false\nsqueeze_deg = 10\nsqueeze2_deg = 10";
 
+/// A bundled scenario with absolute asset paths, `sim` added to its `[sim]` table and
+/// `expect` to its `[expect]` table, written to a temporary folder and loaded.
 fn variant(name: &str, sim: &str, expect: &str) -> (tempfile::TempDir, Scenario) {
     let root = crate::root();
     let text = std::fs::read_to_string(root.join(format!("scenarios/{name}.toml"))).unwrap();

@@ -44,7 +44,7 @@ fn the_scene_matches_the_plan() {
             );
         }
     }
-    // With the default 10° overshoot the fingers grip and the cylinder is held.
+    // With the default 3° overshoot (and reseat) the fingers grip and the cylinder is held.
     let (_d, s) = scenario_with("cylinder_d40.stl", "");
     let r = run(&s, &with_sim()).unwrap();
     assert_eq!(
@@ -309,7 +309,7 @@ fn cylinder_case<R>(
 #[test]
 fn the_closing_ends_when_the_hand_and_the_object_stop() {
     // With `close_until_stalled` (the default) each closing phase ends once every joint and the
-    // object have stopped; the fixed schedule closes for the whole 0.5 s and the reseat for
+    // object have stopped (the reseat once the object has); the fixed schedule closes for the whole 0.5 s and the reseat for
     // another 0.25 s. On D40 both end in the same grip: joint angles within 0.2° (0.11° apart
     // at most), and both hold.
     use grasp_sim::scenario::SimParams;
