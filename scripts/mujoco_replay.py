@@ -171,13 +171,13 @@ def replay(scene_dir, directions=None, trace=False):
     reseat_step = proto.get("reseat_rad_s", 0.0) * dt
     phalanx1 = [m.body(f"{f}_phalanx_1").id for f in proto["fingers"]]
 
-    def phalanx_touching(bodies):
+    def phalanx1_touching():
         out = [False] * n
         for c in d.contact[: d.ncon]:
             b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
             other = b2 if b1 == obj else b1 if b2 == obj else None
             for k in range(n):
-                out[k] = out[k] or other == bodies[k]
+                out[k] = out[k] or other == phalanx1[k]
         return out
 
     def lock_joint1():
@@ -214,7 +214,7 @@ def replay(scene_dir, directions=None, trace=False):
         for _ in range(max_steps):
             moving = False
             if phase == 2:
-                for k, t1 in enumerate(phalanx_touching(phalanx1)):
+                for k, t1 in enumerate(phalanx1_touching()):
                     if not t1 and reseat_at[k] < target[2 * k]:
                         reseat_at[k] = min(reseat_at[k] + reseat_step, target[2 * k])
                         d.ctrl[2 * k] = reseat_at[k]

@@ -1,9 +1,9 @@
 //! Closing the hand on the object, gravity off (docs/SIM.md, "What the closing does"): joint 1
 //! first, then joint 2, each until the hand and the object stop ([`STALL`]) or for its share of
 //! `close_duration_s`, then with `reseat` the locked joint 1s that are off the object, until
-//! they touch and the object stops (at most another half); and what the closing did: the object's shift, the joints' errors against
-//! the plan, which phalanx touched first, the penetration left. Units: millimetres and degrees in
-//! what it reports, SI inside rapier.
+//! they touch and the object stops (at most another half); and what the closing did: the
+//! object's shift, the joints' errors against the plan, which phalanx touched first, the
+//! penetration left. Units: millimetres and degrees in what it reports, SI inside rapier.
 
 use super::convert;
 use super::outcome::{ClosingOutcome, FingerClosing, FirstTouch, WITHIN_PLAN_DEG};

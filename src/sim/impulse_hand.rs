@@ -155,22 +155,37 @@ mod tests {
 
     #[test]
     fn the_impulse_hand_closes_where_the_multibody_hand_does_on_d40() {
-        // Same bodies, limits and motors: on D40 the fingers stop within 2° of each other (within
-        // a degree under the 10° squeeze before session 46's closing) and both hold (docs/SIM.md, "The impulse-joint hand": elsewhere they part).
-        let [mb, imp] = [HandJoints::Multibody, HandJoints::Impulse]
-            .map(|k| d40(&with_joints(k), crate::sim::protocol::check));
-        assert_eq!(mb.verdict, Verdict::Hold);
-        assert_eq!(imp.verdict, Verdict::Hold);
-        for (a, b) in mb.closing.fingers.iter().zip(&imp.closing.fingers) {
-            for j in 0..2 {
-                let d = (a.final_deg[j] - b.final_deg[j]).abs();
-                assert!(d < 2.0, "{} joint {}: {d} deg", a.name, j + 1);
+        // Same bodies, limits and motors: on D40 the fingers stop within 1.5° of each other
+        // under the 10° squeeze the study used, within 2° under session 46's default closing
+        // (1.74° on finger_1's joint 2), and both hold (docs/SIM.md, "The impulse-joint hand":
+        // elsewhere they part).
+        let squeeze = |kind| {
+            let mut p = with_joints(kind);
+            p.closing.approach = super::super::params::Approach::Squeeze;
+            p.closing.reseat = false;
+            p.fingers.squeeze_deg = 10.0;
+            p.fingers.squeeze2_deg = 10.0;
+            p
+        };
+        for (params, within) in [
+            (squeeze as fn(HandJoints) -> SimParams, 1.5),
+            (with_joints, 2.0),
+        ] {
+            let [mb, imp] = [HandJoints::Multibody, HandJoints::Impulse]
+                .map(|k| d40(&params(k), crate::sim::protocol::check));
+            assert_eq!(mb.verdict, Verdict::Hold);
+            assert_eq!(imp.verdict, Verdict::Hold);
+            for (a, b) in mb.closing.fingers.iter().zip(&imp.closing.fingers) {
+                for j in 0..2 {
+                    let d = (a.final_deg[j] - b.final_deg[j]).abs();
+                    assert!(d < within, "{} joint {}: {d} deg", a.name, j + 1);
+                }
             }
-        }
-        // Neither pushes a finger into the object.
-        for r in [&mb, &imp] {
-            let depth = r.directions[0].closing_penetration_mm;
-            assert!(depth < 0.1, "{depth} mm");
+            // Neither pushes a finger into the object.
+            for r in [&mb, &imp] {
+                let depth = r.directions[0].closing_penetration_mm;
+                assert!(depth < 0.1, "{depth} mm");
+            }
         }
     }
 }

@@ -201,7 +201,11 @@ fn a_push_beyond_the_bound_moves_the_search_on() {
     // the search moves on to the next, which holds where it was planned.
     let path = crate::root().join("scenarios/chapter4.toml");
     let mut s = grasp_sim::scenario::Scenario::load(&path).unwrap();
-    s.sim = crate::squeeze_closing();
+    let old = crate::squeeze_closing();
+    s.sim.closing.approach = old.closing.approach;
+    s.sim.closing.reseat = old.closing.reseat;
+    s.sim.fingers.squeeze_deg = old.fingers.squeeze_deg;
+    s.sim.fingers.squeeze2_deg = old.fingers.squeeze2_deg;
     let r = grasp_sim::run(&s, &grasp_sim::RunOptions::default()).unwrap();
     let c = r.sim.closing.as_ref().unwrap();
     assert_eq!(
