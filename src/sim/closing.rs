@@ -329,15 +329,14 @@ fn gaps_mm(scene: &Scene) -> Vec<[f64; 2]> {
             .iter()
             .filter_map(|&h| {
                 let c = &w.colliders[h];
-                rapier3d::parry::query::distance(
+                super::contacts::separation_m(
                     c.position(),
                     c.shape(),
                     object.position(),
                     object.shape(),
                 )
-                .ok()
             })
-            .map(|d| f64::from(d.distance) * 1000.0)
+            .map(|d| d * 1000.0)
             .fold(f64::INFINITY, f64::min)
             .max(0.0)
     };

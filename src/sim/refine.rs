@@ -28,13 +28,13 @@ pub(super) fn gap_mm(object: &SharedShape, frame: &BodyPose, boxes: &[HandBox]) 
             let c = frame.0 + frame.1 * b.centre;
             let pose = convert::pose(&c, &frame.1);
             let h = convert::vector_m(&b.half_extents);
-            rapier3d::parry::query::distance(
+            super::contacts::separation_m(
                 &pose,
                 &rapier3d::parry::shape::Cuboid::new(h),
                 &Pose::IDENTITY,
                 &*object.0,
             )
-            .map_or(f64::INFINITY, |d| f64::from(d.distance) / convert::M_PER_MM)
+            .map_or(f64::INFINITY, |d| d / convert::M_PER_MM)
         })
         .fold(f64::INFINITY, f64::min)
         .max(0.0)

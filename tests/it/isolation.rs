@@ -45,6 +45,10 @@ fn fault(fault: &str, extra: &[&str], expect: &str) {
 }
 
 #[test]
+#[cfg_attr(
+    not(debug_assertions),
+    ignore = "the fault hook GRASP_SIM_TEST_FAULT is compiled into debug builds only"
+)]
 fn a_panic_costs_one_error_line() {
     fault(
         "panic:cup.stl",
@@ -60,6 +64,10 @@ fn a_panic_costs_one_error_line() {
 
 #[cfg(unix)]
 #[test]
+#[cfg_attr(
+    not(debug_assertions),
+    ignore = "the fault hook GRASP_SIM_TEST_FAULT is compiled into debug builds only"
+)]
 fn a_crash_costs_one_error_line() {
     // An abort (as a failed allocation or a C dependency's assertion ends a process): only a
     // worker process of its own survives it.
