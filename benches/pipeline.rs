@@ -99,6 +99,7 @@ fn bench_plan(c: &mut Criterion) {
                         collect: 1,
                         max_checked: None,
                         check: &never,
+                        recheck: None,
                         domains: None,
                         frame: grasp_sim::mesh::FrameRule::File,
                     },

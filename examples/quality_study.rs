@@ -97,6 +97,7 @@ fn plan_one(path: &Path, collect: usize) -> Result<Planned, String> {
             collect,
             max_checked: None,
             check: &no_check,
+            recheck: None,
             domains: None,
             frame: sc.object.frame,
         },

@@ -1044,6 +1044,7 @@ mod tests {
                     collect: 3,
                     max_checked: None,
                     check: &no_check,
+                    recheck: None,
                     domains: None,
                     frame: sc.object.frame,
                 },

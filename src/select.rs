@@ -129,6 +129,11 @@ pub struct SelectParams<'a> {
     /// Runs the physics check on a grasp about an axis.
     #[allow(clippy::type_complexity)]
     pub check: &'a dyn Fn(&AlignedObject, &Grasp) -> SimOutcome,
+    /// The full check (holds run after a failed closing), for `[sim] closing_decides`: when no
+    /// candidate succeeds, the candidates a failed closing decided are checked again with it,
+    /// in order, until the one the full checks would choose is known. `None`: never.
+    #[allow(clippy::type_complexity)]
+    pub recheck: Option<&'a dyn Fn(&AlignedObject, &Grasp) -> SimOutcome>,
     /// Stage-1 domains kept across calls (a parameter sweep): they depend only on the axis, the
     /// rule set, the AngularStep and the HeightStep. `None`: built afresh.
     pub domains: Option<&'a DomainCache>,
@@ -192,8 +197,50 @@ pub fn select(
             sel.axes.push(plan);
         }
     }
+    if let Some(recheck) = p.recheck {
+        recheck_failed_closings(&mut sel, recheck);
+    }
     sel.chosen = choose(&sel.candidates);
     sel
+}
+
+/// Under `[sim] closing_decides`, a candidate whose closing failed was judged `slip` or `drop`
+/// by where the object was when the closing ended; the full check holds it under gravity
+/// first. That changes nothing while some candidate succeeds ([`choose`] takes the first that
+/// did), but when none does, [`choose`] takes the first that slipped: so, in order, each such
+/// candidate is checked again in full until the first `slip` is known, and [`choose`] then
+/// reports what the full checks would have (the same candidate, the same check).
+#[allow(clippy::type_complexity)]
+fn recheck_failed_closings(
+    sel: &mut Selection,
+    recheck: &dyn Fn(&AlignedObject, &Grasp) -> SimOutcome,
+) {
+    let sampled_hold = sel.candidates.iter().any(|c| {
+        c.check
+            .as_ref()
+            .and_then(|o| o.robust.as_ref())
+            .is_some_and(|r| r.counts.hold > 0)
+    });
+    if has_hold(sel) || sampled_hold {
+        return;
+    }
+    for i in 0..sel.candidates.len() {
+        let Some(check) = &sel.candidates[i].check else {
+            continue;
+        };
+        if check.decided_by_closing() {
+            let c = &sel.candidates[i];
+            let full = recheck(&sel.axes[c.axis_plan].aligned, &c.grasp);
+            sel.candidates[i].check = Some(full);
+        }
+        if sel.candidates[i]
+            .check
+            .as_ref()
+            .is_some_and(|o| o.verdict == Verdict::Slip)
+        {
+            return;
+        }
+    }
 }
 
 /// The graded domain of `rules` on `aligned`. The pinch pass searches the extended rules'

@@ -434,6 +434,16 @@ fn select_grasps(
     let check = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
         check_grasp(scenario, object, a, g)
     };
+    // `[sim] closing_decides`: the full check, for the candidates a failed closing decided
+    // when none succeeds (`select::SelectParams::recheck`).
+    let full = scenario.sim.hold.closing_decides.then(|| {
+        let mut s = scenario.clone();
+        s.sim.hold.closing_decides = false;
+        s
+    });
+    let recheck = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
+        check_grasp(full.as_ref().unwrap_or(scenario), object, a, g)
+    };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
     let checks_candidates =
         !options.no_sim && scenario.sim.input.override_angles.is_none() && options.given.is_none();
@@ -450,6 +460,7 @@ fn select_grasps(
             collect: options.candidates,
             max_checked: checks_candidates.then_some(max_checked.max(1)),
             check: &check,
+            recheck: full.is_some().then_some(&recheck as _),
             domains: None,
             frame: scenario.object.frame,
         },

@@ -91,7 +91,14 @@ pub(super) fn hold(
         hand_was_still: false,
     });
     let mut steps = 0;
-    while steps < hold_steps {
+    // `closing_decides`: a failed closing is decided before any step of the hold.
+    if watch.is_some()
+        && params.hold.closing_decides
+        && (closing.outcome.pushed || closing.penetration_mm > params.hold.max_penetration_mm)
+    {
+        decided = Some(Decision::Closing);
+    }
+    while steps < hold_steps && decided.is_none() {
         scene.world.step();
         steps += 1;
         if tracing && early.is_none() && steps % fine_every == 0 {
@@ -227,6 +234,10 @@ fn direction_outcome(
             in_contact = touches_hand(scene);
             (n as f64 * dt, DecidedBy::Rest)
         }
+        Some(Decision::Closing) => {
+            in_contact = touches_hand(scene);
+            (0.0, DecidedBy::Closing)
+        }
         None => {
             in_contact = touches_hand(scene);
             (hold_steps as f64 * dt, DecidedBy::End)
@@ -281,6 +292,8 @@ enum Decision {
     ClearOfHand(usize, Vector3<f64>),
     /// At rest relative to the palm at this step.
     Rest(usize),
+    /// By the closing, before the hold (`[sim] closing_decides`).
+    Closing,
 }
 
 /// True if every finger's motors hold its phalanges against gravity with four times the torque

@@ -103,6 +103,10 @@ pub enum DecidedBy {
     OutOfReach,
     /// The object flies clear of the resting hand for good: `drop`.
     ClearOfHand,
+    /// The closing failed (pushed the object beyond `max_closing_shift_mm`, or left a finger
+    /// deeper than `max_penetration_mm`) and `[sim] closing_decides` is on: no hold was run;
+    /// `slip` if the object touches the hand after the closing, else `drop`.
+    Closing,
 }
 
 impl DecidedBy {
@@ -113,6 +117,7 @@ impl DecidedBy {
             DecidedBy::Rest => "rest",
             DecidedBy::OutOfReach => "out_of_reach",
             DecidedBy::ClearOfHand => "clear_of_hand",
+            DecidedBy::Closing => "closing",
         }
     }
 
@@ -173,6 +178,15 @@ impl SimOutcome {
             Some(r) => r.passes,
             None => self.verdict == Verdict::Hold,
         }
+    }
+
+    /// Returns true if and only if a failed closing decided the check without a hold (`[sim]
+    /// closing_decides`): its `slip` or `drop` says only whether the object touched the hand
+    /// when the closing ended, not whether it would stay there under gravity.
+    pub fn decided_by_closing(&self) -> bool {
+        self.directions
+            .iter()
+            .any(|d| d.decided_by == DecidedBy::Closing)
     }
 }
 

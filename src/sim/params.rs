@@ -302,6 +302,14 @@ pub struct HoldParams {
     /// until the other fingers caught it, a different grasp from the one planned, and the
     /// verdict is `slip` (`closing_pushed`), so the candidate search moves on as for a slip.
     pub max_closing_shift_mm: f64,
+    /// Under the `fast` protocol, a closing that pushed the object beyond
+    /// `max_closing_shift_mm` or left a finger deeper than `max_penetration_mm` decides the
+    /// check at once (`[sim] closing_decides`, issue 35; off by default): no direction is
+    /// held, each is `slip` if the object touches the hand after the closing, else `drop`,
+    /// `decided_by = "closing"`. Neither can be a `hold`; the holds would only tell `slip` from
+    /// `drop`, which is most of a dataset's time (docs/SIM.md, "Failed closings decided at
+    /// once").
+    pub closing_decides: bool,
 }
 
 impl Default for HoldParams {
@@ -312,6 +320,7 @@ impl Default for HoldParams {
             hold_rotation_deg: 5.0,
             max_penetration_mm: 2.0,
             max_closing_shift_mm: DEFAULT_MAX_CLOSING_SHIFT_MM,
+            closing_decides: false,
         }
     }
 }
@@ -449,6 +458,7 @@ mod flat {
         pub(super) max_checked: usize,
         pub(super) max_penetration_mm: f64,
         pub(super) max_closing_shift_mm: f64,
+        pub(super) closing_decides: bool,
         pub(super) balanced_squeeze: bool,
         pub(super) approach: Approach,
         pub(super) samples: usize,
@@ -507,6 +517,7 @@ mod flat {
                     hold_rotation_deg: s.hold_rotation_deg,
                     max_penetration_mm: s.max_penetration_mm,
                     max_closing_shift_mm: s.max_closing_shift_mm,
+                    closing_decides: s.closing_decides,
                 },
                 early: super::EarlyParams {
                     rest_window_s: s.rest_window_s,
@@ -571,6 +582,7 @@ mod flat {
                 max_checked: s.selection.max_checked,
                 max_penetration_mm: s.hold.max_penetration_mm,
                 max_closing_shift_mm: s.hold.max_closing_shift_mm,
+                closing_decides: s.hold.closing_decides,
                 balanced_squeeze: s.fingers.balanced_squeeze,
                 approach: s.closing.approach,
                 samples: s.robust.samples,

@@ -689,6 +689,8 @@ fn run_planned(
             collect: candidates,
             max_checked: Some(p.scenario.sim.selection.max_checked.max(1)),
             check: &check,
+            // Tune scores the held objects; a failed closing's own verdict is kept.
+            recheck: None,
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,
         },

@@ -122,6 +122,80 @@ fn a_palm_backed_off_10_mm_is_reported_and_bounded() {
 }
 
 #[test]
+fn with_closing_decides_a_failed_closing_is_judged_without_a_hold() {
+    // The D40 with the palm 10 mm off: its closing pushes the object past the bound, so no
+    // direction can hold. By default every direction is still held under gravity, to tell
+    // `slip` from `drop`; with `closing_decides` the six are decided at the closing's end, no
+    // step of hold taken, `slip` as the object is in the hand. The same grasp planned flush is
+    // not a failed closing, and the setting changes nothing in its check.
+    let mut six = SimParams {
+        gravity: grasp_sim::scenario::GravityMode::Six,
+        ..SimParams::default()
+    };
+    let held = d40_backed_off(10.0, &six);
+    let closing_steps = (held.directions[0].closed_at_s / six.solver.timestep_s).round() as usize;
+    assert!(held.closing.pushed);
+    assert!(held.steps > closing_steps + 6 * 10, "{} steps", held.steps);
+    six.hold.closing_decides = true;
+    let decided = d40_backed_off(10.0, &six);
+    assert_eq!(decided.closing, held.closing);
+    assert_eq!(decided.steps, closing_steps);
+    assert_eq!(decided.directions.len(), 6);
+    for d in &decided.directions {
+        assert_eq!(d.decided_by, sim::DecidedBy::Closing);
+        assert_eq!((d.decided_at_s, d.translation_mm), (0.0, 0.0));
+        assert!(d.in_contact);
+        assert_eq!(d.verdict, Verdict::Slip);
+    }
+    assert_eq!(decided.verdict, Verdict::Slip);
+    let flush = d40_backed_off(0.0, &six);
+    six.hold.closing_decides = false;
+    let flush_default = d40_backed_off(0.0, &six);
+    assert_eq!(flush.verdict, Verdict::Hold);
+    assert_eq!(
+        (flush.steps, &flush.directions),
+        (flush_default.steps, &flush_default.directions)
+    );
+}
+
+#[test]
+fn with_closing_decides_the_grasp_reported_is_checked_in_full() {
+    // The weak-motor chapter 4 object's one candidate is pushed past the bound by its closing
+    // and nothing holds: with `closing_decides` its check is decided at the closing, then,
+    // being the one reported, checked again in full, so the run reports what it does by
+    // default, the hold under gravity included (a `slip` decided at rest).
+    let dir = tempfile::tempdir().unwrap();
+    let text =
+        std::fs::read_to_string(crate::root().join("scenarios/sim_chapter4_weak_motors.toml"))
+            .unwrap()
+            .replace("\"../", &format!("\"{}/", crate::root().display()));
+    let sim = |decides: bool| -> serde_json::Value {
+        let path = dir.path().join(format!("c4_{decides}.toml"));
+        let t = text.replace("[sim]\n", &format!("[sim]\nclosing_decides = {decides}\n"));
+        std::fs::write(&path, t).unwrap();
+        let out = crate::grasp_sim()
+            .args(["--json"])
+            .arg(&path)
+            .output()
+            .unwrap();
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v["sim"].as_object_mut().unwrap().remove("wall_ms");
+        v["sim"].clone()
+    };
+    let (full, decided) = (sim(false), sim(true));
+    assert_eq!(full["closing"]["pushed"], true, "{full}");
+    assert_eq!(full["verdict"], "slip");
+    assert_eq!(full["directions"][0]["decided_by"], "rest");
+    assert_eq!(decided, full);
+}
+
+#[test]
 fn refined_by_the_contact_a_backed_off_palm_is_commanded_the_touching_bends() {
     // The same palm 10 mm off, refined by the contact (`[sim] refine_contacts = true`): each
     // joint is commanded the bend at which its phalanx meets the cylinder from there, θ1 76.07°
