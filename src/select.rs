@@ -13,6 +13,9 @@
 //! (`--candidates N` collects N). With it, candidates are checked one by one until one holds or
 //! `max_checked` have been checked; the first that holds is the answer (else the first that
 //! slipped, else the first checked), and every candidate checked is reported with its verdict.
+//! Under `[sim] closing_decides` a candidate whose closing failed is judged without a hold,
+//! and checked again in full where the choice or the report needs it
+//! ([`SelectParams::recheck`]).
 
 use crate::hand::Hand;
 use crate::mesh::{align_with_rule, AlignedObject, FrameRule, GraspAxis, MassProperties, Mesh};
@@ -201,15 +204,26 @@ pub fn select(
         recheck_failed_closings(&mut sel, recheck);
     }
     sel.chosen = choose(&sel.candidates);
+    // Under `choose = "robust"` a candidate whose own closing failed can still be chosen by its
+    // samples: the check reported is a full one.
+    if let (Some(recheck), Some(i)) = (p.recheck, sel.chosen) {
+        let c = &sel.candidates[i];
+        if c.check.as_ref().is_some_and(SimOutcome::decided_by_closing) {
+            let full = recheck(&sel.axes[c.axis_plan].aligned, &c.grasp);
+            sel.candidates[i].check = Some(full);
+        }
+    }
     sel
 }
 
 /// Under `[sim] closing_decides`, a candidate whose closing failed was judged `slip` or `drop`
 /// by where the object was when the closing ended; the full check holds it under gravity
 /// first. That changes nothing while some candidate succeeds ([`choose`] takes the first that
-/// did), but when none does, [`choose`] takes the first that slipped: so, in order, each such
-/// candidate is checked again in full until the first `slip` is known, and [`choose`] then
-/// reports what the full checks would have (the same candidate, the same check).
+/// did), but when none does, [`choose`] takes the first that held (under `choose = "robust"`
+/// a nominal hold can fail its samples), else the first that slipped: so, in order, each such
+/// candidate is checked again in full until the first `hold` or `slip` is known, and
+/// [`choose`] then reports what the full checks would have (the same candidate, the same
+/// check).
 #[allow(clippy::type_complexity)]
 fn recheck_failed_closings(
     sel: &mut Selection,
@@ -236,7 +250,7 @@ fn recheck_failed_closings(
         if sel.candidates[i]
             .check
             .as_ref()
-            .is_some_and(|o| o.verdict == Verdict::Slip)
+            .is_some_and(|o| matches!(o.verdict, Verdict::Hold | Verdict::Slip))
         {
             return;
         }

@@ -423,6 +423,13 @@ pub fn check_grasp(
     sim::check_candidate(&object.case(scenario, &pose, &shape))
 }
 
+/// `scenario` with `[sim] closing_decides` off: every check in full.
+fn without_closing_decides(scenario: &Scenario) -> Scenario {
+    let mut s = scenario.clone();
+    s.sim.hold.closing_decides = false;
+    s
+}
+
 /// Plans across axes and rule sets; with the physics check on the planner's grasps, checks
 /// candidates until one holds (at most `max_checked`).
 fn select_grasps(
@@ -436,11 +443,11 @@ fn select_grasps(
     };
     // `[sim] closing_decides`: the full check, for the candidates a failed closing decided
     // when none succeeds (`select::SelectParams::recheck`).
-    let full = scenario.sim.hold.closing_decides.then(|| {
-        let mut s = scenario.clone();
-        s.sim.hold.closing_decides = false;
-        s
-    });
+    let full = scenario
+        .sim
+        .hold
+        .closing_decides
+        .then(|| without_closing_decides(scenario));
     let recheck = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
         check_grasp(full.as_ref().unwrap_or(scenario), object, a, g)
     };
@@ -530,6 +537,15 @@ fn run_sim(
     aligned: &mesh::AlignedObject,
     posed: &Posed,
 ) -> Simulated {
+    // `[sim] closing_decides` acts in the candidate search only: the check reported is a full
+    // one (a given grasp, `override_angles`, the replayed sample, the samples).
+    let full;
+    let scenario = if scenario.sim.hold.closing_decides {
+        full = without_closing_decides(scenario);
+        &full
+    } else {
+        scenario
+    };
     // With --no-sim the check's reason is `--no-sim`, unless an MJCF export asked for the pose
     // and there is none: then the reason is why not.
     let (pose, source, done) = match posed {

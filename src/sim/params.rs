@@ -308,7 +308,8 @@ pub struct HoldParams {
     /// held, each is `slip` if the object touches the hand after the closing, else `drop`,
     /// `decided_by = "closing"`. Neither can be a `hold`; the holds would only tell `slip` from
     /// `drop`, which is most of a dataset's time (docs/SIM.md, "Failed closings decided at
-    /// once").
+    /// once"). The pipeline uses it for the candidate search's checks only; the check it
+    /// reports, the samples and `tune` run in full.
     pub closing_decides: bool,
 }
 

@@ -110,6 +110,8 @@ impl Perturbed {
         let moved = com_mm + r_inv * (origin.coords - com_mm - t);
         let mut params = case.params.clone();
         params.fingers.torque_limit_nm *= p.torque_scale;
+        // A sample is checked in full: its verdict is reported (`verdicts`, `first_failure`).
+        params.hold.closing_decides = false;
         Perturbed {
             pose: SimHand {
                 origin_mm: moved.into(),
@@ -407,6 +409,39 @@ mod tests {
         let [lo16, hi16] = wilson(16, 16);
         assert!(lo0 == 0.0 && (hi0 - (1.0 - lo16)).abs() < 1e-12 && hi16 == 1.0);
         assert_eq!(wilson(0, 0), [0.0, 1.0]);
+    }
+
+    #[test]
+    fn a_sample_is_checked_in_full_whatever_closing_decides_says() {
+        // A sample's verdict is reported (`verdicts`, `first_failure`): a failed closing is
+        // held under gravity there even when the candidate search decides it at once.
+        let hand = crate::hand::thesis_for_tests();
+        let mesh = crate::objects::cylinder(40.0, 124.0);
+        let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
+        let object = super::super::ObjectShape::from_mesh(&mesh, volume);
+        let mut params = SimParams::default();
+        params.hold.closing_decides = true;
+        let pose = SimHand {
+            origin_mm: nalgebra::Point3::new(-20.0, 0.0, 62.0),
+            axes: [-Vector3::x(), -Vector3::y(), Vector3::z()],
+            theta_deg: vec![[72.11, 91.81]; 3],
+        };
+        let case = Case {
+            hand: &hand,
+            pose: &pose,
+            object: &object,
+            mass_kg: 0.08,
+            friction: 0.3,
+            params: &params,
+        };
+        let p = Perturbation::draw(&params.robust, 0);
+        let perturbed = Perturbed::of(&case, &p);
+        let sample = perturbed.case(&case);
+        assert!(!sample.params.hold.closing_decides);
+        let mut expected = params.clone();
+        expected.hold.closing_decides = false;
+        expected.fingers.torque_limit_nm *= p.torque_scale;
+        assert_eq!(*sample.params, expected);
     }
 
     #[test]

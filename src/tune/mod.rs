@@ -433,8 +433,11 @@ pub fn tune_with_progress(
     let mut first_error = None;
     // A bad input is left out (and reported), as in a batch: the others are still tuned on.
     for item in items {
-        let loaded = scenario_for(item, template).and_then(|scenario| {
+        let loaded = scenario_for(item, template).and_then(|mut scenario| {
             let object = PreparedObject::load(&scenario.object, &mut StageTimings::default())?;
+            // Every check of a sweep in full: which candidate an object with no hold reports,
+            // and so what its samples measure, depends on `slip` against `drop`.
+            scenario.sim.hold.closing_decides = false;
             Ok(Prepared { scenario, object })
         });
         match loaded {
@@ -689,7 +692,6 @@ fn run_planned(
             collect: candidates,
             max_checked: Some(p.scenario.sim.selection.max_checked.max(1)),
             check: &check,
-            // Tune scores the held objects; a failed closing's own verdict is kept.
             recheck: None,
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,

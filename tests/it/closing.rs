@@ -163,16 +163,16 @@ fn with_closing_decides_the_grasp_reported_is_checked_in_full() {
     // The weak-motor chapter 4 object's one candidate is pushed past the bound by its closing
     // and nothing holds: with `closing_decides` its check is decided at the closing, then,
     // being the one reported, checked again in full, so the run reports what it does by
-    // default, the hold under gravity included (a `slip` decided at rest).
+    // default, the hold under gravity included (a `slip` decided at rest). With samples
+    // chosen on (`choose = "robust"`), each sample is checked in full too.
     let dir = tempfile::tempdir().unwrap();
     let text =
         std::fs::read_to_string(crate::root().join("scenarios/sim_chapter4_weak_motors.toml"))
             .unwrap()
             .replace("\"../", &format!("\"{}/", crate::root().display()));
-    let sim = |decides: bool| -> serde_json::Value {
-        let path = dir.path().join(format!("c4_{decides}.toml"));
-        let t = text.replace("[sim]\n", &format!("[sim]\nclosing_decides = {decides}\n"));
-        std::fs::write(&path, t).unwrap();
+    let sim = |keys: &str| -> serde_json::Value {
+        let path = dir.path().join("c4.toml");
+        std::fs::write(&path, text.replace("[sim]\n", &format!("[sim]\n{keys}\n"))).unwrap();
         let out = crate::grasp_sim()
             .args(["--json"])
             .arg(&path)
@@ -185,14 +185,22 @@ fn with_closing_decides_the_grasp_reported_is_checked_in_full() {
             String::from_utf8_lossy(&out.stderr)
         );
         let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-        v["sim"].as_object_mut().unwrap().remove("wall_ms");
+        let sim = v["sim"].as_object_mut().unwrap();
+        sim.remove("wall_ms");
+        if let Some(r) = sim.get_mut("robust").and_then(|r| r.as_object_mut()) {
+            r.remove("wall_ms");
+        }
         v["sim"].clone()
     };
-    let (full, decided) = (sim(false), sim(true));
+    let full = sim("closing_decides = false");
     assert_eq!(full["closing"]["pushed"], true, "{full}");
     assert_eq!(full["verdict"], "slip");
     assert_eq!(full["directions"][0]["decided_by"], "rest");
-    assert_eq!(decided, full);
+    assert_eq!(sim("closing_decides = true"), full);
+    let robust = "samples = 3\nchoose = \"robust\"";
+    let full = sim(&format!("{robust}\nclosing_decides = false"));
+    assert_eq!(full["robust"]["samples"], 3, "{full}");
+    assert_eq!(sim(&format!("{robust}\nclosing_decides = true")), full);
 }
 
 #[test]
