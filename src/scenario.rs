@@ -93,7 +93,8 @@ pub struct ObjectSpec {
     pub mass: MassSpec,
     /// Coulomb friction coefficient between hand and object (thesis: 0.3).
     pub friction: f64,
-    /// How the object's own frame is chosen ([`FrameRule`](crate::mesh::FrameRule); `[object] frame`).
+    /// How the object's own frame is chosen ([`FrameRule`](crate::mesh::FrameRule); `[object]
+    /// frame`).
     pub frame: crate::mesh::FrameRule,
 }
 

@@ -1,9 +1,9 @@
 //! Running many objects: input expansion, templates, sharding, parallel runs in a stable order.
 //!
-//! An input is a scenario file, a mesh file (STL, OBJ or PLY), or a folder (its `*.toml`
-//! scenarios and meshes, not recursing, sorted by path). A mesh is run with a template scenario: by default the
-//! thesis hand (built into the binary), millimetres, 500 kg/m³, μ = 0.3, the thesis's planner and
-//! physics defaults. Results come back in input order whatever the number of threads; a shard
+//! An input is a scenario file, a mesh file (STL, OBJ or PLY), or a folder (its `*.toml` scenarios
+//! and meshes, not recursing, sorted by path). A mesh is run with a template scenario: by default
+//! the thesis hand (built into the binary), millimetres, 500 kg/m³, μ = 0.3, the thesis's planner
+//! and physics defaults. Results come back in input order whatever the number of threads; a shard
 //! `K/N` is the K-th of N contiguous blocks, so the shards' outputs concatenate to the whole.
 //!
 //! Each object's result is a [`Record`]: one JSON line that also names its input and the hash

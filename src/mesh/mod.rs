@@ -255,7 +255,8 @@ pub struct Topology {
 }
 
 impl Topology {
-    /// Returns true if and only if every edge is shared by exactly two triangles wound consistently.
+    /// Returns true if and only if every edge is shared by exactly two triangles wound
+    /// consistently.
     pub fn is_closed_manifold(&self) -> bool {
         self.boundary_edges == 0 && self.non_manifold_edges == 0 && self.misoriented_edges == 0
     }

@@ -204,9 +204,9 @@ pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
     cut(mesh, plane, 0..mesh.triangles.len(), |i| dist[i as usize])
 }
 
-/// The contours `plane` cuts from `mesh` as they come (chained, but not joined, united nor
-/// bridged: open chains stay open, overlapping shells overlap), without an index: for a domain whose slices only need to
-/// show that nothing is graspable ([`crate::plan::domain::cannot_grade`]).
+/// The contours `plane` cuts from `mesh` as they come (chained, but not joined, united nor bridged:
+/// open chains stay open, overlapping shells overlap), without an index: for a domain whose slices
+/// only need to show that nothing is graspable ([`crate::plan::domain::cannot_grade`]).
 pub fn slice_unrepaired(mesh: &Mesh, plane: &Plane) -> Slice {
     let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
     let d = |i: u32| dist[i as usize];

@@ -3,11 +3,11 @@
 //! and by the joints from the root link at their zero position, becomes one mesh.
 //!
 //! Per link, the `<visual>` geometry is read (the object's surface as drawn); a link whose visual
-//! geometry grasp-sim cannot read (a `.dae` mesh) or that has none gives its `<collision>`
-//! geometry instead, with a note. The links' `<inertial>` masses, summed, are the object's mass
-//! unless a scenario gives `mass_kg` or `density_kg_m3`. Meshes are STL, OBJ or PLY, with their `scale`; `box`,
-//! `cylinder` and `sphere` are made into meshes. Lengths are metres, as URDF fixes them, so a
-//! scenario's `units` does not apply. `package://PKG/PATH` is looked for as `PKG/PATH` and `PATH`
+//! geometry grasp-sim cannot read (a `.dae` mesh) or that has none gives its `<collision>` geometry
+//! instead, with a note. The links' `<inertial>` masses, summed, are the object's mass unless a
+//! scenario gives `mass_kg` or `density_kg_m3`. Meshes are STL, OBJ or PLY, with their `scale`;
+//! `box`, `cylinder` and `sphere` are made into meshes. Lengths are metres, as URDF fixes them, so
+//! a scenario's `units` does not apply. `package://PKG/PATH` is looked for as `PKG/PATH` and `PATH`
 //! beside the URDF and in the folders above it; `file://` names a path.
 //!
 //! The URDF specification: <http://wiki.ros.org/urdf/XML> (link, joint, origin `xyz`/`rpy` with

@@ -24,11 +24,11 @@
 //! | Cat_9 | in | out | as Cat_6, and pushed up from below | 0.65 |
 //! | Cat_8 | in | in | a protrusion | 0.60 |
 //!
-//! The grades keep the text's order (Cat_4, Cat_2, Cat_7, Cat_1, Cat_5, Cat_3, Cat_6, Cat_9,
-//! Cat_8 from best to worst) on a scale where the best is 1 (the thesis normalises grades; its chapter 4 shows them
-//! ×20 with a best of 19.99). The ninth combination (straight above, in below) is not among the
-//! text's categories; it is graded as a demoted Cat_1 (0.80): weight moves the object down past
-//! the finger, so thinning below the finger matters less than above it.
+//! The grades keep the text's order (Cat_4, Cat_2, Cat_7, Cat_1, Cat_5, Cat_3, Cat_6, Cat_9, Cat_8
+//! from best to worst) on a scale where the best is 1 (the thesis normalises grades; its chapter 4
+//! shows them ×20 with a best of 19.99). The ninth combination (straight above, in below) is not
+//! among the text's categories; it is graded as a demoted Cat_1 (0.80): weight moves the object
+//! down past the finger, so thinning below the finger matters less than above it.
 //!
 //! Choices where the thesis is silent (all parameters in [`CurvatureParams`]):
 //! - Segment-length rules: the walk on each side stops once it is more than the reach (below)

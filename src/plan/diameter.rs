@@ -1,11 +1,11 @@
 //! Stage 2: grading by Effective Diameter (thesis 3.4.3.2, Fig. 3.16).
 //!
-//! The thickness of a vertical slice at an indexed elevation is the distance between its
-//! outermost left and right crossings (found once, by stage 1: [`Domain::crossings`]); the
-//! Effective Diameter is its mean over the slices. An elevation whose Effective Diameter lies outside the graspable range is ungraspable. The others
-//! are graded by the smallest graspable Effective Diameter among them divided by their own, so
-//! the thinnest graspable elevation grades 1 and thicker ones less ("normalised by their least
-//! graspable value"; smaller is better for an enveloping grasp).
+//! The thickness of a vertical slice at an indexed elevation is the distance between its outermost
+//! left and right crossings (found once, by stage 1: [`Domain::crossings`]); the Effective Diameter
+//! is its mean over the slices. An elevation whose Effective Diameter lies outside the graspable
+//! range is ungraspable. The others are graded by the smallest graspable Effective Diameter among
+//! them divided by their own, so the thinnest graspable elevation grades 1 and thicker ones less
+//! ("normalised by their least graspable value"; smaller is better for an enveloping grasp).
 
 use super::{Domain, Grade};
 

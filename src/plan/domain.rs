@@ -167,11 +167,11 @@ impl Domain {
     }
 }
 
-/// Returns true if no palm position on `mesh` can have a finger that must sit on a graded
-/// elevation (every rule set's inner finger) on one, whatever its vertical slices at
-/// `angles_deg` turn out to be; false when that is not known without them (issue 30: a cheap necessary
-/// condition, before the slices are cut, united and bridged, which on a degenerate mesh can
-/// cost a minute in i_overlay). Two bounds, from the vertices alone:
+/// Returns true if no palm position on `mesh` can have a finger that must sit on a graded elevation
+/// (every rule set's inner finger) on one, whatever its vertical slices at `angles_deg` turn out to
+/// be; false when that is not known without them (issue 30: a cheap necessary condition, before the
+/// slices are cut, united and bridged, which on a degenerate mesh can cost a minute in i_overlay).
+/// Two bounds, from the vertices alone:
 /// - the object is shorter than twice the finger offset: the thesis's Effective Elevation is
 ///   empty, and under the extended rules so is the range the inner fingers must lie in
 ///   (a slice spans at most the vertices' elevations);

@@ -393,13 +393,13 @@ pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, Finge
 /// Joint 1's step while a finger whose phalanx 1 meets nothing closes `[deg]`.
 const DISTAL_STEP_DEG: f64 = 0.25;
 
-/// An ALS whose phalanx 1 meets nothing (the extended rules'
-/// [`Relaxation::DistalContactOnly`]): joint 1 closes from its most open angle in
-/// `DISTAL_STEP_DEG` steps and, at each, phalanx 2 closes from straight; the ALS stops at the
-/// first joint-1 angle at which phalanx 2 meets the object within joint 2's range (a contact
-/// beyond the range is passed over, closing on). Phalanx 1's body meeting the object first, or
-/// phalanx 2's body or tip inside it at its contact, is a rejection. This is a thin object pinched by the fingertips with the palm on its narrow face
-/// (a book held by its spine): phalanx 1 reaches past it and only phalanx 2 can come back to it.
+/// An ALS whose phalanx 1 meets nothing (the extended rules' [`Relaxation::DistalContactOnly`]):
+/// joint 1 closes from its most open angle in `DISTAL_STEP_DEG` steps and, at each, phalanx 2
+/// closes from straight; the ALS stops at the first joint-1 angle at which phalanx 2 meets the
+/// object within joint 2's range (a contact beyond the range is passed over, closing on). Phalanx
+/// 1's body meeting the object first, or phalanx 2's body or tip inside it at its contact, is a
+/// rejection. This is a thin object pinched by the fingertips with the palm on its narrow face (a
+/// book held by its spine): phalanx 1 reaches past it and only phalanx 2 can come back to it.
 pub fn place_als_distal(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, FingerRejection> {
     let plane = FingerPlane::new(s, hand, mirror)?;
     let o = hand.fingers.offset_mm;
@@ -535,14 +535,14 @@ mod tests {
 
     #[test]
     fn a_thin_box_is_pinched_by_phalanx_2_where_its_reach_first_meets_the_face() {
-        // The palm on the 30 mm face of a 100 x 30 mm box (x in [-100, 0], |y| <= 15 in the
-        // palm's frame). The thesis's phalanx 1 meets a vertex of the broad face first, with its
-        // body already through the box's corner: rejected. Closing joint 1 from 135°, joint 2 sits at y = 36.7 - 61 cos θ1, and the
-        // end of phalanx 2's contact line reaches hypot(20, 7) = 21.19 mm from it: the face
-        // y = 15 comes within reach at cos θ1 = (36.7 - 15 - 21.19) / 61, θ1 = 89.52°, so the
-        // first 0.25° step there is 89.5°: joint 2 at (−55.20, 36.17), and the end of phalanx
-        // 2's contact line meets the face 0.96 mm further out, at x = −56.16, with phalanx 2
-        // bent 67.6° from phalanx 1 (θ2 = 112.4°).
+        // The palm on the 30 mm face of a 100 x 30 mm box (x in [-100, 0], |y| <= 15 in the palm's
+        // frame). The thesis's phalanx 1 meets a vertex of the broad face first, with its body
+        // already through the box's corner: rejected. Closing joint 1 from 135°, joint 2 sits at y
+        // = 36.7 - 61 cos θ1, and the end of phalanx 2's contact line reaches hypot(20, 7) = 21.19
+        // mm from it: the face y = 15 comes within reach at cos θ1 = (36.7 - 15 - 21.19) / 61, θ1 =
+        // 89.52°, so the first 0.25° step there is 89.5°: joint 2 at (−55.20, 36.17), and the end
+        // of phalanx 2's contact line meets the face 0.96 mm further out, at x = −56.16, with
+        // phalanx 2 bent 67.6° from phalanx 1 (θ2 = 112.4°).
         let hand = thesis_hand();
         let prism = crate::objects::prism(100.0, 30.0, 124.0);
         let s = crate::slice::slice(

@@ -19,9 +19,9 @@
 //!   `Q`, and `W` has finitely many; [`EPA_MAX_POINTS`] bounds it all the same.
 //! - **Volume** by rays from the sum's centre, each an exact small linear programme, integrated
 //!   over a fixed set of directions ([`super::rays`]), with its standard error. The whole hull
-//!   ([`minkowski_sum`]: the incremental sum pruned to its hull's vertices by [`super::hull`]) is exact but
-//!   feasible only up to 3 contacts at 8 cone edges; it is the reference the rays are tested
-//!   against.
+//!   ([`minkowski_sum`]: the incremental sum pruned to its hull's vertices by [`super::hull`]) is
+//!   exact but feasible only up to 3 contacts at 8 cone edges; it is the reference the rays are
+//!   tested against.
 //!
 //! Contacts whose edge wrenches agree (rapier can report one contact twice) are merged first:
 //! `P + P = 2P` exactly for a convex `P`.

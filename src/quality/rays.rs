@@ -1,13 +1,13 @@
 //! The L∞ wrench space's volume for any number of contacts, by rays from an interior point.
 //!
 //! `W = Σᵢ Pᵢ`, `Pᵢ = conv({0} ∪ edgesᵢ)`, has too many vertices to hull beyond three contacts
-//! ([`super::linf`]), but one ray through it is a small linear programme: the largest `t` with
-//! `c + t·u = Σᵢⱼ αᵢⱼ eᵢⱼ`, `αᵢⱼ ≥ 0`, `Σⱼ αᵢⱼ ≤ 1` for every contact `i` (6 + contacts rows).
-//! It is solved exactly (to round-off) by the two-phase simplex method, so every ray's exit
-//! point lies on `W`'s boundary; the first phase (a basis feasible at the centre) does not
-//! depend on the ray and is solved once per wrench space ([`RayCaster`]). The volume is then the integral of the radial function over the sphere,
-//! `vol W = (π³/6) · E[ρ(g)⁶]` for `g` uniform on the unit sphere in 6-D, estimated from a
-//! fixed set of directions:
+//! ([`super::linf`]), but one ray through it is a small linear programme: the largest `t` with `c +
+//! t·u = Σᵢⱼ αᵢⱼ eᵢⱼ`, `αᵢⱼ ≥ 0`, `Σⱼ αᵢⱼ ≤ 1` for every contact `i` (6 + contacts rows). It is
+//! solved exactly (to round-off) by the two-phase simplex method, so every ray's exit point lies on
+//! `W`'s boundary; the first phase (a basis feasible at the centre) does not depend on the ray and
+//! is solved once per wrench space ([`RayCaster`]). The volume is then the integral of the radial
+//! function over the sphere, `vol W = (π³/6) · E[ρ(g)⁶]` for `g` uniform on the unit sphere in 6-D,
+//! estimated from a fixed set of directions:
 //!
 //! - **From the centre** `c = Σᵢ centroid(vertices of Pᵢ)`, in `W`'s relative interior whether or
 //!   not the origin is (a grasp that is not force closure has a volume too).

@@ -281,9 +281,9 @@ impl ObjectShape {
 /// fraction is rebuilt from its planes ([`coarsened_hull`]).
 const MISWEIGHED_FRACTION: f64 = 1e-3;
 
-/// The mass distribution of a convex hull (`vertices` in metres, aligned frame, and
-/// `triangles`, as `try_convex_hull` gives them), from its triangles in double precision ([`crate::mesh::mass_properties`]); `None` where there is no
-/// hull with a volume.
+/// The mass distribution of a convex hull (`vertices` in metres, aligned frame, and `triangles`, as
+/// `try_convex_hull` gives them), from its triangles in double precision
+/// ([`crate::mesh::mass_properties`]); `None` where there is no hull with a volume.
 fn hull_mass(vertices: &[Vector], triangles: &[[u32; 3]]) -> Option<MeshMass> {
     let mut triangles = triangles.to_vec();
     let mm = |v: &Vector| {
@@ -313,11 +313,12 @@ fn hull_mass(vertices: &[Vector], triangles: &[[u32; 3]]) -> Option<MeshMass> {
 const MERGED_FACE_TOLERANCE_M: f32 = 5e-5;
 
 /// How far the faces of `poly` leave their planes `[m]`. parry builds a hull's faces by merging
-/// neighbouring triangles whose unit normals differ by less than √ε of f32 in `1 − n₁·n₂`
-/// (about 1.5°; `ConvexPolyhedron::from_convex_mesh`), with the normal of one of them: right for a plane split into triangles, wrong for a finely tessellated curved
-/// surface (a cylinder of more than about 240 segments, whose faces meet at under 1.5°), which
-/// it chains into one non-planar face. The contacts against that face let a finger sink in:
-/// 8.4 mm into a 512-segment cylinder of 60 mm, against 0.01 mm at 144 segments.
+/// neighbouring triangles whose unit normals differ by less than √ε of f32 in `1 − n₁·n₂` (about
+/// 1.5°; `ConvexPolyhedron::from_convex_mesh`), with the normal of one of them: right for a plane
+/// split into triangles, wrong for a finely tessellated curved surface (a cylinder of more than
+/// about 240 segments, whose faces meet at under 1.5°), which it chains into one non-planar face.
+/// The contacts against that face let a finger sink in: 8.4 mm into a 512-segment cylinder of 60
+/// mm, against 0.01 mm at 144 segments.
 fn bent_face_m(poly: &rapier3d::parry::shape::ConvexPolyhedron) -> f32 {
     let (points, ids) = (poly.points(), poly.vertices_adj_to_face());
     poly.faces()

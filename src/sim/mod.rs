@@ -12,14 +12,14 @@
 //! reported), [`contacts`] (the grip's contacts) and
 //! [`convert`] (nalgebra to glam, millimetres to metres).
 //!
-//! Scene ([`scene`]): the palm is a fixed box at the planned pose; each phalanx is a
-//! dynamic box (finger width and thickness 2 × finger offset; phalanx 2's thinned tip as a thinner
-//! box); joints are revolute on the finger joint axes with the hand's limits, as multibody
-//! (reduced-coordinate) joints: a 10 g phalanx pressing a 0.2 kg object is a mass ratio that
-//! makes impulse joints stretch and drift under load, while a multibody chain cannot come
-//! apart (`[sim] hand_joints = "impulse"` builds them as impulse joints instead, [`impulse_hand`],
-//! measured and not adopted: docs/SIM.md). Each joint has a force-based position motor (stiffness, damping) whose torque is capped
-//! by the torque limit, driving towards the planned angle closed further by the squeeze
+//! Scene ([`scene`]): the palm is a fixed box at the planned pose; each phalanx is a dynamic box
+//! (finger width and thickness 2 × finger offset; phalanx 2's thinned tip as a thinner box); joints
+//! are revolute on the finger joint axes with the hand's limits, as multibody (reduced-coordinate)
+//! joints: a 10 g phalanx pressing a 0.2 kg object is a mass ratio that makes impulse joints
+//! stretch and drift under load, while a multibody chain cannot come apart (`[sim] hand_joints =
+//! "impulse"` builds them as impulse joints instead, [`impulse_hand`], measured and not adopted:
+//! docs/SIM.md). Each joint has a force-based position motor (stiffness, damping) whose torque is
+//! capped by the torque limit, driving towards the planned angle closed further by the squeeze
 //! overshoot, so the torque limit, not the target, bounds the grip. The object is a dynamic body
 //! with the scenario's mass and friction; its collider is the convex hull of the aligned mesh when
 //! the mesh is convex (hull volume within 2 % of the mesh's), a convex decomposition otherwise (a

@@ -328,11 +328,11 @@ fn reseated_every_phalanx_of_the_d40_ends_on_its_plan() {
 
 #[test]
 fn a_bounded_squeeze_keeps_every_joint_within_it_of_its_command() {
-    // The palm 10 mm off the D40, refined by the contact (the test above): with a 10° squeeze
-    // (the closing before the default changed) the phalanx 2s close through all of it as the object is pulled to the palm. With a
-    // 3° squeeze no joint can end more than about 3° past its commanded bend (a position motor
-    // pulls back beyond its target), so a phalanx more than 5° off its plan is one the object
-    // pushed back, not one that closed through its squeeze.
+    // The palm 10 mm off the D40, refined by the contact (the test above): with a 10° squeeze (the
+    // closing before the default changed) the phalanx 2s close through all of it as the object is
+    // pulled to the palm. With a 3° squeeze no joint can end more than about 3° past its commanded
+    // bend (a position motor pulls back beyond its target), so a phalanx more than 5° off its plan
+    // is one the object pushed back, not one that closed through its squeeze.
     let past = |c: &sim::ClosingOutcome| {
         c.fingers
             .iter()

@@ -146,7 +146,8 @@ fn the_thesis_hand_round_trips_through_its_urdf_also_mounted() {
 #[test]
 fn the_sdh2_urdf_and_mjcf_hold_the_cup_between_the_phalanges() {
     let dir = tempfile::tempdir().unwrap();
-    // 3 mm divides the SDH-2's 33 mm finger gap; a 10° open margin (docs/SCENARIO.md, palm stand-off).
+    // 3 mm divides the SDH-2's 33 mm finger gap; a 10° open margin (docs/SCENARIO.md, palm
+    // stand-off).
     let rest = "[planner]\nheight_step_mm = 3.0\n[sim]\nopen_margin_deg = 10.0";
     let mut grasps = Vec::new();
     for (key, file) in [("urdf", "sdh2.urdf"), ("mjcf", "sdh2.xml")] {

@@ -309,9 +309,9 @@ fn cylinder_case<R>(
 #[test]
 fn the_closing_ends_when_the_hand_and_the_object_stop() {
     // With `close_until_stalled` (the default) each closing phase ends once every joint and the
-    // object have stopped (the reseat once the object has); the fixed schedule closes for the whole 0.5 s and the reseat for
-    // another 0.25 s. On D40 both end in the same grip: joint angles within 0.2° (0.11° apart
-    // at most), and both hold.
+    // object have stopped (the reseat once the object has); the fixed schedule closes for the whole
+    // 0.5 s and the reseat for another 0.25 s. On D40 both end in the same grip: joint angles
+    // within 0.2° (0.11° apart at most), and both hold.
     use grasp_sim::scenario::SimParams;
     let mut fixed = SimParams::default();
     fixed.closing.close_until_stalled = false;

@@ -11,12 +11,12 @@
 //! it bevels no corner: under a ridge with nothing below within `w`, the wall keeps its corner,
 //! so the thesis's "under a ridge" category (Cat_2) is still seen.
 //!
-//! The filled region is found by a sweep over the slabs between the vertices' abscissae:
-//! within a slab, the edges that span it do not cross, the gaps between them are bounded by two
-//! edges each, and a gap's height is linear in `x`, so where it is under `w` is one interval.
-//! The pieces (quadrilaterals, merged along a slab boundary where the same two edges go on) are
-//! united with the slice ([`super::super::polygon_limits::union_rings`]). A slice with no such gap is
-//! returned as it is, bit for bit.
+//! The filled region is found by a sweep over the slabs between the vertices' abscissae: within a
+//! slab, the edges that span it do not cross, the gaps between them are bounded by two edges each,
+//! and a gap's height is linear in `x`, so where it is under `w` is one interval. The pieces
+//! (quadrilaterals, merged along a slab boundary where the same two edges go on) are united with
+//! the slice ([`super::super::polygon_limits::union_rings`]). A slice with no such gap is returned
+//! as it is, bit for bit.
 
 use super::{finish, map_closed, Slice};
 use nalgebra::Point2;
