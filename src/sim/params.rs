@@ -682,6 +682,13 @@ impl SimParams {
                 format!("must be zero or positive, got {damping}"),
             ));
         }
+        if self.hold.closing_decides && self.protocol == Protocol::Full {
+            return Err((
+                "sim.closing_decides",
+                "needs protocol = \"fast\" (the full protocol holds every direction to its end)"
+                    .to_string(),
+            ));
+        }
         if self.early.rest_margin > 1.0 {
             return Err((
                 "sim.rest_margin",

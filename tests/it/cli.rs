@@ -184,6 +184,7 @@ fn bad_scenarios_name_the_file_and_key() {
         ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[planner]\nheight_step_mm = 3.0\n[expect]\noutcome = \"hold\"\n", "finger gap"),
         ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[planner]\nangular_step_deg = 7.0\n[expect]\noutcome = \"hold\"\n", "divide 360"),
         ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[expect]\noutcome = \"wobble\"\n", "wobble"),
+        ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\n[sim]\nprotocol = \"full\"\nclosing_decides = true\n", "sim.closing_decides"),
         ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"nohand.toml\"\n[expect]\noutcome = \"hold\"\n", "nohand.toml"),
         ("[object]\nmesh = \"m.stl\"\n[hand]\nfile = \"hand.toml\"\noverrides = { \"phalanx_9.length_mm\" = 3.0 }\n[expect]\noutcome = \"hold\"\n", "hand.overrides.\"phalanx_9.length_mm\""),
         ("[object\nmesh = \"m.stl\"\n", "line 1"),
