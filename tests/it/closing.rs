@@ -173,17 +173,7 @@ fn with_closing_decides_the_grasp_reported_is_checked_in_full() {
     let sim = |keys: &str| -> serde_json::Value {
         let path = dir.path().join("c4.toml");
         std::fs::write(&path, text.replace("[sim]\n", &format!("[sim]\n{keys}\n"))).unwrap();
-        let out = crate::grasp_sim()
-            .args(["--json"])
-            .arg(&path)
-            .output()
-            .unwrap();
-        assert_eq!(
-            out.status.code(),
-            Some(0),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let out = crate::succeed(crate::grasp_sim().arg("--json").arg(&path));
         let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
         let sim = v["sim"].as_object_mut().unwrap();
         sim.remove("wall_ms");
