@@ -207,13 +207,23 @@ pub fn select(
     // Under `choose = "robust"` a candidate whose own closing failed can still be chosen by its
     // samples: the check reported is a full one.
     if let (Some(recheck), Some(i)) = (p.recheck, sel.chosen) {
-        let c = &sel.candidates[i];
-        if c.check.as_ref().is_some_and(SimOutcome::decided_by_closing) {
-            let full = recheck(&sel.axes[c.axis_plan].aligned, &c.grasp);
-            sel.candidates[i].check = Some(full);
-        }
+        recheck_if_closing_decided(&mut sel, i, recheck);
     }
     sel
+}
+
+/// Checks candidate `i` again with `recheck` if a failed closing decided its check.
+#[allow(clippy::type_complexity)]
+fn recheck_if_closing_decided(
+    sel: &mut Selection,
+    i: usize,
+    recheck: &dyn Fn(&AlignedObject, &Grasp) -> SimOutcome,
+) {
+    let c = &sel.candidates[i];
+    if c.check.as_ref().is_some_and(SimOutcome::decided_by_closing) {
+        let full = recheck(&sel.axes[c.axis_plan].aligned, &c.grasp);
+        sel.candidates[i].check = Some(full);
+    }
 }
 
 /// Under `[sim] closing_decides`, a candidate whose closing failed was judged `slip` or `drop`
@@ -239,14 +249,7 @@ fn recheck_failed_closings(
         return;
     }
     for i in 0..sel.candidates.len() {
-        let Some(check) = &sel.candidates[i].check else {
-            continue;
-        };
-        if check.decided_by_closing() {
-            let c = &sel.candidates[i];
-            let full = recheck(&sel.axes[c.axis_plan].aligned, &c.grasp);
-            sel.candidates[i].check = Some(full);
-        }
+        recheck_if_closing_decided(sel, i, recheck);
         if sel.candidates[i]
             .check
             .as_ref()

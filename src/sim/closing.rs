@@ -68,6 +68,14 @@ pub(super) struct Closing {
     pub(super) contacts: Vec<super::contacts::GripContact>,
 }
 
+impl Closing {
+    /// True if the closing failed: it pushed the object beyond `max_closing_shift_mm` or left a
+    /// finger deeper than `max_penetration_mm`. Such a grasp is no `hold` whatever gravity does.
+    pub(super) fn failed(&self, params: &super::params::SimParams) -> bool {
+        self.outcome.pushed || self.penetration_mm > params.hold.max_penetration_mm
+    }
+}
+
 /// How long the `timed` approach (`[sim] approach = "timed"`) takes to move every finger's
 /// joint 1 target from its open bend to its planned bend `[s]`: the fingers arrive together.
 pub const RAMP_S: f64 = 0.1;

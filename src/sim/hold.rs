@@ -92,10 +92,7 @@ pub(super) fn hold(
     });
     let mut steps = 0;
     // `closing_decides`: a failed closing is decided before any step of the hold.
-    if watch.is_some()
-        && params.hold.closing_decides
-        && (closing.outcome.pushed || closing.penetration_mm > params.hold.max_penetration_mm)
-    {
+    if watch.is_some() && params.hold.closing_decides && closing.failed(params) {
         decided = Some(Decision::Closing);
     }
     while steps < hold_steps && decided.is_none() {
@@ -182,13 +179,12 @@ impl EarlyWatch<'_> {
         let remaining_s = (hold_steps - steps) as f64 * params.solver.timestep_s;
         // A grasp the closing left too deep in the object, or pushed too far, is `slip`
         // whatever it does while on the hand.
-        let penetrated = closing.penetration_mm > params.hold.max_penetration_mm;
         match rule.decide(
             samples,
             &self.frame,
             remaining_s,
             params,
-            penetrated || closing.outcome.pushed,
+            closing.failed(params),
         ) {
             Some(Verdict::Hold) => {}
             Some(_) if touches_hand(scene) => {}
@@ -252,8 +248,7 @@ fn direction_outcome(
         Verdict::Drop
     } else if translation_mm <= params.hold.hold_translation_mm
         && judged_rotation <= params.hold.hold_rotation_deg
-        && closing.penetration_mm <= params.hold.max_penetration_mm
-        && !closing.outcome.pushed
+        && !closing.failed(params)
     {
         Verdict::Hold
     } else if in_contact {
