@@ -70,9 +70,10 @@ pub(super) struct Closing {
 
 impl Closing {
     /// True if the closing failed: it pushed the object beyond `max_closing_shift_mm` or left a
-    /// finger deeper than `max_penetration_mm`. Such a grasp is no `hold` whatever gravity does.
+    /// finger deeper than `max_penetration_mm` (or a depth that is no number). Such a grasp is
+    /// no `hold` whatever gravity does.
     pub(super) fn failed(&self, params: &super::params::SimParams) -> bool {
-        self.outcome.pushed || self.penetration_mm > params.hold.max_penetration_mm
+        self.outcome.pushed || !(self.penetration_mm <= params.hold.max_penetration_mm)
     }
 }
 
