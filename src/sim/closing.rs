@@ -73,7 +73,9 @@ impl Closing {
     /// finger deeper than `max_penetration_mm` (or a depth that is no number). Such a grasp is
     /// no `hold` whatever gravity does.
     pub(super) fn failed(&self, params: &super::params::SimParams) -> bool {
-        self.outcome.pushed || !(self.penetration_mm <= params.hold.max_penetration_mm)
+        self.outcome.pushed
+            || self.penetration_mm.is_nan()
+            || self.penetration_mm > params.hold.max_penetration_mm
     }
 }
 
