@@ -89,9 +89,10 @@ pub enum FingerRejection {
 /// until phalanx 2 touches ([`place_als_distal`], [`Relaxation::DistalContactOnly`]; if that
 /// fails too, the first rejection stands). Under either extended rule set, an ALS that meets
 /// nothing is allowed while another touches
-/// ([`Relaxation::AlsOffObject`]), and the finger stops where its first ALS touches: its most
-/// open θ1 and θ2 over the ALS that touch, with a deviation beyond the Joint Angular Deviation
-/// recorded ([`Relaxation::JointDeviationRecorded`]) instead of rejected. An ALS off the object
+/// ([`Relaxation::AlsOffObject`]), and the finger stops where its first ALS touches: joint 1 at
+/// the most open θ1 over the ALS that touch, joint 2 where phalanx 2 then first touches
+/// ([`place_finger_extended`]), with a deviation beyond the Joint Angular Deviation recorded
+/// ([`Relaxation::JointDeviationRecorded`]) instead of rejected. An ALS off the object
 /// is reported with the finger's angles. Every other rejection (range, penetration) stands.
 pub fn place_finger(
     mesh: &Mesh,
@@ -105,13 +106,14 @@ pub fn place_finger(
     let f = &hand.finger_list[k];
     let o = hand.fingers.offset_mm;
     let mirror = f.side.sign();
-    let als = |dz: f64| -> Result<AlsAngles, FingerRejection> {
-        let tol = hand.relief_mm();
+    let slice = |dz: f64| {
         let plane = palm.finger_plane(f.height_mm + dz);
-        let s = slice_indexed_bridged(mesh, index, &plane, 2.0 * o, tol);
-        match place_als(&s, hand, mirror) {
+        slice_indexed_bridged(mesh, index, &plane, 2.0 * o, hand.relief_mm())
+    };
+    let als = |s: &Slice| -> Result<AlsAngles, FingerRejection> {
+        match place_als(s, hand, mirror) {
             Err(e) if rules == RuleSet::Pinch && e != FingerRejection::PalmPenetration => {
-                place_als_distal(&s, hand, mirror).map_err(|_| e)
+                place_als_distal(s, hand, mirror).map_err(|_| e)
             }
             placed => placed,
         }
@@ -120,21 +122,31 @@ pub fn place_finger(
         // Centre, top, bottom, each placed only while the others leave the finger possible
         // (a slice of a many-shell mesh is costly).
         let mut placed = Vec::with_capacity(3);
+        let mut planes = Vec::with_capacity(3);
         for dz in [0.0, o, -o] {
-            let r = als(dz);
+            let s = slice(dz);
+            let r = als(&s);
             if let Err(e) = r {
                 if !is_off_object(e) {
                     return Err(e);
                 }
             }
             placed.push(r);
+            planes.push(FingerPlane::new(&s, hand, mirror)?);
         }
         let [centre, top, bottom]: [_; 3] = placed.try_into().expect("three ALS");
-        return place_finger_extended(f.name.clone(), [centre, top, bottom], deviation_deg);
+        let planes: [_; 3] = planes.try_into().ok().expect("three planes");
+        return place_finger_extended(
+            f.name.clone(),
+            [centre, top, bottom],
+            &planes,
+            hand,
+            deviation_deg,
+        );
     }
-    let centre = als(0.0)?;
-    let top = als(o)?;
-    let bottom = als(-o)?;
+    let centre = als(&slice(0.0))?;
+    let top = als(&slice(o))?;
+    let bottom = als(&slice(-o))?;
     for other in [&top, &bottom] {
         if (other.theta1_deg - centre.theta1_deg).abs() > deviation_deg[0]
             || (other.theta2_deg - centre.theta2_deg).abs() > deviation_deg[1]
@@ -160,10 +172,22 @@ fn is_off_object(r: FingerRejection) -> bool {
     )
 }
 
-/// The extended rules' finger (see [`place_finger`]); `als` is centre, top, bottom.
+/// The extended rules' finger (see [`place_finger`]); `als` is centre, top, bottom, and
+/// `planes` their finger slice planes.
+///
+/// Joint 1 stops where the first ALS's phalanx 1 touches (the most open θ1). Phalanx 2 then
+/// closes about joint 2 with phalanx 1 *there*, so its θ2 is the first contact of phalanx 2,
+/// with phalanx 1 at the finger's θ1, in the planes of the ALS that touch (each ALS's own θ2
+/// was found with its own θ1: taking the most open of those put the Adroit ball's phalanx 2
+/// 1.7 mm clear of the ball, 7° short of where it touches). The plane of an ALS that meets
+/// nothing is left out, as it is from θ1: the finger's edge is off the object there, and
+/// phalanx 2 would meet at most the edge of a face the curvature rules did not grade (a
+/// tapered box's, which its grasp then drops). A pinch keeps the most open θ2 of its ALS.
 fn place_finger_extended(
     name: String,
     als: [Result<AlsAngles, FingerRejection>; 3],
+    planes: &[FingerPlane; 3],
+    hand: &Hand,
     deviation_deg: [f64; 2],
 ) -> Result<FingerPlacement, FingerRejection> {
     let mut relaxations = Vec::new();
@@ -183,12 +207,26 @@ fn place_finger_extended(
         .copied()
         .max_by(|a, b| a.theta1_deg.total_cmp(&b.theta1_deg))
         .ok_or_else(|| *als[0].as_ref().expect_err("no ALS touched"))?;
-    let theta2 = touching
-        .iter()
-        .map(|a| a.theta2_deg)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (theta2, is_tip_contact) = if relaxations.contains(&Relaxation::DistalContactOnly) {
+        // A pinch's θ1 is where joint 1's search first let phalanx 2 reach the object in
+        // one plane, not a contact; its phalanx 2 keeps the most open of the ALS's own.
+        let theta2 = touching
+            .iter()
+            .map(|a| a.theta2_deg)
+            .fold(f64::NEG_INFINITY, f64::max);
+        (theta2, first.is_tip_contact)
+    } else {
+        let touched: Vec<&FingerPlane> = planes
+            .iter()
+            .zip(&als)
+            .filter(|(_, a)| a.is_ok())
+            .map(|(p, _)| p)
+            .collect();
+        phalanx2_at(&touched, hand, first.theta1_deg)?
+    };
     let finger = AlsAngles {
         theta2_deg: theta2,
+        is_tip_contact,
         contacts: als[0].as_ref().map_or([None, None], |a| a.contacts),
         ..*first
     };
@@ -283,6 +321,20 @@ impl FingerPlane {
         })
     }
 
+    /// Phalanx 2's search domain about joint 2 at `j2`: the contour's vertices within `reach`
+    /// and the points where its segments cross the circle of that radius, so the end of the
+    /// contact line can touch a segment (tip contact, Fig. 3.22).
+    fn phalanx2_domain(&self, j2: Point2<f64>, reach: f64) -> Vec<Point2<f64>> {
+        let mut domain = Vec::new();
+        for (a, b) in &self.segments {
+            if (a - j2).norm() <= reach {
+                domain.push(*a);
+            }
+            domain.extend(circle_crossings(*a, *b, j2, reach));
+        }
+        domain
+    }
+
     /// A contact on a contact line in the palm's frame, mirrored back to the plane's.
     fn unmirror(&self, p: Point2<f64>, n: Vector2<f64>) -> (Point2<f64>, Vector2<f64>) {
         (
@@ -307,14 +359,7 @@ fn place_phalanx2(
         p2.unusable_proximal_mm,
         p2.length_mm - p2.unusable_distal_mm,
     );
-    let reach2 = usable2.1.hypot(o);
-    let mut domain2: Vec<Point2<f64>> = Vec::new();
-    for (a, b) in &plane.segments {
-        if (a - j2).norm() <= reach2 {
-            domain2.push(*a);
-        }
-        domain2.extend(circle_crossings(*a, *b, j2, reach2));
-    }
+    let domain2 = plane.phalanx2_domain(j2, usable2.1.hypot(o));
     let (bend2, along2) =
         first_contact(&domain2, j2, d1, usable2, o).ok_or(FingerRejection::Phalanx2NoContact)?;
     let theta2 = 180.0 - bend2.to_degrees();
@@ -324,20 +369,84 @@ fn place_phalanx2(
     }
     let e = Rotation2::new(bend2) * d1;
     let n_e = inward_normal(&e);
-    let body2 = ConvexPolygon::strip(j2, e, usable2.1, -o, o);
-    // The thinned tip (Fig. 3.8): from the end of the contact line to the tip's front corner.
-    let tip_front = hand.fingers.tip_thickness_mm - o;
-    let tip = ConvexPolygon::new(vec![
-        j2 + e * usable2.1 - n_e * o,
-        j2 + e * p2.length_mm - n_e * o,
-        j2 + e * p2.length_mm + n_e * tip_front,
-        j2 + e * usable2.1 + n_e * o,
-    ]);
-    if plane.hits(&body2) || (p2.length_mm > usable2.1 && plane.hits(&tip)) {
+    let (body2, tip) = phalanx2_outline(hand, j2, e);
+    if plane.hits(&body2) || tip.as_ref().is_some_and(|t| plane.hits(t)) {
         return Err(FingerRejection::Phalanx2Penetration);
     }
     let is_tip_contact = along2 >= usable2.1 - 1e-6;
     Ok((theta2, j2 + e * along2 + n_e * o, n_e, is_tip_contact))
+}
+
+/// Phalanx 2's outline pivoting at `j2` along `e`: its body up to the end of the contact line
+/// and, if the phalanx reaches beyond it, the thinned tip (Fig. 3.8) from there to the tip's
+/// front corner.
+fn phalanx2_outline(
+    hand: &Hand,
+    j2: Point2<f64>,
+    e: Vector2<f64>,
+) -> (ConvexPolygon, Option<ConvexPolygon>) {
+    let o = hand.fingers.offset_mm;
+    let p2 = &hand.phalanx_2;
+    let usable_end = p2.length_mm - p2.unusable_distal_mm;
+    let n_e = inward_normal(&e);
+    let body2 = ConvexPolygon::strip(j2, e, usable_end, -o, o);
+    let tip_front = hand.fingers.tip_thickness_mm - o;
+    let tip = (p2.length_mm > usable_end).then(|| {
+        ConvexPolygon::new(vec![
+            j2 + e * usable_end - n_e * o,
+            j2 + e * p2.length_mm - n_e * o,
+            j2 + e * p2.length_mm + n_e * tip_front,
+            j2 + e * usable_end + n_e * o,
+        ])
+    });
+    (body2, tip)
+}
+
+/// Phalanx 2 of a finger whose joint 1 stands at `theta1_deg`, closing about joint 2 until it
+/// first touches the object in any of `planes`: its θ2 `[deg]` and whether that is a tip
+/// contact. The contact must lie in joint 2's range, and phalanx 2's body and tip must be clear
+/// of every plane at that θ2.
+fn phalanx2_at(
+    planes: &[&FingerPlane],
+    hand: &Hand,
+    theta1_deg: f64,
+) -> Result<(f64, bool), FingerRejection> {
+    let o = hand.fingers.offset_mm;
+    let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
+    let d1 = phalanx1_direction(theta1_deg.to_radians());
+    let j2 = j1 + d1 * hand.phalanx_1.length_mm;
+    let p2 = &hand.phalanx_2;
+    let usable2 = (
+        p2.unusable_proximal_mm,
+        p2.length_mm - p2.unusable_distal_mm,
+    );
+    let (bend2, along2) = planes
+        .iter()
+        .filter_map(|p| {
+            first_contact(
+                &p.phalanx2_domain(j2, usable2.1.hypot(o)),
+                j2,
+                d1,
+                usable2,
+                o,
+            )
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))
+        .ok_or(FingerRejection::Phalanx2NoContact)?;
+    let theta2 = 180.0 - bend2.to_degrees();
+    let [lo2, hi2] = hand.joints.theta2_range_deg;
+    if !(lo2..=hi2).contains(&theta2) {
+        return Err(FingerRejection::Theta2OutOfRange);
+    }
+    let e = Rotation2::new(bend2) * d1;
+    let (body2, tip) = phalanx2_outline(hand, j2, e);
+    if planes
+        .iter()
+        .any(|p| p.hits(&body2) || tip.as_ref().is_some_and(|t| p.hits(t)))
+    {
+        return Err(FingerRejection::Phalanx2Penetration);
+    }
+    Ok((theta2, along2 >= usable2.1 - 1e-6))
 }
 
 /// Places one ALS on its finger slice plane. `mirror` is +1 for a left finger (joint at +y) and
@@ -589,5 +698,43 @@ mod tests {
             RuleSet::Thesis,
         );
         assert_eq!(r, Err(FingerRejection::Theta1OutOfRange));
+    }
+    #[test]
+    fn phalanx_2_closes_from_where_joint_1_stopped() {
+        // A 70 mm ball, the palm with finger_1 20 mm above its equator (the Adroit ball's grasp).
+        // Finger_1's centre ALS meets the ball with phalanx 1 at θ1 90.02°, its top ALS (a
+        // smaller circle, 7 mm higher) only at 69.34°, and there its phalanx 2 touches at θ2
+        // 127.34°. Joint 1 stops at the first touch, 90.02°; with phalanx 1 there, phalanx 2
+        // meets the centre plane's circle first, at the centre ALS's own 122.29°. The top ALS's
+        // 127.34° (the most open θ2 of the three) would leave phalanx 2 off the ball: 1.7 mm
+        // clear on the Adroit ball, which the check closed 3° past without touching.
+        let hand = thesis_hand();
+        let r: f64 = 35.0;
+        let profile: Vec<(f64, f64)> = (0..=72)
+            .map(|k| {
+                let z = -r + 2.0 * r * f64::from(k) / 72.0;
+                (z + r, 2.0 * (r * r - z * z).max(0.0).sqrt())
+            })
+            .collect();
+        let ball = crate::objects::revolved(&profile);
+        let palm = place_palm(&ball, &hand, 60.0, 0.0, 0.2).unwrap();
+        let f = place_finger(
+            &ball,
+            &SliceIndex::new(&ball),
+            &hand,
+            &palm,
+            0,
+            [5.0, 5.0],
+            RuleSet::Extended,
+        )
+        .unwrap();
+        let (top, centre) = (f.top, f.centre);
+        assert!((top.theta1_deg - 69.34).abs() < 0.01, "{top:?}");
+        assert!((top.theta2_deg - 127.34).abs() < 0.01, "{top:?}");
+        assert!((centre.theta1_deg - 90.02).abs() < 0.01, "{centre:?}");
+        assert!((centre.theta2_deg - 122.29).abs() < 0.01, "{centre:?}");
+        assert_eq!(f.bottom.theta1_deg, centre.theta1_deg);
+        assert_eq!(f.bottom.theta2_deg, centre.theta2_deg);
+        assert!(f.relaxations.contains(&Relaxation::JointDeviationRecorded));
     }
 }
