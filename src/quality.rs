@@ -294,7 +294,9 @@ pub fn torque_scale(mesh: &crate::mesh::Mesh) -> (Point3<f64>, f64) {
 /// The planned contacts of a grasp: the palm's contacts in the vertical slice at the approach
 /// angle (pushing along the palm's normal) and, for every finger, where each ALS's phalanx 1
 /// and phalanx 2 touch in its finger slice plane (top, centre, bottom), pushing along the
-/// phalanx's inward normal. Aligned object frame.
+/// phalanx's inward normal. Under the thesis's rules each ALS touches at its own angles; under
+/// the extended rules a finger touches only where it stops ([`crate::plan::finger::AlsAngles`]'s
+/// `contacts`). Aligned object frame.
 pub fn planned_contacts(
     grasp: &crate::plan::search::Grasp,
     hand: &crate::hand::Hand,

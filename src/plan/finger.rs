@@ -28,6 +28,10 @@ use crate::slice::{slice_indexed_bridged, Slice, SliceIndex};
 use nalgebra::{Point2, Rotation2, Vector2};
 use std::f64::consts::PI;
 
+/// A contact in a finger slice plane's 2D coordinates `[mm]`, with the unit direction in which
+/// the phalanx pushes.
+pub type PlaneContact = (Point2<f64>, Vector2<f64>);
+
 /// The joint angles of one ALS `[deg]`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AlsAngles {
@@ -43,8 +47,11 @@ pub struct AlsAngles {
     /// `[mm]`, each with the unit direction in which the phalanx pushes (its contact surface's
     /// inward normal), phalanx 1 then phalanx 2; `None` for a phalanx that touches nothing: both
     /// for an ALS reported with its finger's angles because it met nothing, phalanx 1 for an ALS
-    /// placed by [`place_als_distal`] (extended rules).
-    pub contacts: [Option<(Point2<f64>, Vector2<f64>)>; 2],
+    /// placed by [`place_als_distal`] (extended rules). Under the extended rules (but a pinch)
+    /// these are the *finger's* contacts in this ALS's plane, at the finger's angles, not at the
+    /// ALS's own: a phalanx touches in the planes whose first contact stopped it, and nowhere
+    /// else.
+    pub contacts: [Option<PlaneContact>; 2],
 }
 
 /// A positioned finger: its three ALS.
@@ -110,11 +117,12 @@ pub fn place_finger(
         let plane = palm.finger_plane(f.height_mm + dz);
         slice_indexed_bridged(mesh, index, &plane, 2.0 * o, hand.relief_mm())
     };
-    let als = |s: &Slice| -> Result<AlsAngles, FingerRejection> {
-        match place_als(s, hand, mirror) {
-            Err(e) if rules == RuleSet::Pinch && e != FingerRejection::PalmPenetration => {
-                place_als_distal(s, hand, mirror).map_err(|_| e)
-            }
+    // Each plane is built once (its segments copied, the palm's outline checked: a
+    // `PalmPenetration`, which no rule set relaxes) and its ALS placed on it.
+    let plane = |dz: f64| FingerPlane::new(&slice(dz), hand, mirror);
+    let als = |plane: &FingerPlane| -> Result<AlsAngles, FingerRejection> {
+        match als_on(plane, hand) {
+            Err(e) if rules == RuleSet::Pinch => als_distal_on(plane, hand).map_err(|_| e),
             placed => placed,
         }
     };
@@ -124,15 +132,15 @@ pub fn place_finger(
         let mut placed = Vec::with_capacity(3);
         let mut planes = Vec::with_capacity(3);
         for dz in [0.0, o, -o] {
-            let s = slice(dz);
-            let r = als(&s);
+            let p = plane(dz)?;
+            let r = als(&p);
             if let Err(e) = r {
                 if !is_off_object(e) {
                     return Err(e);
                 }
             }
             placed.push(r);
-            planes.push(FingerPlane::new(&s, hand, mirror)?);
+            planes.push(p);
         }
         let [centre, top, bottom]: [_; 3] = placed.try_into().expect("three ALS");
         let planes: [_; 3] = planes.try_into().ok().expect("three planes");
@@ -144,9 +152,9 @@ pub fn place_finger(
             deviation_deg,
         );
     }
-    let centre = als(&slice(0.0))?;
-    let top = als(&slice(o))?;
-    let bottom = als(&slice(-o))?;
+    let centre = als(&plane(0.0)?)?;
+    let top = als(&plane(o)?)?;
+    let bottom = als(&plane(-o)?)?;
     for other in [&top, &bottom] {
         if (other.theta1_deg - centre.theta1_deg).abs() > deviation_deg[0]
             || (other.theta2_deg - centre.theta2_deg).abs() > deviation_deg[1]
@@ -183,6 +191,10 @@ fn is_off_object(r: FingerRejection) -> bool {
 /// nothing is left out, as it is from θ1: the finger's edge is off the object there, and
 /// phalanx 2 would meet at most the edge of a face the curvature rules did not grade (a
 /// tapered box's, which its grasp then drops). A pinch keeps the most open θ2 of its ALS.
+///
+/// The finger's contacts are where it stops: phalanx 1 in the plane(s) of the ALS whose
+/// θ1 it took, phalanx 2 in the plane(s) where it first touched; each ALS carries those in its
+/// plane (a pinch keeps each ALS's own).
 fn place_finger_extended(
     name: String,
     als: [Result<AlsAngles, FingerRejection>; 3],
@@ -207,6 +219,10 @@ fn place_finger_extended(
         .copied()
         .max_by(|a, b| a.theta1_deg.total_cmp(&b.theta1_deg))
         .ok_or_else(|| *als[0].as_ref().expect_err("no ALS touched"))?;
+    // Each ALS's own contacts (a pinch's), or the finger's where it stops (below).
+    let mut contacts = als
+        .each_ref()
+        .map(|a| a.as_ref().map_or([None, None], |a| a.contacts));
     let (theta2, is_tip_contact) = if relaxations.contains(&Relaxation::DistalContactOnly) {
         // A pinch's θ1 is where joint 1's search first let phalanx 2 reach the object in
         // one plane, not a contact; its phalanx 2 keeps the most open of the ALS's own.
@@ -216,18 +232,31 @@ fn place_finger_extended(
             .fold(f64::NEG_INFINITY, f64::max);
         (theta2, first.is_tip_contact)
     } else {
-        let touched: Vec<&FingerPlane> = planes
+        let touched: Vec<(usize, &FingerPlane)> = planes
             .iter()
+            .enumerate()
             .zip(&als)
             .filter(|(_, a)| a.is_ok())
             .map(|(p, _)| p)
             .collect();
-        phalanx2_at(&touched, hand, first.theta1_deg)?
+        let p2 = phalanx2_at(&touched, hand, first.theta1_deg)?;
+        // The finger's contacts at its own angles: phalanx 1 in the planes whose ALS set θ1
+        // (the others' phalanx 1 would touch only further closed), phalanx 2 where it stops.
+        for (c, a) in contacts.iter_mut().zip(&als) {
+            let sets_theta1 = a
+                .as_ref()
+                .is_ok_and(|a| first.theta1_deg - a.theta1_deg <= SAME_THETA1_DEG);
+            *c = [if sets_theta1 { c[0] } else { None }, None];
+        }
+        for (k, c) in p2.contacts {
+            contacts[k][1] = Some(c);
+        }
+        (p2.theta2_deg, p2.is_tip_contact)
     };
     let finger = AlsAngles {
         theta2_deg: theta2,
         is_tip_contact,
-        contacts: als[0].as_ref().map_or([None, None], |a| a.contacts),
+        contacts: contacts[0],
         ..*first
     };
     if touching.iter().any(|a| {
@@ -238,8 +267,11 @@ fn place_finger_extended(
     }
     relaxations.sort();
     relaxations.dedup();
-    let pick = |r: &Result<AlsAngles, FingerRejection>| match r {
-        Ok(a) => *a,
+    let pick = |k: usize| match &als[k] {
+        Ok(a) => AlsAngles {
+            contacts: contacts[k],
+            ..*a
+        },
         Err(_) => AlsAngles {
             contacts: [None, None],
             ..finger
@@ -247,9 +279,9 @@ fn place_finger_extended(
     };
     Ok(FingerPlacement {
         name,
-        top: pick(&als[1]),
+        top: pick(1),
         centre: finger,
-        bottom: pick(&als[2]),
+        bottom: pick(2),
         relaxations,
     })
 }
@@ -402,15 +434,32 @@ fn phalanx2_outline(
     (body2, tip)
 }
 
+/// Where phalanx 2 of an extended-rule finger touches: its θ2 `[deg]`, whether it is a tip
+/// contact, and its contacts: in every plane it meets at that θ2 (each plane's index among
+/// the finger's, the contact in its coordinates with the phalanx's inward normal).
+struct Phalanx2Contact {
+    theta2_deg: f64,
+    is_tip_contact: bool,
+    contacts: Vec<(usize, PlaneContact)>,
+}
+
+/// An ALS whose θ1 is this close to its finger's `[deg]` touches with phalanx 1 where the
+/// finger stops.
+const SAME_THETA1_DEG: f64 = 1e-9;
+
+/// Two first contacts this close in bend `[rad]` are the same contact in two planes (the
+/// planes of a prism cut the same contour).
+const SAME_BEND_RAD: f64 = 1e-9;
+
 /// Phalanx 2 of a finger whose joint 1 stands at `theta1_deg`, closing about joint 2 until it
-/// first touches the object in any of `planes`: its θ2 `[deg]` and whether that is a tip
-/// contact. The contact must lie in joint 2's range, and phalanx 2's body and tip must be clear
-/// of every plane at that θ2.
+/// first touches the object in any of `planes` (each with its index among the finger's). The
+/// contact must lie in joint 2's range, and phalanx 2's body and tip must be clear of every
+/// plane at that θ2.
 fn phalanx2_at(
-    planes: &[&FingerPlane],
+    planes: &[(usize, &FingerPlane)],
     hand: &Hand,
     theta1_deg: f64,
-) -> Result<(f64, bool), FingerRejection> {
+) -> Result<Phalanx2Contact, FingerRejection> {
     let o = hand.fingers.offset_mm;
     let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
     let d1 = phalanx1_direction(theta1_deg.to_radians());
@@ -420,9 +469,9 @@ fn phalanx2_at(
         p2.unusable_proximal_mm,
         p2.length_mm - p2.unusable_distal_mm,
     );
-    let (bend2, along2) = planes
+    let firsts: Vec<_> = planes
         .iter()
-        .filter_map(|p| {
+        .filter_map(|&(k, p)| {
             first_contact(
                 &p.phalanx2_domain(j2, usable2.1.hypot(o)),
                 j2,
@@ -430,7 +479,12 @@ fn phalanx2_at(
                 usable2,
                 o,
             )
+            .map(|c| (c, (k, p)))
         })
+        .collect();
+    let (bend2, along2) = firsts
+        .iter()
+        .map(|(c, _)| *c)
         .min_by(|a, b| a.0.total_cmp(&b.0))
         .ok_or(FingerRejection::Phalanx2NoContact)?;
     let theta2 = 180.0 - bend2.to_degrees();
@@ -442,17 +496,30 @@ fn phalanx2_at(
     let (body2, tip) = phalanx2_outline(hand, j2, e);
     if planes
         .iter()
-        .any(|p| p.hits(&body2) || tip.as_ref().is_some_and(|t| p.hits(t)))
+        .any(|(_, p)| p.hits(&body2) || tip.as_ref().is_some_and(|t| p.hits(t)))
     {
         return Err(FingerRejection::Phalanx2Penetration);
     }
-    Ok((theta2, along2 >= usable2.1 - 1e-6))
+    let n_e = inward_normal(&e);
+    Ok(Phalanx2Contact {
+        theta2_deg: theta2,
+        is_tip_contact: along2 >= usable2.1 - 1e-6,
+        contacts: firsts
+            .iter()
+            .filter(|((b, _), _)| b - bend2 <= SAME_BEND_RAD)
+            .map(|&((_, along), (k, p))| (k, p.unmirror(j2 + e * along + n_e * o, n_e)))
+            .collect(),
+    })
 }
 
 /// Places one ALS on its finger slice plane. `mirror` is +1 for a left finger (joint at +y) and
 /// −1 for a right one (the contour is mirrored so the finger is handled as a left one).
 pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, FingerRejection> {
-    let plane = FingerPlane::new(s, hand, mirror)?;
+    als_on(&FingerPlane::new(s, hand, mirror)?, hand)
+}
+
+/// [`place_als`] on a finger plane already built.
+fn als_on(plane: &FingerPlane, hand: &Hand) -> Result<AlsAngles, FingerRejection> {
     let o = hand.fingers.offset_mm;
 
     // Phalanx 1.
@@ -483,8 +550,7 @@ pub fn place_als(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, Finge
     }
 
     // Phalanx 2, with segments cut at its domain's border.
-    let (theta2, c2, n2, is_tip_contact) =
-        place_phalanx2(&plane, hand, j1 + d1 * p1.length_mm, d1)?;
+    let (theta2, c2, n2, is_tip_contact) = place_phalanx2(plane, hand, j1 + d1 * p1.length_mm, d1)?;
     // The contacts on the contact lines, a finger offset inside the centrelines, mirrored back.
     let n_d1 = inward_normal(&d1);
     Ok(AlsAngles {
@@ -510,7 +576,11 @@ const DISTAL_STEP_DEG: f64 = 0.25;
 /// rejection. This is a thin object pinched by the fingertips with the palm on its narrow face (a
 /// book held by its spine): phalanx 1 reaches past it and only phalanx 2 can come back to it.
 pub fn place_als_distal(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles, FingerRejection> {
-    let plane = FingerPlane::new(s, hand, mirror)?;
+    als_distal_on(&FingerPlane::new(s, hand, mirror)?, hand)
+}
+
+/// [`place_als_distal`] on a finger plane already built.
+fn als_distal_on(plane: &FingerPlane, hand: &Hand) -> Result<AlsAngles, FingerRejection> {
     let o = hand.fingers.offset_mm;
     let p1 = &hand.phalanx_1;
     let j1 = Point2::new(hand.joints.setback_mm, hand.joints.lateral_mm);
@@ -523,7 +593,7 @@ pub fn place_als_distal(s: &Slice, hand: &Hand, mirror: f64) -> Result<AlsAngles
         if plane.hits(&ConvexPolygon::strip(j1, d1, p1.length_mm, -o, o)) {
             return Err(FingerRejection::Phalanx1Penetration);
         }
-        match place_phalanx2(&plane, hand, j1 + d1 * p1.length_mm, d1) {
+        match place_phalanx2(plane, hand, j1 + d1 * p1.length_mm, d1) {
             Ok((theta2, c2, n2, is_tip_contact)) => {
                 return Ok(AlsAngles {
                     theta1_deg: theta1,
@@ -702,12 +772,13 @@ mod tests {
     #[test]
     fn phalanx_2_closes_from_where_joint_1_stopped() {
         // A 70 mm ball, the palm with finger_1 20 mm above its equator (the Adroit ball's grasp).
-        // Finger_1's centre ALS meets the ball with phalanx 1 at θ1 90.02°, its top ALS (a
-        // smaller circle, 7 mm higher) only at 69.34°, and there its phalanx 2 touches at θ2
-        // 127.34°. Joint 1 stops at the first touch, 90.02°; with phalanx 1 there, phalanx 2
-        // meets the centre plane's circle first, at the centre ALS's own 122.29°. The top ALS's
-        // 127.34° (the most open θ2 of the three) would leave phalanx 2 off the ball: 1.7 mm
-        // clear on the Adroit ball, which the check closed 3° past without touching.
+        // Finger_1's bottom ALS (7 mm lower, a larger circle) meets the ball first, with phalanx
+        // 1 at θ1 90.02° and phalanx 2 at θ2 122.29°; the centre ALS at 82.39° and 126.22°, the
+        // top ALS (a smaller circle) only at 69.34° and 127.34°. Joint 1 stops at the first
+        // touch, 90.02°; with phalanx 1 there, phalanx 2 meets the bottom plane's circle first,
+        // at 122.29°. The most open θ2 of the three, the top ALS's 127.34°, would leave phalanx
+        // 2 off the ball: 1.7 mm clear on the Adroit ball, which the check closed 3° past
+        // without touching.
         let hand = thesis_hand();
         let r: f64 = 35.0;
         let profile: Vec<(f64, f64)> = (0..=72)
@@ -728,13 +799,42 @@ mod tests {
             RuleSet::Extended,
         )
         .unwrap();
-        let (top, centre) = (f.top, f.centre);
+        let (top, centre, bottom) = (f.top, f.centre, f.bottom);
         assert!((top.theta1_deg - 69.34).abs() < 0.01, "{top:?}");
         assert!((top.theta2_deg - 127.34).abs() < 0.01, "{top:?}");
-        assert!((centre.theta1_deg - 90.02).abs() < 0.01, "{centre:?}");
-        assert!((centre.theta2_deg - 122.29).abs() < 0.01, "{centre:?}");
-        assert_eq!(f.bottom.theta1_deg, centre.theta1_deg);
-        assert_eq!(f.bottom.theta2_deg, centre.theta2_deg);
+        assert!((bottom.theta1_deg - 90.02).abs() < 0.01, "{bottom:?}");
+        assert!((bottom.theta2_deg - 122.29).abs() < 0.01, "{bottom:?}");
+        // The finger's angles (reported as its centre ALS's).
+        assert_eq!(
+            (centre.theta1_deg, centre.theta2_deg),
+            (bottom.theta1_deg, bottom.theta2_deg)
+        );
         assert!(f.relaxations.contains(&Relaxation::JointDeviationRecorded));
+
+        // The finger's contacts are where it stops: phalanx 1 and phalanx 2 both in the bottom
+        // plane, on the ball. The top and centre ALS's own contacts, at their own angles, are
+        // not the finger's (they were among the planned contacts `--quality` used).
+        assert_eq!(top.contacts, [None, None]);
+        assert_eq!(centre.contacts, [None, None]);
+        let o = hand.fingers.offset_mm;
+        let plane = palm.finger_plane(hand.finger_list[0].height_mm - o);
+        for (p, n) in bottom
+            .contacts
+            .map(|c| c.expect("a contact in the bottom plane"))
+        {
+            let q = plane.to_3d(&p) - nalgebra::Point3::new(0.0, 0.0, r);
+            // On the ball (its 72-step profile revolved: within 0.3 mm), pushing inwards: towards
+            // the centre of the ball's circle in the plane.
+            assert!(
+                (q.norm() - r).abs() < 0.3,
+                "{} mm from the centre",
+                q.norm()
+            );
+            let in_plane = nalgebra::Vector2::new(q.dot(&plane.u), q.dot(&plane.v));
+            assert!(
+                n.dot(&in_plane) < -0.99 * in_plane.norm(),
+                "{n:?} at {in_plane:?}"
+            );
+        }
     }
 }
