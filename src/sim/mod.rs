@@ -39,6 +39,7 @@ pub mod closing;
 pub mod collider;
 pub mod contacts;
 pub mod convert;
+pub mod dispatcher;
 pub mod early;
 pub mod flight;
 pub mod hand_shapes;

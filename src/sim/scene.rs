@@ -494,6 +494,9 @@ pub fn build(case: &Case) -> Scene {
 /// An empty world, gravity off, with the integration parameters of the check.
 fn new_world(params: &SimParams) -> PhysicsWorld {
     let mut world = PhysicsWorld::new();
+    // Contact manifolds checked against parry's own contact query, and rebuilt from scratch
+    // where they miss a phalanx inside the object (`dispatcher`).
+    world.narrow_phase = NarrowPhase::with_query_dispatcher(super::dispatcher::CheckedManifolds);
     world.gravity = Vector::ZERO;
     let ip = &mut world.integration_parameters;
     ip.dt = params.solver.timestep_s as f32;

@@ -12,7 +12,6 @@ mod hand_files;
 mod hostile;
 mod isolation;
 mod issue16;
-mod parry_coherence;
 mod planner;
 mod quality;
 mod real_meshes;

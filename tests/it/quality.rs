@@ -96,7 +96,7 @@ fn the_summary_gives_epsilon_and_the_json_has_it_per_candidate() {
     assert!(
         line.contains("epsilon 0.125 (force closure)")
             && line.contains("8 cone edges, mu 0.3")
-            && line.contains("10 contacts at the end of closing"),
+            && line.contains("9 contacts at the end of closing"),
         "{line}"
     );
     // Without it: from the planned contacts (palm and the phalanges of every ALS), for every
