@@ -153,7 +153,7 @@ fn bench_sim(c: &mut Criterion) {
         &mut StageTimings::default(),
     );
     let g0 = &found.grasps[0];
-    let pose = SimHand::from_grasp(g0);
+    let pose = SimHand::from_grasp(g0, &hand);
     let shape = ObjectShape::from_mesh(&a.mesh, mass_properties(&a.mesh).volume_mm3);
     let mass = 500.0 * mass_properties(&a.mesh).volume_mm3 * 1e-9;
     let mut g = c.benchmark_group("sim");
@@ -221,7 +221,7 @@ fn bench_quality(c: &mut Criterion) {
             &mut StageTimings::default(),
         );
         let grasp = &found.grasps[0];
-        let pose = SimHand::from_grasp(grasp);
+        let pose = SimHand::from_grasp(grasp, &hand);
         let volume = mass_properties(&a.mesh).volume_mm3;
         let shape = ObjectShape::from_mesh(&a.mesh, volume);
         let params = SimParams::default();

@@ -63,7 +63,7 @@ fn main() {
         spec.mesh = path;
         spec.units = units;
         let o = PreparedObject::load(&spec, &mut timings).expect("mesh");
-        let shape = o.shape(&o.aligned);
+        let shape = o.own_shape(&o.aligned);
         let (c, i) = com_inertia(&shape, o.mass_kg);
         let v = &o.aligned.mesh.vertices;
         let moved = first.as_ref().map_or(0.0, |f| {

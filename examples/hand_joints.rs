@@ -40,7 +40,7 @@ fn main() {
         1,
         &mut grasp_sim::report::StageTimings::default(),
     );
-    let pose = SimHand::from_grasp(&found.grasps[0]);
+    let pose = SimHand::from_grasp(&found.grasps[0], &hand);
     let volume = grasp_sim::mesh::mass_properties(&aligned.mesh).volume_mm3;
     let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
     let kinds = [HandJoints::Multibody, HandJoints::Impulse];

@@ -124,7 +124,7 @@ fn study_grasp(p: &Planned, k: usize, six: bool) -> Row {
     let c = &p.selection.candidates[k];
     let axis = &p.selection.axes[c.axis_plan];
     let shape = sim::ObjectShape::from_mesh(&axis.aligned.mesh, p.volume);
-    let pose = sim::SimHand::from_grasp(&c.grasp);
+    let pose = sim::SimHand::from_grasp(&c.grasp, &sc.hand);
     let mut down_params = sc.sim.clone();
     down_params.gravity = GravityMode::Down;
     let mut six_params = sc.sim.clone();

@@ -4,6 +4,7 @@
 //! `run` (one scenario) and `tune` (a grid of planner settings) both start from a
 //! [`PreparedObject`], so loading, aligning, the mass formula and the collider are written once.
 
+use crate::hand::Hand;
 use crate::mesh::{self, AlignedObject, GraspAxis, LoadedMesh, MassProperties, Mesh, MeshError};
 use crate::plan::timings::ms;
 use crate::plan::StageTimings;
@@ -82,13 +83,23 @@ impl PreparedObject {
         self.props.volume_mm3
     }
 
-    /// The collider of the object aligned as `a` is (made once per axis).
-    pub fn shape(&self, a: &AlignedObject) -> ObjectShape {
+    /// The collider of the object aligned as `a` is, whatever the grasp (made once per axis):
+    /// its convex hull if the mesh is convex, else its convex decomposition.
+    pub fn own_shape(&self, a: &AlignedObject) -> ObjectShape {
         let mut shapes = self.shapes.lock().unwrap_or_else(|e| e.into_inner());
         shapes
             .entry(a.axis)
             .or_insert_with(|| ObjectShape::cached(&a.mesh, self.props.volume_mm3))
             .clone()
+    }
+
+    /// The collider for a check of `pose` on the object aligned as `a`: [`Self::own_shape`],
+    /// but the hull of a convex mesh gives way to its decomposition where it lies more than
+    /// the hand's relief (`hand.relief_mm()`, the depth a finger does not feel) outside the
+    /// pose's planned contacts ([`ObjectShape::true_at`]).
+    pub fn shape(&self, a: &AlignedObject, pose: &SimHand, hand: &Hand) -> ObjectShape {
+        self.own_shape(a)
+            .true_at(&a.mesh, &pose.planned_contacts_mm, hand.relief_mm())
     }
 
     /// The physics check's case for `scenario`'s hand, friction and protocol, this object's

@@ -1056,7 +1056,7 @@ mod tests {
                 let axis = &selection.axes[c.axis_plan];
                 let shape =
                     crate::sim::ObjectShape::from_mesh(&axis.aligned.mesh, props.volume_mm3);
-                let pose = crate::sim::SimHand::from_grasp(&c.grasp);
+                let pose = crate::sim::SimHand::from_grasp(&c.grasp, &sc.hand);
                 let mut sim_params = sc.sim.clone();
                 sim_params.gravity = crate::scenario::GravityMode::Down;
                 let t = Instant::now();

@@ -469,5 +469,6 @@ pub fn override_pose(
         origin_mm: palm.origin,
         axes: palm.axes,
         theta_deg: angles.to_vec(),
+        planned_contacts_mm: Vec::new(),
     })
 }

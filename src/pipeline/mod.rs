@@ -85,6 +85,7 @@ impl GivenGrasp {
             origin_mm: aligned.to_aligned * p,
             axes: [0, 1, 2].map(|i| m.matrix().column(i).into_owned()),
             theta_deg: self.theta_deg.clone(),
+            planned_contacts_mm: Vec::new(),
         })
     }
 }
@@ -360,7 +361,7 @@ pub fn write_outputs(
     }
     if let (Some(dir), Some(pose)) = (&options.export_mjcf, &computed.posed) {
         let aligned = computed.checked_on();
-        let shape = computed.object.shape(aligned);
+        let shape = computed.object.shape(aligned, pose, &scenario.hand);
         let input = export::ExportInput {
             name: &scenario.name,
             object: aligned,
@@ -418,8 +419,8 @@ pub fn check_grasp(
     aligned: &mesh::AlignedObject,
     grasp: &plan::search::Grasp,
 ) -> sim::SimOutcome {
-    let shape = object.shape(aligned);
-    let pose = sim::SimHand::from_grasp(grasp);
+    let pose = sim::SimHand::from_grasp(grasp, &scenario.hand);
+    let shape = object.shape(aligned, &pose, &scenario.hand);
     sim::check_candidate(&object.case(scenario, &pose, &shape))
 }
 
@@ -516,7 +517,11 @@ fn sim_pose(
         )
         .map(|pose| (pose, GraspSource::OverrideAngles, None))
         .map_err(|e| e.to_string()),
-        (None, Some((g, done))) => Ok((sim::SimHand::from_grasp(g), GraspSource::Planner, done)),
+        (None, Some((g, done))) => Ok((
+            sim::SimHand::from_grasp(g, &scenario.hand),
+            GraspSource::Planner,
+            done,
+        )),
         (None, None) => Err("no feasible grasp to check".to_string()),
     }
 }
@@ -556,7 +561,7 @@ fn run_sim(
         Ok(_) if options.no_sim => return (SimReport::not_run("--no-sim"), None, None),
         Ok((pose, source, done)) => (pose, *source, done),
     };
-    let shape = object.shape(aligned);
+    let shape = object.shape(aligned, pose, &scenario.hand);
     let case = object.case(scenario, pose, &shape);
     // The candidate search already checked the chosen grasp: the same case, the same outcome.
     let (mut out, payload, ran) = match done {

@@ -55,6 +55,35 @@ pub struct ObjectShape {
     /// [`object_mass_properties`]): the hull's own, where parry's polyhedron of it misweighs it
     /// and cannot be rebuilt; `None` (every other collider): the collider's, scaled to the mass.
     pub mesh_mass: Option<MeshMass>,
+    /// For a convex decomposition taken in place of the hull of a convex mesh because the hull
+    /// lies off a grasp's planned contacts ([`ObjectShape::true_at`]): how far, at most `[mm]`.
+    pub hull_off_mm: Option<f64>,
+    /// For a convex hull: its face planes, aligned frame, metres (unit outward normal, offset),
+    /// from the hull's own triangles ([`ObjectShape::depth_mm`]).
+    pub hull_planes: Option<std::sync::Arc<[HullPlane]>>,
+}
+
+/// A face plane of a convex hull: unit outward normal and offset (`n · x = d` on the face),
+/// aligned frame, metres.
+pub type HullPlane = (nalgebra::Vector3<f64>, f64);
+
+/// The face planes of the convex hull `(vertices, triangles)` (metres), each through its
+/// triangle and turned to face away from the vertices' centroid (a sliver's winding can come
+/// out inwards in single precision); degenerate triangles are left out.
+fn hull_planes(vertices: &[Vector], triangles: &[[u32; 3]]) -> Vec<HullPlane> {
+    let v64 = |v: &Vector| nalgebra::Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z));
+    let points: Vec<nalgebra::Vector3<f64>> = vertices.iter().map(v64).collect();
+    let centre = points.iter().sum::<nalgebra::Vector3<f64>>() / points.len().max(1) as f64;
+    triangles
+        .iter()
+        .filter_map(|t| {
+            let [a, b, c] = t.map(|i| points.get(i as usize).copied());
+            let (a, b, c) = (a?, b?, c?);
+            let n = (b - a).cross(&(c - a)).try_normalize(1e-15)?;
+            let n = if n.dot(&(centre - a)) > 0.0 { -n } else { n };
+            Some((n, n.dot(&a)))
+        })
+        .collect()
 }
 
 /// A solid's mass distribution, aligned frame, unit density, integrated from its triangles
@@ -106,7 +135,7 @@ pub fn object_mass_properties(object: &ObjectShape, mass_kg: f64) -> MassPropert
 /// count, and for a hull rebuilt from its face planes, the vertex counts before and after.
 /// Serialised as the sentence its [`Display`](std::fmt::Display) writes, e.g.
 /// `convex_decomposition (12 parts)`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ColliderReport {
     /// How the collider was made.
     pub kind: ColliderKind,
@@ -114,6 +143,9 @@ pub struct ColliderReport {
     pub parts: usize,
     /// For a convex hull rebuilt from its face planes ([`ObjectShape::coarsened_from`]).
     pub rebuilt: Option<RebuiltHull>,
+    /// For a decomposition taken because the hull lies off a grasp's planned contacts
+    /// ([`ObjectShape::hull_off_mm`]).
+    pub hull_off_mm: Option<f64>,
 }
 
 /// The vertex counts of a convex hull rebuilt from its face planes.
@@ -138,12 +170,20 @@ impl ColliderReport {
                     .as_convex_polyhedron()
                     .map_or(0, |c| c.points().len()),
             }),
+            hull_off_mm: shape.hull_off_mm,
         }
     }
 }
 
 impl std::fmt::Display for ColliderReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if let Some(off) = self.hull_off_mm {
+            return write!(
+                f,
+                "{} ({} parts, for a convex mesh whose hull lies {off:.1} mm outside a planned contact)",
+                self.kind, self.parts
+            );
+        }
         match self.rebuilt {
             Some(RebuiltHull {
                 from_vertices,
@@ -173,8 +213,27 @@ static SHAPE_CACHE: std::sync::Mutex<Vec<([u8; 32], ObjectShape)>> =
 /// Convex decompositions kept by [`ObjectShape::cached`].
 pub const SHAPE_CACHE_LEN: usize = 16;
 
-/// The digest of what [`ObjectShape::from_mesh`] reads: vertices, triangles and volume.
-fn shape_key(mesh: &Mesh, volume_mm3: f64) -> [u8; 32] {
+/// The shape [`SHAPE_CACHE`] keeps under `key`.
+fn cache_get(key: &[u8; 32]) -> Option<ObjectShape> {
+    let cache = SHAPE_CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    cache.iter().find(|(k, _)| k == key).map(|(_, s)| s.clone())
+}
+
+/// Keeps `shape` under `key` in [`SHAPE_CACHE`] unless a shape is kept there already, dropping
+/// the oldest when full.
+fn cache_put(key: [u8; 32], shape: &ObjectShape) {
+    let mut cache = SHAPE_CACHE.lock().unwrap_or_else(|e| e.into_inner());
+    if !cache.iter().any(|(k, _)| *k == key) {
+        if cache.len() >= SHAPE_CACHE_LEN {
+            cache.remove(0);
+        }
+        cache.push((key, shape.clone()));
+    }
+}
+
+/// The digest of what [`ObjectShape::from_mesh`] reads: vertices, triangles and volume; without
+/// a volume, of what the decomposition alone reads ([`ObjectShape::true_at`]).
+fn shape_key(mesh: &Mesh, volume_mm3: Option<f64>) -> [u8; 32] {
     use sha2::{Digest, Sha256};
     let mut h = Sha256::new();
     for p in &mesh.vertices {
@@ -188,7 +247,10 @@ fn shape_key(mesh: &Mesh, volume_mm3: f64) -> [u8; 32] {
             h.update(i.to_le_bytes());
         }
     }
-    h.update(volume_mm3.to_bits().to_le_bytes());
+    match volume_mm3 {
+        Some(v) => h.update(v.to_bits().to_le_bytes()),
+        None => h.update(b"decomposition"),
+    }
     h.finalize().into()
 }
 
@@ -197,20 +259,13 @@ impl ObjectShape {
     /// (tens of milliseconds) kept for the rest of the process: the same mesh gives the same
     /// shape, bit for bit, either way.
     pub fn cached(mesh: &Mesh, volume_mm3: f64) -> ObjectShape {
-        let key = shape_key(mesh, volume_mm3);
-        let lock = || SHAPE_CACHE.lock().unwrap_or_else(|e| e.into_inner());
-        if let Some((_, s)) = lock().iter().find(|(k, _)| *k == key) {
-            return s.clone();
+        let key = shape_key(mesh, Some(volume_mm3));
+        if let Some(s) = cache_get(&key) {
+            return s;
         }
         let shape = ObjectShape::from_mesh(mesh, volume_mm3);
         if shape.kind == ColliderKind::ConvexDecomposition || shape.coarsened_from.is_some() {
-            let mut cache = lock();
-            if !cache.iter().any(|(k, _)| *k == key) {
-                if cache.len() >= SHAPE_CACHE_LEN {
-                    cache.remove(0);
-                }
-                cache.push((key, shape.clone()));
-            }
+            cache_put(key, &shape);
         }
         shape
     }
@@ -256,15 +311,21 @@ impl ObjectShape {
                     is_revolution,
                     coarsened_from,
                     mesh_mass,
+                    hull_off_mm: None,
+                    hull_planes: Some(hull_planes(vertices, triangles).into()),
                 };
             }
         }
+        Self::decomposition(mesh, &points, is_revolution)
+    }
+
+    /// The convex decomposition (V-HACD) of `mesh`, whose vertices in metres are `points`.
+    fn decomposition(mesh: &Mesh, points: &[Vector], is_revolution: bool) -> ObjectShape {
         let params = VHACDParameters {
             resolution: 64,
             ..VHACDParameters::default()
         };
-        let shape =
-            SharedShape::convex_decomposition_with_params(&points, &mesh.triangles, &params);
+        let shape = SharedShape::convex_decomposition_with_params(points, &mesh.triangles, &params);
         let parts = shape.as_compound().map_or(1, |c| c.shapes().len());
         ObjectShape {
             shape,
@@ -273,8 +334,112 @@ impl ObjectShape {
             is_revolution,
             coarsened_from: None,
             mesh_mass: None,
+            hull_off_mm: None,
+            hull_planes: None,
         }
     }
+
+    /// How deep the deepest of `points_mm` (aligned frame) lies inside this shape's hull
+    /// `[mm]`: the least distance to its face planes ([`ObjectShape::hull_planes`]), 0 for a
+    /// point outside; 0 without points or for a decomposition. The planes are the hull's own
+    /// triangles': parry's polyhedron of it can miss faces (rs_cereal's in one frame, which
+    /// put a point on the box's face 30 mm inside), its face normals can point inwards, and
+    /// its point projection put a point on the Adroit ball's hull 14.9 mm inside it.
+    pub fn depth_mm(&self, points_mm: &[nalgebra::Point3<f64>]) -> f64 {
+        let Some(planes) = &self.hull_planes else {
+            return 0.0;
+        };
+        points_mm
+            .iter()
+            .map(|q| {
+                let p = q.coords * convert::M_PER_MM;
+                let inside = planes
+                    .iter()
+                    .map(|(n, d)| d - n.dot(&p))
+                    .fold(f64::INFINITY, f64::min);
+                if inside.is_finite() {
+                    inside.max(0.0) / convert::M_PER_MM
+                } else {
+                    0.0
+                }
+            })
+            .fold(0.0, f64::max)
+    }
+
+    /// This collider (`self`, of `mesh`), or where it is the hull of a convex mesh lying more
+    /// than `tolerance_mm` outside a body's planned contacts, the mesh's convex decomposition.
+    /// `contacts_mm` are the points where a grasp is planned to touch the object (aligned frame),
+    /// a group per phalanx; a phalanx counts by its least depth ([`beyond_mesh_mm`]): one whose
+    /// other contacts rest on the hull is stopped where planned even if one lies in a groove
+    /// narrower than the finger (as the basketball's seams, 1.4 mm deep), which a single point
+    /// would count in one frame and not another. The volume
+    /// test that takes the hull is global: a bottle whose neck is narrower than its cap is
+    /// within 2 % of its hull, yet a grasp at its neck has phalanges all of whose planned contacts
+    /// lie 1.6–1.8 mm inside the hull, and each phalanx 1 stopped 6–8° short of its plan
+    /// (issue 33).
+    /// Decompositions come from the process-wide cache.
+    pub fn true_at(
+        &self,
+        mesh: &Mesh,
+        contacts_mm: &[Vec<nalgebra::Point3<f64>>],
+        tolerance_mm: f64,
+    ) -> ObjectShape {
+        if self.kind != ColliderKind::ConvexHull {
+            return self.clone();
+        }
+        let least_depth = |body: &Vec<nalgebra::Point3<f64>>| {
+            body.iter()
+                .map(|p| self.depth_mm(std::slice::from_ref(p)))
+                .fold(f64::INFINITY, f64::min)
+        };
+        if !contacts_mm
+            .iter()
+            .any(|body| least_depth(body) > tolerance_mm)
+        {
+            return self.clone();
+        }
+        let off = beyond_mesh_mm(self, mesh, contacts_mm);
+        if off <= tolerance_mm {
+            return self.clone();
+        }
+        let key = shape_key(mesh, None);
+        let parts = cache_get(&key).unwrap_or_else(|| {
+            let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
+            let made = Self::decomposition(mesh, &points, self.is_revolution);
+            cache_put(key, &made);
+            made
+        });
+        ObjectShape {
+            hull_off_mm: Some(off),
+            ..parts
+        }
+    }
+}
+
+/// How far `hull`, the hull of `mesh`, lies beyond the mesh at the planned contacts `[mm]`:
+/// the largest over the bodies (`contacts_mm`, a group per body) of the least over a body's
+/// points of the point's depth in the hull less its distance to the mesh's surface, so that a
+/// contact the plan presses into the object (an extended rule's phalanx) counts only what the
+/// hull adds to the mesh there. 0 where the mesh cannot be made a triangle mesh.
+fn beyond_mesh_mm(
+    hull: &ObjectShape,
+    mesh: &Mesh,
+    contacts_mm: &[Vec<nalgebra::Point3<f64>>],
+) -> f64 {
+    let vertices = mesh.vertices.iter().map(convert::point_m).collect();
+    let Ok(surface) = TriMesh::new(vertices, mesh.triangles.clone()) else {
+        return 0.0;
+    };
+    let beyond = |q: &nalgebra::Point3<f64>| {
+        let p = convert::point_m(q);
+        let to_surface = (surface.project_local_point(p, false).point - p).length();
+        hull.depth_mm(std::slice::from_ref(q)) - f64::from(to_surface) / convert::M_PER_MM
+    };
+    contacts_mm
+        .iter()
+        .filter(|body| !body.is_empty())
+        .map(|body| body.iter().map(beyond).fold(f64::INFINITY, f64::min))
+        .fold(0.0, f64::max)
 }
 
 /// parry's polyhedron of a hull whose volume differs from the hull's own by more than this
@@ -512,6 +677,65 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_hull_that_bridges_a_planned_contact_gives_way_to_the_decomposition() {
+        // A bottle: a body 60 mm across and 300 mm tall, a cone to a neck 28 mm across at
+        // 330-336 mm, a lip 32 mm across to 338 mm. The hull bridges the neck from the cone's
+        // foot (300 mm, r 30) to the lip's top edge (338 mm, r 16); the bridge adds 1.4 % of
+        // the volume, so the volume test takes the hull. The neck at 333 mm (r 14) lies inside
+        // it by the distance from (33, −16) to the line along (38, −14) in the profile:
+        // (16·38 − 33·14) / √(38² + 14²) = 3.605 mm (3.593 on parry's faceted hull).
+        let mesh = crate::objects::revolved(&[
+            (0.0, 60.0),
+            (300.0, 60.0),
+            (330.0, 28.0),
+            (336.0, 28.0),
+            (336.0, 32.0),
+            (338.0, 32.0),
+        ]);
+        let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
+        let hull = ObjectShape::from_mesh(&mesh, volume);
+        assert_eq!(hull.kind, ColliderKind::ConvexHull);
+        let body = nalgebra::Point3::new(30.0, 0.0, 100.0);
+        let neck = nalgebra::Point3::new(14.0, 0.0, 333.0);
+        let outside = nalgebra::Point3::new(40.0, 0.0, 100.0);
+        assert!(hull.depth_mm(&[body, outside]) < 1e-3);
+        let depth = hull.depth_mm(&[body, neck]);
+        assert!((depth - 3.605).abs() < 0.015, "{depth}");
+        // A grasp of the body keeps the hull; one that touches the neck gets the parts.
+        let kept = hull.true_at(&mesh, &[vec![body]], 0.5);
+        assert_eq!(
+            (kept.kind, kept.hull_off_mm),
+            (ColliderKind::ConvexHull, None)
+        );
+        assert_eq!(hull.true_at(&mesh, &[], 0.5).kind, ColliderKind::ConvexHull);
+        let taken = hull.true_at(&mesh, &[vec![body], vec![neck]], 0.5);
+        assert_eq!(taken.kind, ColliderKind::ConvexDecomposition);
+        assert!(taken.parts > 1);
+        assert!((taken.hull_off_mm.unwrap() - depth).abs() < 1e-3);
+        assert!(ColliderReport::of(&taken).to_string().ends_with(
+            "parts, for a convex mesh whose hull lies 3.6 mm outside a planned contact)"
+        ));
+        // A contact the plan presses 2 mm into the body is as deep in the mesh as in the
+        // hull: the hull adds nothing there and stays.
+        let pressed = nalgebra::Point3::new(28.0, 0.0, 100.0);
+        assert!((hull.depth_mm(&[pressed]) - 2.0).abs() < 0.01);
+        assert_eq!(
+            hull.true_at(&mesh, &[vec![body], vec![pressed]], 0.5).kind,
+            ColliderKind::ConvexHull
+        );
+        // Within the tolerance the hull stays.
+        assert_eq!(
+            hull.true_at(&mesh, &[vec![neck]], 3.7).kind,
+            ColliderKind::ConvexHull
+        );
+        // A body with one contact in the neck and another on the hull rests on the hull.
+        assert_eq!(
+            hull.true_at(&mesh, &[vec![neck, body]], 0.5).kind,
+            ColliderKind::ConvexHull
+        );
+    }
+
+    #[test]
     fn a_hulls_own_mass_is_parrys_where_parry_weighs_it_right() {
         // The D40 cylinder and the prism: parry's polyhedron weighs their hulls right, so they
         // keep it (no `mesh_mass`), and the hull's own mass distribution, which the body takes
@@ -567,7 +791,10 @@ mod tests {
         // Another mesh (one vertex moved) is another key.
         let mut moved = mesh.clone();
         moved.vertices[0].x += 1e-3;
-        assert_ne!(shape_key(&moved, volume), shape_key(&mesh, volume));
+        assert_ne!(
+            shape_key(&moved, Some(volume)),
+            shape_key(&mesh, Some(volume))
+        );
         // A convex mesh is not kept (its hull is cheap).
         let prism = crate::objects::prism(40.0, 100.0, 80.0);
         let v = crate::mesh::mass_properties(&prism).volume_mm3;
@@ -642,6 +869,7 @@ mod tests {
             kind: ColliderKind::ConvexDecomposition,
             parts: 12,
             rebuilt: None,
+            hull_off_mm: None,
         };
         assert_eq!(
             serde_json::to_string(&plain).unwrap(),
@@ -654,6 +882,7 @@ mod tests {
                 from_vertices: 1024,
                 to_vertices: 296,
             }),
+            hull_off_mm: None,
         };
         assert_eq!(
             rebuilt.to_string(),

@@ -111,7 +111,7 @@ mod tests {
             1,
             &mut crate::report::StageTimings::default(),
         );
-        let pose = SimHand::from_grasp(&found.grasps[0]);
+        let pose = SimHand::from_grasp(&found.grasps[0], &hand);
         let volume = crate::mesh::mass_properties(&aligned.mesh).volume_mm3;
         let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
         f(&Case {

@@ -138,6 +138,7 @@ mod tests {
             origin_mm: Point3::new(-20.0 - backoff, 0.0, 62.0),
             axes: [-Vector3::x(), -Vector3::y(), Vector3::z()],
             theta_deg: vec![[72.11, 91.81]; 3],
+            planned_contacts_mm: Vec::new(),
         };
         let j1 = Vector2::new(5.8, 36.7);
         let flush = tangent_theta_deg(j1, Vector2::new(-20.0, 0.0), 7.0, 20.0);

@@ -117,6 +117,7 @@ impl Perturbed {
                 origin_mm: moved.into(),
                 axes: case.pose.axes.map(|a| r_inv * a),
                 theta_deg: case.pose.theta_deg.clone(),
+                planned_contacts_mm: Vec::new(),
             },
             params,
             mass_kg: case.mass_kg * p.mass_scale,
@@ -425,6 +426,7 @@ mod tests {
             origin_mm: nalgebra::Point3::new(-20.0, 0.0, 62.0),
             axes: [-Vector3::x(), -Vector3::y(), Vector3::z()],
             theta_deg: vec![[72.11, 91.81]; 3],
+            planned_contacts_mm: Vec::new(),
         };
         let case = Case {
             hand: &hand,

@@ -20,11 +20,19 @@ pub struct SimHand {
     pub axes: [Vector3<f64>; 3],
     /// Planned `[θ1, θ2]` per finger `[deg]`.
     pub theta_deg: Vec<[f64; 2]>,
+    /// Where the plan has the phalanges touch the object, aligned object frame `[mm]`, a group
+    /// per phalanx (its contacts in the finger's planes), in the order of
+    /// [`crate::quality::planned_contacts`]; empty for a pose given by its angles alone. The
+    /// collider is made true there ([`super::ObjectShape::true_at`]). The palm's are left out:
+    /// a plate the width of the hand rests on the rims of a groove its contact point lies in
+    /// (the basketball's seams).
+    pub planned_contacts_mm: Vec<Vec<Point3<f64>>>,
 }
 
 impl SimHand {
-    /// The palm pose and the centre ALS's joint angles of a planned grasp.
-    pub fn from_grasp(g: &crate::plan::search::Grasp) -> SimHand {
+    /// The palm pose, the centre ALS's joint angles and the planned contacts of a grasp planned
+    /// for `hand`.
+    pub fn from_grasp(g: &crate::plan::search::Grasp, hand: &Hand) -> SimHand {
         SimHand {
             origin_mm: g.palm.origin,
             axes: g.palm.axes,
@@ -33,8 +41,26 @@ impl SimHand {
                 .iter()
                 .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
                 .collect(),
+            planned_contacts_mm: by_body(&crate::quality::planned_contacts(g, hand)),
         }
     }
+}
+
+/// The points of `contacts`, a group per phalanx (finger and phalanx), in the order each
+/// first appears; the palm's left out.
+fn by_body(contacts: &[crate::quality::Contact]) -> Vec<Vec<Point3<f64>>> {
+    let mut bodies: Vec<(&str, u8)> = Vec::new();
+    let mut groups: Vec<Vec<Point3<f64>>> = Vec::new();
+    for c in contacts.iter().filter(|c| c.phalanx > 0) {
+        let body = (c.finger.as_str(), c.phalanx);
+        let k = bodies.iter().position(|b| *b == body).unwrap_or_else(|| {
+            bodies.push(body);
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[k].push(Point3::from(c.point_mm));
+    }
+    groups
 }
 
 /// Handles of what the protocol measures.
@@ -760,6 +786,7 @@ mod tests {
             origin_mm: Point3::new(x, 0.0, 40.0),
             axes: [-Vector3::x(), -Vector3::y(), Vector3::z()],
             theta_deg: vec![theta; 3],
+            planned_contacts_mm: Vec::new(),
         }
     }
 

@@ -392,6 +392,12 @@ fn fingerprint(h: &SimHand) -> Vec<u64> {
     for t in &h.theta_deg {
         k.extend(t.iter().map(|v| v.to_bits()));
     }
+    for body in &h.planned_contacts_mm {
+        k.push(body.len() as u64);
+        for c in body {
+            k.extend(c.iter().map(|v| v.to_bits()));
+        }
+    }
     k
 }
 
@@ -646,7 +652,7 @@ fn run_override(
     );
     let outcome = pose.ok().map(|pose| {
         let key = (crate::mesh::GraspAxis::THESIS, fingerprint(&pose));
-        let shape = p.object.shape(aligned);
+        let shape = p.object.shape(aligned, &pose, &p.scenario.hand);
         let o = simulate(
             p,
             &pose,
@@ -674,8 +680,8 @@ fn run_planned(
         std::mem::take(&mut shared.counters),
     ));
     let check = |a: &AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
-        let pose = SimHand::from_grasp(g);
-        let shape = p.object.shape(a);
+        let pose = SimHand::from_grasp(g, &p.scenario.hand);
+        let shape = p.object.shape(a, &pose, &p.scenario.hand);
         let key = (a.axis, fingerprint(&pose));
         let (sims, counters) = &mut *cache.borrow_mut();
         let o = simulate(p, &pose, &shape, key, sims, counters);
@@ -703,13 +709,13 @@ fn run_planned(
     shared.counters.plans += 1;
     let best = selection.chosen().and_then(|c| {
         let a = &selection.axes[c.axis_plan].aligned;
-        let pose = SimHand::from_grasp(&c.grasp);
+        let pose = SimHand::from_grasp(&c.grasp, &p.scenario.hand);
         let key = (a.axis, fingerprint(&pose));
         let o = shared.sims.get(&key).cloned()?;
         Some(sampled(
             p,
             &pose,
-            &p.object.shape(a),
+            &p.object.shape(a, &pose, &p.scenario.hand),
             key,
             o,
             &mut shared.sims,

@@ -124,6 +124,7 @@ fn rapier_tolerances_are_pinned_at_hand_scale() {
             nalgebra::Vector3::z(),
         ],
         theta_deg: vec![[72.1, 91.8]; 3],
+        planned_contacts_mm: Vec::new(),
     };
     let scene = build(&Case {
         hand: &s.hand,
@@ -293,7 +294,7 @@ fn cylinder_case<R>(
         1,
         &mut grasp_sim::report::StageTimings::default(),
     );
-    let pose = SimHand::from_grasp(&found.grasps[0]);
+    let pose = SimHand::from_grasp(&found.grasps[0], &hand);
     let volume = grasp_sim::mesh::mass_properties(&aligned.mesh).volume_mm3;
     let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
     f(&Case {
