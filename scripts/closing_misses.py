@@ -113,6 +113,13 @@ def main():
         near = sum(r["class"] in ("on_plan", "near_within") for r in rows)
         print(f"- phalanges the plan gives a contact: {len(planned)}, on plan {pon} "
               f"({100.0 * pon / max(len(planned), 1):.0f} %)")
+        # A phalanx the plan gives no contact (a pinch's phalanx 1) that never touched and ends
+        # within 5 deg of its bend is where the plan put it: clear of the object.
+        clear = sum(not r["planned_contact"] and not r["ever"] and abs(r["error_deg"]) <= 5.0
+                    for r in rows)
+        on = sum(r["class"] == "on_plan" for r in rows)
+        print(f"- on plan, or planned clear and ending clear within 5 deg: {on + clear} of {n} "
+              f"({100.0 * (on + clear) / max(n, 1):.0f} %; {clear} planned clear)")
         print(f"- within 5 deg and touching or within {NEAR_MM} mm: {near} of {n} "
               f"({100.0 * near / max(n, 1):.0f} %)\n")
 

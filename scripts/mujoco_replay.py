@@ -275,9 +275,15 @@ def replay(scene_dir, directions=None, trace=False):
     closing_turn = quat_angle_deg(q0c, qcc)
     max_shift = proto.get("max_closing_shift_mm", math.inf)
     pushed = closing_shift > max_shift
+    # Nor is a hold that left fewer phalanges on the object within 5 deg of their planned bend
+    # than `min_on_plan_fraction` asks (as grasp-sim's).
+    on_plan = on_plan_count(m, d, proto, obj, planned) if planned else None
+    fraction = proto.get("min_on_plan_fraction", 0.0)
+    off_plan = on_plan is not None and on_plan < math.ceil(fraction * 2 * n - 1e-9)
     closing = {
         "closed": closed, "t0": t0, "pc": pc, "rc": rc, "pushed": pushed,
         "closing_shift_mm": closing_shift, "closing_turn_deg": closing_turn,
+        "closing_off_plan": off_plan, "phalanges_on_plan": on_plan,
     }
     if directions is None:
         return hold(m, d, proto, gravity, hold_steps, closing)
@@ -306,6 +312,7 @@ def replay(scene_dir, directions=None, trace=False):
 def hold(m, d, proto, gravity, hold_steps, closing):
     """Gravity on along `gravity` (m/s²) for the whole hold from the closed state in `d`."""
     closed, t0, pc, rc, pushed = (closing[k] for k in ("closed", "t0", "pc", "rc", "pushed"))
+    off_plan = closing["closing_off_plan"]
     palm = m.body("palm").id
     obj = m.body("object").id
     dt = m.opt.timestep
@@ -329,7 +336,7 @@ def hold(m, d, proto, gravity, hold_steps, closing):
         if (b1 == obj and b2 in hand_bodies) or (b2 == obj and b1 in hand_bodies):
             in_contact = True
     if (translation <= proto["hold_translation_mm"] and rotation <= proto["hold_rotation_deg"]
-            and not pushed):
+            and not pushed and not off_plan):
         verdict = "hold"
     elif in_contact:
         verdict = "slip"
@@ -349,7 +356,29 @@ def hold(m, d, proto, gravity, hold_steps, closing):
         "closing_shift_mm": closing["closing_shift_mm"],
         "closing_turn_deg": closing["closing_turn_deg"],
         "closing_pushed": pushed,
+        "closing_off_plan": closing["closing_off_plan"],
+        "phalanges_on_plan": closing["phalanges_on_plan"],
     }
+
+
+def on_plan_count(m, d, proto, obj, planned):
+    """Phalanges touching the object with their joint within 5 deg of the planned bend."""
+    touching = set()
+    for c in d.contact[: d.ncon]:
+        b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
+        if b1 == obj:
+            touching.add(b2)
+        elif b2 == obj:
+            touching.add(b1)
+    count = 0
+    for k, f in enumerate(proto["fingers"]):
+        for j in (0, 1):
+            a = 2 * k + j
+            bend = float(d.qpos[m.jnt_qposadr[m.actuator_trnid[a, 0]]])
+            if (m.body(f"{f}_phalanx_{j + 1}").id in touching
+                    and abs(bend - planned[a]) <= math.radians(5.0)):
+                count += 1
+    return count
 
 
 def main(argv):

@@ -213,7 +213,8 @@ def main():
                 try:
                     m = mujoco_replay.replay(scene)
                     r["mujoco"] = {k: m.get(k) for k in ("verdict", "translation_mm", "rotation_deg",
-                                                         "closing_shift_mm", "closing_pushed")}
+                                                         "closing_shift_mm", "closing_pushed",
+                                                         "closing_off_plan", "phalanges_on_plan")}
                 except Exception as e:  # noqa: BLE001 - a scene MuJoCo refuses is a finding
                     r["mujoco"] = {"verdict": f"error: {str(e).splitlines()[0][:80]}"}
     (out / "results.json").write_text(json.dumps(results, indent=1, sort_keys=True))

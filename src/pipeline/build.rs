@@ -190,6 +190,7 @@ pub(super) fn checked_report(
             rotation_deg: case.params.hold.hold_rotation_deg,
             penetration_mm: case.params.hold.max_penetration_mm,
             closing_shift_mm: case.params.hold.max_closing_shift_mm,
+            on_plan_fraction: case.params.hold.min_on_plan_fraction,
         }),
     }
 }

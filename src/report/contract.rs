@@ -504,6 +504,9 @@ pub struct HoldLimits {
     pub penetration_mm: f64,
     /// How far the closing may push the object (`[sim] max_closing_shift_mm`) `[mm]`.
     pub closing_shift_mm: f64,
+    /// The least share of the hand's phalanges that must end the closing on their plan
+    /// (`[sim] min_on_plan_fraction`).
+    pub on_plan_fraction: f64,
 }
 
 impl SimReport {

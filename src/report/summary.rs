@@ -306,12 +306,22 @@ impl RunReport {
             SimVerdict::Ran(Verdict::Hold) => {
                 format!("{grasp}: HELD under gravity (moved {moved})")
             }
-            SimVerdict::Ran(Verdict::Slip) => match (penetrated_slip(sim), pushed_slip(sim)) {
-                (None, Some(c)) => format!(
+            SimVerdict::Ran(Verdict::Slip) => match (penetrated_slip(sim), failed_closing(sim)) {
+                (None, Some(c)) if c.pushed => format!(
                     "{grasp}: NOT held as planned: the closing pushed the object {:.1} mm, more \
                      than max_closing_shift_mm ({} mm), before the fingers caught it, so the \
                      grasp that held is not the one planned (the object then moved {moved})",
                     c.shift_mm, c.max_shift_mm
+                ),
+                (None, Some(c)) => format!(
+                    "{grasp}: NOT held as planned: only {} of {} phalanges ended the closing on \
+                     the object within {} deg of their plan, fewer than min_on_plan_fraction \
+                     asks ({}), so the grasp that held is not the one planned (the object then \
+                     moved {moved})",
+                    c.phalanges_on_plan,
+                    2 * c.fingers.len(),
+                    crate::sim::protocol::WITHIN_PLAN_DEG,
+                    c.min_on_plan
                 ),
                 (Some((depth, limit)), _) => format!(
                     "{grasp}: NOT held: a finger ended the closing {depth:.2} mm inside the \
@@ -355,10 +365,11 @@ fn penetrated_slip(sim: &SimReport) -> Option<(f64, f64)> {
 }
 
 /// For a `slip` that moved within the hold limits in every direction and left no finger too
-/// deep: it is a slip because the closing pushed the object farther than its bound.
-fn pushed_slip(sim: &SimReport) -> Option<&crate::sim::ClosingOutcome> {
+/// deep: it is a slip because the closing pushed the object farther than its bound, or left
+/// fewer phalanges on their plan than `min_on_plan_fraction` asks.
+fn failed_closing(sim: &SimReport) -> Option<&crate::sim::ClosingOutcome> {
     let l = sim.limits?;
-    let c = sim.closing.as_ref().filter(|c| c.pushed)?;
+    let c = sim.closing.as_ref().filter(|c| c.pushed || c.off_plan)?;
     let within = sim.directions.iter().all(|d| {
         d.verdict != Verdict::Slip
             || (d.translation_mm <= l.translation_mm && d.rotation_deg <= l.rotation_deg)
@@ -392,9 +403,17 @@ pub fn closing_line(c: &crate::sim::ClosingOutcome) -> String {
     }
     let phalanges = 2 * c.fingers.len();
     s += &format!(
-        "; {} of {phalanges} phalanges end on the object within {} deg of their plan",
+        "; {} of {phalanges} phalanges end on the object within {} deg of their plan{}",
         c.phalanges_on_plan,
-        crate::sim::protocol::WITHIN_PLAN_DEG
+        crate::sim::protocol::WITHIN_PLAN_DEG,
+        if c.off_plan {
+            format!(
+                " (fewer than {}: not a hold of the planned grasp)",
+                c.min_on_plan
+            )
+        } else {
+            String::new()
+        }
     );
     match &c.first_touch {
         Some(t) if t.phalanx == 0 => s += &format!("; the palm touched first, at {:.3} s", t.at_s),

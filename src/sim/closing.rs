@@ -69,11 +69,13 @@ pub(super) struct Closing {
 }
 
 impl Closing {
-    /// True if the closing failed: it pushed the object beyond `max_closing_shift_mm` or left a
-    /// finger deeper than `max_penetration_mm` (or a depth that is no number). Such a grasp is
-    /// no `hold` whatever gravity does.
+    /// True if the closing failed: it pushed the object beyond `max_closing_shift_mm`, left
+    /// fewer phalanges on their plan than `min_on_plan_fraction` asks, or left a finger deeper
+    /// than `max_penetration_mm` (or a depth that is no number). Such a grasp is no `hold`
+    /// whatever gravity does.
     pub(super) fn failed(&self, params: &super::params::SimParams) -> bool {
         self.outcome.pushed
+            || self.outcome.off_plan
             || self.penetration_mm.is_nan()
             || self.penetration_mm > params.hold.max_penetration_mm
     }
@@ -539,6 +541,7 @@ fn closing_outcome(
         .filter(|on| *on)
         .count();
     let max_shift_mm = case.params.hold.max_closing_shift_mm;
+    let min_on_plan = min_on_plan(case.params.hold.min_on_plan_fraction, 2 * fingers.len());
     ClosingOutcome {
         shift_mm,
         turn_deg,
@@ -549,7 +552,17 @@ fn closing_outcome(
         palm_touching: end.palm,
         fingers,
         phalanges_on_plan,
+        min_on_plan,
+        off_plan: phalanges_on_plan < min_on_plan,
     }
+}
+
+/// The least number of `phalanges` that must end on their plan: `fraction` of them, rounded
+/// up (half of six is three; a hair over half is four).
+pub(super) fn min_on_plan(fraction: f64, phalanges: usize) -> usize {
+    // A fraction times a count is exact for the fractions a user writes (0.5 × 6 = 3); the
+    // tolerance keeps 1/3 × 6 at 2 rather than 3.
+    ((fraction * phalanges as f64) - 1e-9).ceil().max(0.0) as usize
 }
 
 /// The hand's and the object's motion relative to the palm: (fastest joint `[rad/s]`, object

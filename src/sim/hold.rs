@@ -177,8 +177,8 @@ impl EarlyWatch<'_> {
         }
         self.hand_was_still = hand_still;
         let remaining_s = (hold_steps - steps) as f64 * params.solver.timestep_s;
-        // A grasp the closing left too deep in the object, or pushed too far, is `slip`
-        // whatever it does while on the hand.
+        // A grasp the closing left too deep in the object, pushed too far or left off its
+        // plan is `slip` whatever it does while on the hand.
         match rule.decide(
             samples,
             &self.frame,
@@ -266,6 +266,7 @@ fn direction_outcome(
         closing_translation_mm: (pc - p0).norm(),
         closing_rotation_deg: closing.q0.angle_to(&qc).to_degrees(),
         closing_pushed: closing.outcome.pushed,
+        closing_off_plan: closing.outcome.off_plan,
         closing_penetration_mm: closing.penetration_mm,
         closed_at_s: closing.steps as f64 * dt,
         joint_error_deg,

@@ -61,6 +61,10 @@ pub struct DirectionOutcome {
     /// True if and only if the closing pushed the object farther than `max_closing_shift_mm`:
     /// then the verdict is not `hold` (issue 33), whatever the hold did.
     pub closing_pushed: bool,
+    /// True if and only if fewer phalanges ended the closing on their plan than
+    /// `min_on_plan_fraction` asks: then the verdict is not `hold` (issue 33), whatever the
+    /// hold did.
+    pub closing_off_plan: bool,
     /// Deepest penetration of a finger or the palm into the object at the end of closing `[mm]`
     /// (rapier's contact depth): a grasp that holds only because a finger passed into the object
     /// shows here (issue 14).
@@ -215,6 +219,12 @@ pub struct ClosingOutcome {
     /// Phalanges that end the closing touching the object within [`WITHIN_PLAN_DEG`] of their
     /// planned bend.
     pub phalanges_on_plan: usize,
+    /// The least `phalanges_on_plan` for a hold of the planned grasp: `[sim]
+    /// min_on_plan_fraction` of the hand's phalanges, rounded up.
+    pub min_on_plan: usize,
+    /// True if and only if `phalanges_on_plan` is below `min_on_plan`: the object was caught
+    /// by a different grasp from the one planned, and the verdict is not `hold`.
+    pub off_plan: bool,
 }
 
 /// A phalanx ends the closing "on its plan" when it touches the object and its joint is within
@@ -318,6 +328,8 @@ mod tests {
             palm_touching: false,
             fingers: vec![finger("finger_1", [1.0, -3.5]), finger("thumb", [3.0, 2.0])],
             phalanges_on_plan: 4,
+            min_on_plan: 2,
+            off_plan: false,
         };
         assert_eq!(c.worst_joint(), Some(("finger_1", 2, -3.5)));
         assert_eq!(

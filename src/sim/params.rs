@@ -53,6 +53,10 @@ impl HandJoints {
 /// The default of `[sim] max_closing_shift_mm` `[mm]` (docs/SIM.md, "What the closing does").
 pub const DEFAULT_MAX_CLOSING_SHIFT_MM: f64 = 5.0;
 
+/// The default of `[sim] min_on_plan_fraction`: half the hand's phalanges (docs/SIM.md, "A
+/// closing that leaves most phalanges off their plan").
+pub const DEFAULT_MIN_ON_PLAN_FRACTION: f64 = 0.5;
+
 /// Physics check parameters (DESIGN.md section 5); used by the physics check. Each field of a
 /// group is the `[sim]` key of the same name.
 #[derive(Clone, PartialEq, Deserialize, serde::Serialize)]
@@ -302,6 +306,12 @@ pub struct HoldParams {
     /// until the other fingers caught it, a different grasp from the one planned, and the
     /// verdict is `slip` (`closing_pushed`), so the candidate search moves on as for a slip.
     pub max_closing_shift_mm: f64,
+    /// Least share of the hand's phalanges that must end the closing on the object within
+    /// 5° of their planned bend (`phalanges_on_plan`) for the grasp to count as a hold of the
+    /// planned grasp (issue 33): with fewer, the object was caught by a different grasp from
+    /// the one planned, and the verdict is `slip` (`closing_off_plan`), so the candidate search
+    /// moves on as for a slip. 0 turns the rule off; 1 asks for every phalanx.
+    pub min_on_plan_fraction: f64,
     /// Under the `fast` protocol, a closing that pushed the object beyond
     /// `max_closing_shift_mm` or left a finger deeper than `max_penetration_mm` decides the
     /// check at once (`[sim] closing_decides`, issue 35; off by default): no direction is
@@ -321,6 +331,7 @@ impl Default for HoldParams {
             hold_rotation_deg: 5.0,
             max_penetration_mm: 2.0,
             max_closing_shift_mm: DEFAULT_MAX_CLOSING_SHIFT_MM,
+            min_on_plan_fraction: DEFAULT_MIN_ON_PLAN_FRACTION,
             closing_decides: false,
         }
     }
@@ -459,6 +470,7 @@ mod flat {
         pub(super) max_checked: usize,
         pub(super) max_penetration_mm: f64,
         pub(super) max_closing_shift_mm: f64,
+        pub(super) min_on_plan_fraction: f64,
         pub(super) closing_decides: bool,
         pub(super) balanced_squeeze: bool,
         pub(super) approach: Approach,
@@ -518,6 +530,7 @@ mod flat {
                     hold_rotation_deg: s.hold_rotation_deg,
                     max_penetration_mm: s.max_penetration_mm,
                     max_closing_shift_mm: s.max_closing_shift_mm,
+                    min_on_plan_fraction: s.min_on_plan_fraction,
                     closing_decides: s.closing_decides,
                 },
                 early: super::EarlyParams {
@@ -583,6 +596,7 @@ mod flat {
                 max_checked: s.selection.max_checked,
                 max_penetration_mm: s.hold.max_penetration_mm,
                 max_closing_shift_mm: s.hold.max_closing_shift_mm,
+                min_on_plan_fraction: s.hold.min_on_plan_fraction,
                 closing_decides: s.hold.closing_decides,
                 balanced_squeeze: s.fingers.balanced_squeeze,
                 approach: s.closing.approach,
@@ -680,6 +694,13 @@ impl SimParams {
             return Err((
                 "sim.motor_damping_nms_per_rad",
                 format!("must be zero or positive, got {damping}"),
+            ));
+        }
+        let share = self.hold.min_on_plan_fraction;
+        if !(0.0..=1.0).contains(&share) {
+            return Err((
+                "sim.min_on_plan_fraction",
+                format!("must be in 0..=1 (a share of the hand's phalanges), got {share}"),
             ));
         }
         if self.hold.closing_decides && self.protocol == Protocol::Full {

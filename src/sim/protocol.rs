@@ -189,6 +189,8 @@ fn summarise(
             palm_touching: false,
             fingers: Vec::new(),
             phalanges_on_plan: 0,
+            min_on_plan: 0,
+            off_plan: false,
         },
         closed_poses: Vec::new(),
         robust: None,

@@ -91,6 +91,38 @@ fn equal_torques_push_the_d40_towards_the_thumb() {
 }
 
 #[test]
+fn a_hold_with_most_phalanges_off_their_plan_is_not_the_planned_grasp() {
+    // The same equal-torque closing pushes the D40 under 5 mm, within `max_closing_shift_mm`,
+    // and the object stays in the hand under gravity; but it ends held by a grasp other than
+    // the one planned: fewer than half of the six phalanges end on the object within 5° of
+    // their plan. By default that is no hold (`closing_off_plan`, the verdict `slip`) ...
+    let mut params = crate::squeeze_closing();
+    params.fingers.balanced_squeeze = false;
+    assert_eq!(params.hold.min_on_plan_fraction, 0.5);
+    let out = d40_backed_off(0.0, &params);
+    let c = &out.closing;
+    assert!(!c.pushed, "{c:?}");
+    assert_eq!(c.min_on_plan, 3);
+    assert!(c.off_plan && c.phalanges_on_plan < 3, "{c:?}");
+    assert_eq!(out.verdict, Verdict::Slip, "{:?}", out.directions);
+    for d in &out.directions {
+        assert!(d.closing_off_plan && !d.closing_pushed);
+        assert!(d.translation_mm <= params.hold.hold_translation_mm, "{d:?}");
+    }
+    // ... with the rule off, the same closing is judged by the hold alone and holds ...
+    let mut off = params.clone();
+    off.hold.min_on_plan_fraction = 0.0;
+    let loose = d40_backed_off(0.0, &off);
+    assert_eq!(loose.closing.phalanges_on_plan, c.phalanges_on_plan);
+    assert!(!loose.closing.off_plan && loose.closing.min_on_plan == 0);
+    assert_eq!(loose.verdict, Verdict::Hold, "{:?}", loose.directions);
+    // ... and the balanced closing of the same grasp is on its plan and holds.
+    let balanced = d40_backed_off(0.0, &SimParams::default());
+    assert!(!balanced.closing.off_plan, "{:?}", balanced.closing);
+    assert_eq!(balanced.verdict, Verdict::Hold);
+}
+
+#[test]
 fn a_palm_backed_off_10_mm_is_reported_and_bounded() {
     // The palm 10 mm off the object, the plan's angles commanded as they are (no refinement by
     // the contact, the default): the fingers pull the object to it as they close. The shift is
@@ -236,6 +268,8 @@ fn the_summary_and_json_say_what_the_closing_did() {
         "palm_touching",
         "fingers",
         "phalanges_on_plan",
+        "min_on_plan",
+        "off_plan",
     ] {
         assert!(!c[key].is_null(), "sim.closing.{key} missing: {c}");
     }
@@ -256,7 +290,9 @@ fn the_summary_and_json_say_what_the_closing_did() {
         }
     }
     assert_eq!(r["sim"]["limits"]["closing_shift_mm"], 5.0);
+    assert_eq!(r["sim"]["limits"]["on_plan_fraction"], 0.5);
     assert!(r["sim"]["directions"][0]["closing_pushed"].is_boolean());
+    assert!(r["sim"]["directions"][0]["closing_off_plan"].is_boolean());
     let shift = c["shift_mm"].as_f64().unwrap();
     let text = crate::succeed(crate::grasp_sim().arg("scenarios/cylinder_d40.toml"));
     let text = String::from_utf8(text.stdout).unwrap();
