@@ -631,6 +631,17 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_least_on_plan_is_the_fraction_of_the_phalanges_rounded_up() {
+        assert_eq!(min_on_plan(0.5, 6), 3);
+        assert_eq!(min_on_plan(0.51, 6), 4);
+        assert_eq!(min_on_plan(1.0 / 3.0, 6), 2);
+        assert_eq!(min_on_plan(0.0, 6), 0);
+        assert_eq!(min_on_plan(1.0, 6), 6);
+        assert_eq!(min_on_plan(0.5, 8), 4);
+        assert_eq!(min_on_plan(0.5, 5), 3);
+    }
+
+    #[test]
     fn the_stall_rule_needs_every_speed_below_its_bound() {
         // 0.02 rad/s for the joints, 0.5 mm/s and 0.01 rad/s for the object.
         assert!(STALL.quiet((0.019, 0.49, 0.009)));

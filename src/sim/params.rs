@@ -925,6 +925,14 @@ mod tests {
         );
         assert_eq!(check("timestep_s = 0.5"), Err("sim.timestep_s"));
         assert_eq!(check("rest_margin = 1.5"), Err("sim.rest_margin"));
+        assert_eq!(check("min_on_plan_fraction = 1.0"), Ok(()));
+        assert_eq!(check("min_on_plan_fraction = 0.0"), Ok(()));
+        for bad in ["1.5", "-0.1", "nan"] {
+            assert_eq!(
+                check(&format!("min_on_plan_fraction = {bad}")),
+                Err("sim.min_on_plan_fraction")
+            );
+        }
         assert_eq!(check("override_index = 2"), Err("sim.override_index"));
         assert_eq!(
             check("override_angles = [[90.0, 90.0]]\nsqueeze2_deg = -1.0"),
