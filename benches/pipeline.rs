@@ -13,6 +13,9 @@
 //!   and the chapter 4 object, from the contacts at the end of the `down` check's closing
 //!   (`sim_*`) and from the planned contacts (`planned_*`), beside that same `down` check
 //!   (`check_down_*`), so the ratio comes from one run.
+//! - `support_scan/*`: the support point of a convex polyhedron of 256 and 1,024 points (a
+//!   LIBERO bottle's hull part has 300–1,100) towards 4,096 directions, by parry's scan
+//!   (`parry_*`) and by the object's hulls in the scene (`lanes_*`, `sim::fast_hull`).
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use grasp_sim::hand::Hand;
@@ -246,8 +249,45 @@ fn bench_quality(c: &mut Criterion) {
     g.finish();
 }
 
+fn bench_support_scan(c: &mut Criterion) {
+    use grasp_sim::sim::fast_hull::FastHull;
+    use rapier3d::parry::math::Vector;
+    use rapier3d::parry::shape::{ConvexPolyhedron, SupportMap};
+    let mut g = c.benchmark_group("support_scan");
+    let mut s = 1_u32;
+    let mut r = move || {
+        s = s.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (s >> 8) as f32 / (1 << 24) as f32 - 0.5
+    };
+    let dirs: Vec<Vector> = (0..4096).map(|_| Vector::new(r(), r(), r())).collect();
+    for n in [256_usize, 1024] {
+        // Points on a sphere: every one is a vertex of the hull.
+        let points: Vec<Vector> = (0..n)
+            .map(|_| Vector::new(r(), r(), r()).normalize())
+            .collect();
+        let poly = ConvexPolyhedron::from_convex_hull(&points).unwrap();
+        let fast = FastHull::new(poly.clone());
+        g.bench_function(format!("parry_{n}"), |b| {
+            b.iter(|| {
+                dirs.iter()
+                    .map(|d| poly.local_support_point(*d).x)
+                    .sum::<f32>()
+            })
+        });
+        g.bench_function(format!("lanes_{n}"), |b| {
+            b.iter(|| {
+                dirs.iter()
+                    .map(|d| fast.local_support_point(*d).x)
+                    .sum::<f32>()
+            })
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    bench_support_scan,
     bench_slice,
     bench_kinematics,
     bench_plan,

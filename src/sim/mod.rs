@@ -41,6 +41,7 @@ pub mod contacts;
 pub mod convert;
 pub mod dispatcher;
 pub mod early;
+pub mod fast_hull;
 pub mod flight;
 pub mod hand_shapes;
 pub mod hold;
