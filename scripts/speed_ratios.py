@@ -54,17 +54,18 @@ def load():
     return " ".join(pathlib.Path("/proc/loadavg").read_text().split()[:3])
 
 
-def check(binary, scenario, keys, tmp, export=None):
+def check(binary, scenario, keys, tmp, export=None, env=None):
     """grasp-sim's JSON `sim` of `scenario` with `keys` in its [sim]."""
     f = pathlib.Path(tmp) / pathlib.Path(scenario).name
     f.write_text(with_sim(scenario, keys))
     cmd = [binary, "--json", str(f)]
     if export is not None:
         cmd[1:1] = ["--export-mjcf", str(export)]
-    p = subprocess.run(cmd, capture_output=True, text=True)
+    p = subprocess.run(cmd, capture_output=True, text=True,
+                       env=None if env is None else {**os.environ, **env})
     if p.returncode == 2:
         sys.exit(p.stderr)
-    return json.loads(p.stdout.splitlines()[0])["sim"]
+    return json.loads(p.stdout.splitlines()[0]).get("sim")
 
 
 def parse_variants(specs):
@@ -152,20 +153,15 @@ def batch(a, keys, tmp, name):
             "load": f"{l0} → {load()}", "verdicts": verdicts, "sim_ms": sim_ms}
 
 
-def export_six(binary, scenario, keys, tmp):
+def export_six(binary, scenario, tmp):
     """grasp-sim's run of `scenario` in six directions with its reported grasp's scene exported:
-    (the scene's directory or None when no grasp was checked, the JSON's `sim`)."""
+    (the scene's directory, or None when no grasp was checked; the JSON's `sim`). One thread, so
+    that `sim.wall_ms` is the physics' CPU time, as a batch worker's is."""
     d = pathlib.Path(tmp) / "mj_export"
     d.mkdir(exist_ok=True)
-    f = d / pathlib.Path(scenario).name
-    f.write_text(with_sim(scenario, {**keys, "gravity": '"six"'}))
-    # One thread, so that `sim.wall_ms` is the physics' CPU time, as a batch worker's is.
-    p = subprocess.run([binary, "--export-mjcf", str(d / "scenes"), "--json", str(f)],
-                       capture_output=True, text=True, env={**os.environ, "RAYON_NUM_THREADS": "1"})
-    if p.returncode == 2:
-        sys.exit(p.stderr)
-    sim = json.loads(p.stdout.splitlines()[0]).get("sim") or {}
-    scene = d / "scenes" / f.stem
+    sim = check(binary, scenario, {"gravity": '"six"'}, d, d / "scenes",
+                {"RAYON_NUM_THREADS": "1"}) or {}
+    scene = d / "scenes" / pathlib.Path(scenario).stem
     return (scene if (scene / "scene.xml").is_file() else None), sim
 
 
@@ -182,7 +178,7 @@ def batch_mujoco(a, tmp):
     for s in sorted(pathlib.Path(a.batch_dir).glob("*.toml")):
         if any(k in s.stem for k in a.skip):
             continue
-        scene, sim = export_six(a.binary, s, {}, tmp)
+        scene, sim = export_six(a.binary, s, tmp)
         if scene is not None and sim.get("wall_ms") is not None:
             scenes.append(scene)
             rapier_ms += sim["wall_ms"]

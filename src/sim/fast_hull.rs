@@ -60,29 +60,29 @@ impl Lanes {
     /// is the first vector whose product equals the largest. Two passes over the lanes: the
     /// largest product, then the first lane equal to it. A direction with a NaN or an infinity
     /// gives parry's scalar scan, whose answer NaNs decide.
-    fn argmax(&self, dir: Vector, scalar: &[Vector]) -> usize {
+    fn argmax(&self, dir: Vector) -> usize {
         if !(dir.x.is_finite() && dir.y.is_finite() && dir.z.is_finite()) {
-            return scalar_argmax(dir, scalar);
+            return self.scalar_argmax(dir);
         }
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx") {
             // SAFETY: the CPU has AVX (checked just above), all the function asks.
-            return unsafe { self.argmax_avx(dir, scalar) };
+            return unsafe { self.argmax_avx(dir) };
         }
-        self.argmax_lanes(dir, scalar)
+        self.argmax_lanes(dir)
     }
 
     /// [`Self::argmax_lanes`] compiled for AVX: eight lanes in one register. The same
     /// operations (AVX adds no fused multiply-add), so the same answer.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx")]
-    unsafe fn argmax_avx(&self, dir: Vector, scalar: &[Vector]) -> usize {
-        self.argmax_lanes(dir, scalar)
+    unsafe fn argmax_avx(&self, dir: Vector) -> usize {
+        self.argmax_lanes(dir)
     }
 
     /// The two passes of [`Self::argmax`] for a finite direction.
     #[inline(always)]
-    fn argmax_lanes(&self, dir: Vector, scalar: &[Vector]) -> usize {
+    fn argmax_lanes(&self, dir: Vector) -> usize {
         let (dx, dy, dz) = (dir.x, dir.y, dir.z);
         let chunks = self.x.iter().zip(&self.y).zip(&self.z);
         let mut best = [f32::NEG_INFINITY; LANES];
@@ -112,21 +112,27 @@ impl Lanes {
             }
         }
         // No product is finite (no finite hull gives that): parry's answer.
-        scalar_argmax(dir, scalar)
+        self.scalar_argmax(dir)
     }
-}
 
-/// parry's scan, for what the lanes leave to it.
-fn scalar_argmax(dir: Vector, v: &[Vector]) -> usize {
-    let mut best = 0;
-    let mut best_dot = v[0].dot(dir);
-    for (i, p) in v.iter().enumerate().skip(1) {
-        let d = p.dot(dir);
-        if d > best_dot {
-            (best_dot, best) = (d, i);
-        }
+    /// The `i`th vector, as it was given.
+    fn get(&self, i: usize) -> Vector {
+        let (c, l) = (i / LANES, i % LANES);
+        Vector::new(self.x[c][l], self.y[c][l], self.z[c][l])
     }
-    best
+
+    /// parry's scan, one vector at a time, for what the lanes leave to it.
+    fn scalar_argmax(&self, dir: Vector) -> usize {
+        let mut best = 0;
+        let mut best_dot = self.get(0).dot(dir);
+        for i in 1..self.len {
+            let d = self.get(i).dot(dir);
+            if d > best_dot {
+                (best_dot, best) = (d, i);
+            }
+        }
+        best
+    }
 }
 
 /// A convex polyhedron whose support point and support face are found by lane scans.
@@ -135,25 +141,17 @@ pub struct FastHull {
     inner: ConvexPolyhedron,
     points: Lanes,
     normals: Lanes,
-    /// The faces' normals, for the scalar fallback.
-    face_normals: Vec<Vector>,
 }
 
 impl FastHull {
     /// `inner` with its points and face normals laid out in lanes.
     pub fn new(inner: ConvexPolyhedron) -> FastHull {
-        let face_normals: Vec<Vector> = inner.faces().iter().map(|f| f.normal).collect();
+        let normals: Vec<Vector> = inner.faces().iter().map(|f| f.normal).collect();
         FastHull {
             points: Lanes::new(inner.points()),
-            normals: Lanes::new(&face_normals),
-            face_normals,
+            normals: Lanes::new(&normals),
             inner,
         }
-    }
-
-    /// The polyhedron inside.
-    pub fn polyhedron(&self) -> &ConvexPolyhedron {
-        &self.inner
     }
 }
 
@@ -177,7 +175,7 @@ pub fn with_fast_hulls(shape: &SharedShape) -> SharedShape {
 impl SupportMap for FastHull {
     #[inline]
     fn local_support_point(&self, dir: Vector) -> Vector {
-        self.inner.points()[self.points.argmax(dir, self.inner.points())]
+        self.inner.points()[self.points.argmax(dir)]
     }
 }
 
@@ -185,7 +183,7 @@ impl PolygonalFeatureMap for FastHull {
     /// parry's `ConvexPolyhedron::local_support_feature` with the face scan in lanes.
     fn local_support_feature(&self, dir: Vector, out_feature: &mut PolygonalFeature) {
         let p = &self.inner;
-        let best_fid = self.normals.argmax(dir, &self.face_normals);
+        let best_fid = self.normals.argmax(dir);
         let face = &p.faces()[best_fid];
         let i1 = face.first_vertex_or_edge as usize;
         let num_vertices = face.num_vertices_or_edges.min(4) as usize;
@@ -385,6 +383,10 @@ mod tests {
             Vector::Z,
             Vector::new(1.0, 1.0, 0.0),
             Vector::ZERO,
+            // Left to the scalar scan: NaN and infinite directions.
+            Vector::new(f32::NAN, 1.0, 0.0),
+            Vector::new(f32::INFINITY, 0.5, -0.5),
+            Vector::new(0.0, f32::NEG_INFINITY, 0.0),
         ];
         let mut s = 12345_u32;
         for _ in 0..2000 {
@@ -401,7 +403,7 @@ mod tests {
             for d in &dirs {
                 let parry = point_cloud_support_point_id(*d, &pts);
                 // Both builds of the lanes: this CPU's (AVX where it has it) and the baseline.
-                if lanes.argmax(*d, &pts) != parry || lanes.argmax_lanes(*d, &pts) != parry {
+                if lanes.argmax(*d) != parry || lanes.argmax_lanes(*d) != parry {
                     differ += 1;
                 }
             }
@@ -412,10 +414,10 @@ mod tests {
             .map(|i| Vector::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32))
             .collect();
         let lanes = Lanes::new(&cube);
-        assert_eq!(lanes.argmax(Vector::X, &cube), 1);
-        assert_eq!(lanes.argmax(Vector::Z, &cube), 4);
-        assert_eq!(lanes.argmax(-Vector::X, &cube), 0);
-        assert_eq!(lanes.argmax(Vector::new(f32::NAN, 0.0, 1.0), &cube), 0);
+        assert_eq!(lanes.argmax(Vector::X), 1);
+        assert_eq!(lanes.argmax(Vector::Z), 4);
+        assert_eq!(lanes.argmax(-Vector::X), 0);
+        assert_eq!(lanes.argmax(Vector::new(f32::NAN, 0.0, 1.0)), 0);
     }
 
     #[test]
