@@ -608,11 +608,12 @@ fn insert_finger(
     let (p1, p2) = hand.phalanx_boxes(f.side);
     let [(j1, r1), (j2, r2)] = hand.finger_poses(f, &at.palm_pose, [open1, open2]);
     // Body `k` of the hand (`Hand::body_poses`' order): phalanx 1 of finger `i` is 1 + 2i.
-    let first = 1 + 2 * hand
+    let index = hand
         .finger_list
         .iter()
         .position(|g| std::ptr::eq(g, f))
         .unwrap_or(0);
+    let first = 1 + 2 * index;
     let mut phalanx = |world: &mut PhysicsWorld, pose: Pose, boxes: &[HandBox], k: usize| {
         let body = world
             .bodies
@@ -640,7 +641,11 @@ fn insert_finger(
         motor(bend(t1) + squeeze, limits1),
     );
     let kind = params.solver.hand_joints;
-    let joint1 = insert_joint(world, kind, palm, b1, joint1);
+    let base = match kind {
+        HandJoints::Multibody if index > 0 => finger_base(world, palm, b1),
+        HandJoints::Multibody | HandJoints::Impulse => palm,
+    };
+    let joint1 = insert_joint(world, kind, base, b1, joint1);
     let b2 = phalanx(world, convert::pose(&j2, &r2), &p2, first + 1);
     // Joint 2 is held at its open angle until released (see `Scene::release_joint2`).
     let joint2 = revolute(&hand.joint2_anchor_mm(f.side), limits2, open2 as f32);
@@ -654,6 +659,42 @@ fn insert_finger(
         joint2_target: motor(bend(t2) + squeeze2, limits2),
         joint1_target: motor(bend(t1) + squeeze, limits1),
     }
+}
+
+/// Membership of the palm's colliders, which its fingers' phalanx 1s do not touch.
+const PALM: Group = Group::GROUP_1;
+/// Membership of a phalanx 1's colliders, which the palm's do not touch.
+const PHALANX_1: Group = Group::GROUP_2;
+
+/// The root of a finger's multibody but the first's: a fixed body without colliders at the
+/// palm's pose, so that each finger is a multibody of its own (two coordinates) rather than a
+/// branch of one rooted at the palm (six). The first finger's multibody keeps the palm as its
+/// root, so that the palm's contacts are solved as before (as a multibody link's, not a fixed
+/// body's). The equations are the same: the fingers' coordinates share no mass-matrix entries,
+/// so the hand's matrix is block-diagonal and the zeros between its blocks change no sum; the
+/// results are the same to the bit (docs/SIM.md, "The fingers as separate multibodies") and the
+/// solve is smaller. A multibody keeps jointed links off each other, and phalanx 1 is no longer
+/// jointed to the palm: collision groups keep them apart, as the joint did, and leave phalanx 2
+/// touching the palm, as before.
+fn finger_base(
+    world: &mut PhysicsWorld,
+    palm: RigidBodyHandle,
+    phalanx1: RigidBodyHandle,
+) -> RigidBodyHandle {
+    let pose = *world.bodies[palm].position();
+    let base = world.bodies.insert(RigidBodyBuilder::fixed().pose(pose));
+    let groups = |member: Group, shun: Group| {
+        InteractionGroups::new(member, Group::ALL ^ shun, InteractionTestMode::And)
+    };
+    for (body, groups) in [
+        (palm, groups(PALM, PHALANX_1)),
+        (phalanx1, groups(PHALANX_1, PALM)),
+    ] {
+        for c in world.bodies[body].colliders().to_vec() {
+            world.colliders[c].set_collision_groups(groups);
+        }
+    }
+    base
 }
 
 /// A finger joint: revolute about `axis` (the parent's frame) at `anchor` `[mm]` on the parent,
@@ -803,6 +844,67 @@ mod tests {
             friction: 0.5,
             params: &params,
         })
+    }
+
+    /// Whether any collider of `a` has an active contact with any collider of `b`.
+    fn touching(world: &PhysicsWorld, a: RigidBodyHandle, b: RigidBodyHandle) -> bool {
+        world.bodies[a].colliders().iter().any(|&ca| {
+            world.bodies[b].colliders().iter().any(|&cb| {
+                world
+                    .narrow_phase
+                    .contact_pair(ca, cb)
+                    .is_some_and(|p| p.has_any_active_contact())
+            })
+        })
+    }
+
+    #[test]
+    fn each_finger_is_a_multibody_of_its_own_and_phalanx_1_never_touches_the_palm() {
+        let (hand, object, params) = (thesis_hand(), box_shape(), SimParams::default());
+        // Fingers bent so far that phalanx 1 would lie on the palm's face: the box is 30 mm
+        // away from the palm, out of the way.
+        let pose = hand_at(-50.0, [95.0, 180.0]);
+        let case = Case {
+            hand: &hand,
+            pose: &pose,
+            object: &object,
+            mass_kg: 0.1,
+            friction: 0.5,
+            params: &params,
+        };
+        let mut scene = build(&case);
+        let roots: Vec<_> = scene
+            .fingers
+            .iter()
+            .map(|f| {
+                let link = scene.world.multibody_joints.rigid_body_link(f.phalanx1);
+                let mb = scene
+                    .world
+                    .multibody_joints
+                    .get_multibody(link.unwrap().multibody);
+                let mb = mb.unwrap();
+                assert_eq!((mb.ndofs(), mb.num_links()), (2, 3));
+                mb.root().rigid_body_handle()
+            })
+            .collect();
+        // The first finger keeps the palm as its root; the others have roots of their own.
+        assert_eq!(roots[0], scene.palm);
+        assert!(roots[1] != scene.palm && roots[2] != scene.palm && roots[1] != roots[2]);
+        for _ in 0..20 {
+            scene.world.step();
+        }
+        for f in &scene.fingers {
+            assert!(!touching(&scene.world, scene.palm, f.phalanx1));
+        }
+        // Without the collision groups phalanx 1 of a finger with its own root lies on the palm.
+        let f = &scene.fingers[1];
+        for &c in scene.world.bodies[f.phalanx1].colliders().to_vec().iter() {
+            scene.world.colliders[c].set_collision_groups(InteractionGroups::default());
+        }
+        for _ in 0..20 {
+            scene.world.step();
+        }
+        assert!(touching(&scene.world, scene.palm, f.phalanx1));
     }
 
     #[test]
