@@ -1,6 +1,7 @@
 //! The hand's finger joints in either of rapier's two joint kinds (`[sim] hand_joints`,
-//! docs/SIM.md "The impulse-joint hand"): the multibody hand (one reduced-coordinate
-//! articulation rooted at the fixed palm, the default) or the impulse-joint hand (the phalanges
+//! docs/SIM.md "The impulse-joint hand"): the multibody hand (a reduced-coordinate
+//! articulation per finger, rooted at the fixed palm or at a fixed base at its pose, the
+//! default) or the impulse-joint hand (the phalanges
 //! free rigid bodies held to the palm and to each other by revolute impulse joints, solved
 //! with the contacts). Both have the same bodies, colliders, limits and motors; only the joint
 //! kind differs. Contacts between two free rigid bodies go through rapier's SIMD two-body
@@ -12,7 +13,7 @@ use rapier3d::prelude::*;
 /// A finger joint of the scene, of either kind.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum FingerJoint {
-    /// A link of the hand's multibody.
+    /// A link of its finger's multibody.
     Multibody(MultibodyJointHandle),
     /// An impulse joint between two rigid bodies.
     Impulse(ImpulseJointHandle),

@@ -37,7 +37,8 @@ pub enum Protocol {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum HandJoints {
-    /// One multibody (reduced-coordinate articulation) rooted at the fixed palm (the default).
+    /// A multibody (reduced-coordinate articulation) per finger, the first rooted at the fixed
+    /// palm and the others at fixed bases at its pose (the default).
     Multibody,
     /// Free rigid bodies held by revolute impulse joints, solved with the contacts.
     Impulse,

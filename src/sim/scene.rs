@@ -896,6 +896,24 @@ mod tests {
         for f in &scene.fingers {
             assert!(!touching(&scene.world, scene.palm, f.phalanx1));
         }
+        // The groups keep nothing else apart: every hand body may touch the object, phalanx 2
+        // the palm, and the fingers each other, as in one multibody with self-contacts.
+        let groups = |b: RigidBodyHandle| {
+            let c = scene.world.bodies[b].colliders()[0];
+            scene.world.colliders[c].collision_groups()
+        };
+        let object = scene.world.colliders[scene.object_collider].collision_groups();
+        for (i, f) in scene.fingers.iter().enumerate() {
+            for b in [scene.palm, f.phalanx1, f.phalanx2] {
+                assert!(groups(b).test(object));
+            }
+            assert!(groups(scene.palm).test(groups(f.phalanx2)));
+            for g in &scene.fingers[i + 1..] {
+                for (a, b) in [(f.phalanx1, g.phalanx1), (f.phalanx1, g.phalanx2)] {
+                    assert!(groups(a).test(groups(b)) && groups(b).test(groups(a)));
+                }
+            }
+        }
         // Without the collision groups phalanx 1 of a finger with its own root lies on the palm.
         let f = &scene.fingers[1];
         for &c in scene.world.bodies[f.phalanx1].colliders().to_vec().iter() {
