@@ -350,21 +350,18 @@ fn mjcf_object(s: &mut String, case: &Case, meshes: &[(String, Mesh)]) {
     let _ = writeln!(s, "    </body>");
 }
 
-/// The hand's bodies never collide with each other here. The rapier check keeps jointed
-/// bodies, and the palm and each phalanx 1, apart, but lets the fingers meet each other and
-/// phalanx 2 the palm; that happens only when fingers close on nothing after a drop (with it
-/// turned off in rapier, the real-object set in six directions keeps every verdict, and two
-/// dropped candidates' numbers move: docs/MUJOCO.md). MuJoCo only filters parent-child pairs,
-/// and not those of a body welded to the world such as the palm, so every pair is listed.
+/// The hand's bodies collide as in the rapier check: everything but the pairs a joint joins
+/// (the palm and each phalanx 1, each phalanx 1 and its phalanx 2), so fingers meet each other
+/// and phalanx 2 the palm where they reach them. MuJoCo only filters parent-child pairs, and
+/// not those of a body welded to the world such as the palm, so the jointed pairs are listed.
 fn mjcf_contacts(s: &mut String, hand: &Hand) {
-    let mut hand_bodies = vec!["palm".to_string()];
-    for f in &hand.finger_list {
-        hand_bodies.push(format!("{}_phalanx_1", f.name));
-        hand_bodies.push(format!("{}_phalanx_2", f.name));
-    }
     let _ = writeln!(s, "  <contact>");
-    for (i, a) in hand_bodies.iter().enumerate() {
-        for b in &hand_bodies[i + 1..] {
+    for f in &hand.finger_list {
+        let (p1, p2) = (
+            format!("{}_phalanx_1", f.name),
+            format!("{}_phalanx_2", f.name),
+        );
+        for (a, b) in [("palm", p1.as_str()), (p1.as_str(), p2.as_str())] {
             let _ = writeln!(s, "    <exclude body1=\"{a}\" body2=\"{b}\"/>");
         }
     }

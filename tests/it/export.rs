@@ -59,6 +59,25 @@ fn mjcf_has_the_hand_the_object_and_the_actuators() {
             .count(),
         1
     );
+    // The hand's contacts as rapier's: only the jointed pairs are kept apart, so the fingers
+    // may meet each other and phalanx 2 the palm.
+    let mut excluded: Vec<(&str, &str)> = doc
+        .descendants()
+        .filter(|n| n.has_tag_name("exclude"))
+        .map(|n| (n.attribute("body1").unwrap(), n.attribute("body2").unwrap()))
+        .collect();
+    excluded.sort();
+    assert_eq!(
+        excluded,
+        [
+            ("finger_1_phalanx_1", "finger_1_phalanx_2"),
+            ("finger_2_phalanx_1", "finger_2_phalanx_2"),
+            ("finger_3_phalanx_1", "finger_3_phalanx_2"),
+            ("palm", "finger_1_phalanx_1"),
+            ("palm", "finger_2_phalanx_1"),
+            ("palm", "finger_3_phalanx_1"),
+        ]
+    );
     let actuators: Vec<_> = doc
         .descendants()
         .filter(|n| n.has_tag_name("position"))
