@@ -671,9 +671,10 @@ const PHALANX_1: Group = Group::GROUP_2;
 /// branch of one rooted at the palm (six). The first finger's multibody keeps the palm as its
 /// root, so that the palm's contacts are solved as before (as a multibody link's, not a fixed
 /// body's). The equations are the same: the fingers' coordinates share no mass-matrix entries,
-/// so the hand's matrix is block-diagonal and the zeros between its blocks change no sum; the
-/// results are the same to the bit (docs/SIM.md, "The fingers as separate multibodies") and the
-/// solve is smaller. A multibody keeps jointed links off each other, and phalanx 1 is no longer
+/// so the hand's matrix is block-diagonal and the zeros between its blocks change no sum; on
+/// every scenario measured the results are the same to the bit (docs/SIM.md, "The fingers as
+/// separate multibodies": measured, not structural, so a rapier upgrade repeats the
+/// comparison) and the solve is smaller. A multibody keeps jointed links off each other, and phalanx 1 is no longer
 /// jointed to the palm: collision groups keep them apart, as the joint did, and leave phalanx 2
 /// touching the palm, as before.
 fn finger_base(
