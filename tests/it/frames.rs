@@ -279,7 +279,7 @@ fn verdict_flips(a: &RunReport, b: &RunReport) -> Result<Vec<usize>, Vec<String>
             ));
             break;
         }
-        let verdict = |g: &GraspReport| g.check.as_ref().map(|c| c.verdict);
+        let verdict = |g: &GraspReport| g.check.as_ref().and_then(|c| c.ran());
         if verdict(g) != verdict(h) {
             flips.push(i);
         }
@@ -316,7 +316,7 @@ fn null_flips(
             if !grasp_differences(c, g).is_empty() {
                 return None;
             }
-            let v = c.check.as_ref().map(|c| c.verdict);
+            let v = c.check.as_ref().and_then(|c| c.ran());
             (holds(v) != holds(nominal)).then(|| format!("{}: {v:?}", NULLS[k]))
         })
         .collect()
@@ -392,7 +392,7 @@ fn check_frames(names: Option<&[&str]>, mode: Mode) -> (usize, Vec<String>, Vec<
             let cands = checked(&reference);
             for i in flips {
                 let g = cands[i];
-                let verdict = |r: &RunReport| checked(r)[i].check.as_ref().map(|c| c.verdict);
+                let verdict = |r: &RunReport| checked(r)[i].check.as_ref().and_then(|c| c.ran());
                 let (va, vb) = (verdict(&reference), verdict(&other));
                 let what = format!(
                     "{} frame {k}: candidate {i} ({}) {va:?} / {vb:?}",
