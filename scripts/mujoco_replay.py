@@ -10,7 +10,7 @@ fingers start at the `open` keyframe; gravity off; joint 1 closes towards its ta
 bend plus squeeze) while joint 2 is held open; when the hand and the object have stopped
 (`close_until_stalled`), or at the latest halfway through the closing time, joint 1 locks where
 it stopped (a TorqueSwitch) and joint 2 closes, again until they stop; with `reseat` (the
-default since session 46) each locked joint 1 whose phalanx 1 is off the object moves on until it
+default) each locked joint 1 whose phalanx 1 is off the object moves on until it
 touches, until no joint 1 moves and the object has stopped; then gravity on for the hold (its
 whole length: the replay is the full-length protocol).
 `--six`: the six gravity directions of `[sim] gravity = "six"`, each held from one closing.

@@ -6,12 +6,12 @@ loading included), both cores free for it.
     cargo build --release
     ./target/release/grasp-sim gen-assets --hard --out out/hard
     python3 scripts/plan_bench.py                         # table, median, 95th percentile, max
-    python3 scripts/plan_bench.py --bin /tmp/old-grasp-sim --timeout 120 --out out/bench_old.json
+    python3 scripts/plan_bench.py --bin out/old-grasp-sim --timeout 120 --out out/bench_old.json
 
 The default inputs are assets/real/scenarios/*.toml and out/hard/*.stl. An object that runs past
 `--timeout` seconds is killed and counted at the timeout (marked `>`).
 
-    python3 scripts/plan_bench.py --against /tmp/old-grasp-sim --out out/bench.json
+    python3 scripts/plan_bench.py --against out/old-grasp-sim --out out/bench.json
 
 times a second binary on each object just before the first (both under the same load, which on a
 shared machine drifts), prints both tables and the results that differ, and writes its rows to
