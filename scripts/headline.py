@@ -11,7 +11,9 @@ block another script writes (scripts/docblock.py), so the README cannot drift fr
 - the real-object set and MuJoCo's replay of it: docs/REAL_OBJECTS.md,
   scripts/real_objects_eval.py (its **Summary** line);
 - planning time: BENCHMARKS.md, scripts/plan_bench.py (its headline line);
-- the check's speed: BENCHMARKS.md, scripts/speed_ratios.py (its headline line).
+- the check's speed: BENCHMARKS.md, scripts/speed_ratios.py (its headline line);
+- MuJoCo on the bundled and tuning sets: docs/MUJOCO.md, scripts/compare_engines.py (its
+  headline line).
 
 Run it after any of those scripts' `--write-doc`. `cargo test --test it repository` builds the
 same block from the same sources (tests/it/repository.rs) and fails when the README's differs.
@@ -40,6 +42,7 @@ def block():
     t = docblock.headline(ROOT / "docs" / "USAGE.md", "scripts/thesis_table.py")
     p = docblock.headline(ROOT / "BENCHMARKS.md", "scripts/plan_bench.py")
     s = docblock.headline(ROOT / "BENCHMARKS.md", "scripts/speed_ratios.py")
+    m = docblock.headline(ROOT / "docs" / "MUJOCO.md", "scripts/compare_engines.py")
     r = real_objects()
     graspable, planned, down, six, replayed, agree = r[0], r[1], r[3], r[5], r[7], r[8]
     lines = [
@@ -50,8 +53,9 @@ def block():
         f"- **Real objects.** Of {graspable} real objects labelled graspable, {planned} get a "
         f"grasp; {down} hold with gravity down and {six} in all six directions "
         "([docs/REAL_OBJECTS.md](docs/REAL_OBJECTS.md#the-table)).",
-        f"- **Another engine.** MuJoCo replays {replayed} of the real-object grasps checked and "
-        f"agrees with rapier on {agree} ([docs/MUJOCO.md](docs/MUJOCO.md)).",
+        f"- **Another engine.** MuJoCo replays the checked grasps and agrees with rapier on "
+        f"{m['agree']} of {m['compared']} bundled and tuning-set grasps and on {agree} of "
+        f"{replayed} real-object grasps ([docs/MUJOCO.md](docs/MUJOCO.md#agreement)).",
         f"- **Planning time.** {p['within_5s']} of {p['objects']} real and hard meshes plan "
         f"within 5 s: median {p['median_s']} s, 95th percentile {p['p95_s']} s, the slowest "
         f"({p['slowest']}) {p['max_s']} s ([BENCHMARKS.md](BENCHMARKS.md#planning-time-on-any-mesh)).",
