@@ -22,6 +22,7 @@ per-sample outcomes, and how often one says >= 0.9 while the other says < 0.5. `
 writes one line per grasp with both engines' per-sample verdicts.
 """
 import json
+import os
 import pathlib
 import subprocess
 import sys
@@ -171,7 +172,8 @@ def main(argv):
                                       differ=",".join(differ) or "none")
         docblock.replace(docblock.ROOT / "docs" / "MUJOCO.md", "scripts/compare_engines.py",
                          "\n".join([head, "", f"Run at {docblock.revision()} (rapier's `fast` protocol; "
-                                     "MuJoCo's replay full-length; wall times of that run):", "",
+                                     "MuJoCo's replay full-length; wall times of that run, load "
+                                     f"average {os.getloadavg()[0]:.1f} at its end):", "",
                                      *lines, "", summary]) + "\n")
     for name in required:
         if name not in rapier:

@@ -15,6 +15,7 @@ mod issue16;
 mod planner;
 mod quality;
 mod real_meshes;
+mod repository;
 mod resume;
 mod robust;
 mod settings;
