@@ -138,7 +138,7 @@ def doc(rows, load0):
         objects=len(rows), within_5s=sum(w <= 5 for w in walls),
         within_05s=sum(w <= 0.5 for w in walls), median_s=f"{statistics.median(walls):.3f}",
         p95_s=f"{percentile(walls, 0.95):.3f}", max_s=f"{max(walls):.2f}",
-        slowest=pathlib.Path(slowest[0]["input"]).stem)
+        slowest=pathlib.Path(slowest[0]["input"]).stem, load=f"{load0:.1f}")
     text = [head, "",
             f"Run at {docblock.revision()} on {datetime.date.today()}, load average "
             f"{load0:.1f} at the start, {os.cpu_count()} CPUs: {len(rows)} objects ({real} "

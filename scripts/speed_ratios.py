@@ -225,7 +225,8 @@ def main():
     variants = parse_variants(a.variant)
     result = {}
     with tempfile.TemporaryDirectory() as tmp:
-        print(f"load at the start: {load()}", file=sys.stderr)
+        start_load = load()
+        print(f"load at the start: {start_load}", file=sys.stderr)
         r = ratios(a, variants, tmp) if a.rounds > 0 else {}
         b = {n: batch(a, keys, tmp, n) for n, keys in variants
              if a.batch and (not a.batch_only or n in a.batch_only)}
@@ -277,7 +278,8 @@ def main():
             six_ratio=f"{statistics.median(o['six']):.3f}",
             down_ms=f"{statistics.median(o['down_ms']):.1f}",
             six_ms=f"{statistics.median(o['six_ms']):.1f}",
-            checks_per_s=f"{x['rate']:.2f}", checks_per_cpu_s=f"{x['per_cpu_s']:.2f}")
+            checks_per_s=f"{x['rate']:.2f}", checks_per_cpu_s=f"{x['per_cpu_s']:.2f}",
+            load=start_load.split()[0])
         intro = (f"Run at {docblock.revision()} on {datetime.date.today()} "
                  f"(`{' '.join(['python3', 'scripts/speed_ratios.py'] + sys.argv[1:])}`), "
                  f"{a.rounds} rounds on {pathlib.Path(a.scenario).stem}:")
