@@ -513,11 +513,7 @@ fn expected_headline() -> String {
              the same scene with gravity down ({} ms) and {} in six directions; a batch of the \
              real-object set runs {} six-direction checks a second on 2 cores at load \
              average {} ([BENCHMARKS.md](BENCHMARKS.md#physics-check)).",
-            s["down_ratio"],
-            s["down_ms"],
-            s["six_ratio"],
-            s["checks_per_s"],
-            s["load"]
+            s["down_ratio"], s["down_ms"], s["six_ratio"], s["checks_per_s"], s["load"]
         ),
     ];
     lines.join("\n")
