@@ -60,9 +60,10 @@ def block():
         f"within 5 s: median {p['median_s']} s, 95th percentile {p['p95_s']} s, the slowest "
         f"({p['slowest']}) {p['max_s']} s, in a run at load average {p['load']} on 2 cores "
         "([BENCHMARKS.md](BENCHMARKS.md#planning-time-on-any-mesh)).",
-        f"- **The check's speed.** The D40 cylinder's check takes {s['down_ratio']} of MuJoCo's "
-        f"replay of the same scene with gravity down ({s['down_ms']} ms) and {s['six_ratio']} in "
-        f"six directions; a batch of the real-object set runs {s['checks_per_s']} six-direction "
+        f"- **The check's speed.** The D40 cylinder's check takes {s['down_ratio']} of the time "
+        f"MuJoCo's replay of the same scene takes with gravity down ({s['down_ms']} ms) and "
+        f"{s['six_ratio']} in six directions; a batch of the real-object set runs "
+        f"{s['checks_per_s']} six-direction "
         f"checks a second on 2 cores at load average {s['load']} "
         "([BENCHMARKS.md](BENCHMARKS.md#physics-check)).",
     ]
