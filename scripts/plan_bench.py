@@ -125,11 +125,12 @@ def main():
             other = a.out.with_suffix(".against" + a.out.suffix)
             other.write_text(json.dumps(against, indent=1))
     if a.write_doc:
-        docblock.replace(ROOT / "BENCHMARKS.md", "scripts/plan_bench.py", doc(rows, load0))
+        docblock.replace(ROOT / "BENCHMARKS.md", "scripts/plan_bench.py",
+                         doc(rows, load0, os.getloadavg()[0]))
     return 0
 
 
-def doc(rows, load0):
+def doc(rows, load0, load1):
     """The generated block of BENCHMARKS.md: a headline line, the summary, the slowest objects."""
     walls = [r["wall_s"] for r in rows]
     slowest = sorted(rows, key=lambda r: -r["wall_s"])
@@ -138,10 +139,11 @@ def doc(rows, load0):
         objects=len(rows), within_5s=sum(w <= 5 for w in walls),
         within_05s=sum(w <= 0.5 for w in walls), median_s=f"{statistics.median(walls):.3f}",
         p95_s=f"{percentile(walls, 0.95):.3f}", max_s=f"{max(walls):.2f}",
-        slowest=pathlib.Path(slowest[0]["input"]).stem, load=f"{load0:.1f}")
+        slowest=pathlib.Path(slowest[0]["input"]).stem, load=f"{load0:.1f}–{load1:.1f}")
     text = [head, "",
             f"Run at {docblock.revision()} on {datetime.date.today()}, load average "
-            f"{load0:.1f} at the start, {os.cpu_count()} CPUs: {len(rows)} objects ({real} "
+            f"{load0:.1f} at the start and {load1:.1f} at the end, {os.cpu_count()} CPUs: "
+            f"{len(rows)} objects ({real} "
             f"real-object scenarios, {len(rows) - real} hard meshes), median "
             f"{statistics.median(walls):.3f} s, 95th percentile {percentile(walls, 0.95):.3f} s, "
             f"max {max(walls):.2f} s; {sum(w <= 0.5 for w in walls)} within 0.5 s, "

@@ -279,7 +279,7 @@ def main():
             down_ms=f"{statistics.median(o['down_ms']):.1f}",
             six_ms=f"{statistics.median(o['six_ms']):.1f}",
             checks_per_s=f"{x['rate']:.2f}", checks_per_cpu_s=f"{x['per_cpu_s']:.2f}",
-            load=f"{float(start_load.split()[0]):.1f}")
+            load=f"{float(start_load.split()[0]):.1f}–{float(load().split()[0]):.1f}")
         intro = (f"Run at {docblock.revision()} on {datetime.date.today()} "
                  f"(`{' '.join(['python3', 'scripts/speed_ratios.py'] + sys.argv[1:])}`), "
                  f"{a.rounds} rounds on {pathlib.Path(a.scenario).stem}:")
