@@ -45,9 +45,14 @@ def headline_line(**figures):
 
 
 def revision():
-    """The commit the repository is at (`git describe --always --dirty`), or "unknown"."""
+    """The commit the code is at, with `-dirty` if a tracked file other than a Markdown one (which
+    the generated blocks themselves change) differs from it; "unknown" without git."""
     try:
-        return subprocess.run(["git", "describe", "--always", "--dirty"], cwd=ROOT,
-                              capture_output=True, text=True, check=True).stdout.strip()
+        def git(*args):
+            return subprocess.run(["git", *args], cwd=ROOT, capture_output=True, text=True,
+                                  check=True).stdout
+        head = git("rev-parse", "--short", "HEAD").strip()
+        changed = [l[3:] for l in git("status", "--porcelain", "--untracked-files=no").splitlines()]
+        return head + ("-dirty" if any(not c.endswith(".md") for c in changed) else "")
     except (OSError, subprocess.CalledProcessError):
         return "unknown"
