@@ -10,6 +10,11 @@ the check's two questions apart (issue 55): the verdict (what gravity did) and t
 plan), then the agreement on each and the distributions of the differences, so that a
 disagreement across a threshold by a hair and one by 20 mm do not look alike. Exits 1 if a
 scenario named with --require gets different verdicts (CI requires D40 and the cup).
+With --write-doc the table and its count replace the generated block of docs/MUJOCO.md
+("Agreement"), whose headline line the README's headline copies (scripts/headline.py):
+
+    python3 scripts/compare_engines.py target/release/grasp-sim out/ --write-doc \
+        scenarios/*.toml assets/objects/train/*.toml
 
     python3 scripts/compare_engines.py GRASP_SIM_BINARY OUT_DIR --robust N [--six] [--jsonl F] SCENARIO...
 
@@ -22,11 +27,13 @@ writes one line per grasp with both engines' per-sample verdicts.
 """
 import json
 import math
+import os
 import pathlib
 import subprocess
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import docblock  # noqa: E402
 import mujoco_replay  # noqa: E402
 
 
@@ -144,10 +151,13 @@ def main(argv):
             del args[j:j + 2]
         return robust(argv[1], pathlib.Path(argv[2]), n, six, jsonl, args)
     binary, out_dir, rest = argv[1], pathlib.Path(argv[2]), argv[3:]
-    required, scenarios = [], []
+    required, scenarios, write_doc = [], [], False
     i = 0
     while i < len(rest):
-        if rest[i] == "--require":
+        if rest[i] == "--write-doc":
+            write_doc = True
+            i += 1
+        elif rest[i] == "--require":
             required.append(rest[i + 1])
             i += 2
         else:
@@ -165,21 +175,29 @@ def main(argv):
     for line in run.stdout.splitlines():
         d = json.loads(line)
         rapier[d["scenario"]] = d["sim"]
-    print(
-        "| scenario | rapier | translation [mm] | rotation [deg] | MuJoCo | translation [mm] "
+    lines = []
+
+    def out(text):
+        lines.append(text)
+        print(text)
+
+    out("| scenario | rapier | translation [mm] | rotation [deg] | MuJoCo | translation [mm] "
         "| rotation [deg] | verdicts agree | rapier as planned | MuJoCo as planned | as planned agree "
-        "| shift rapier / MuJoCo [mm] | on plan rapier / MuJoCo | rapier [ms] | MuJoCo [ms] | ratio |"
-    )
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    failed = []
+        "| shift rapier / MuJoCo [mm] | on plan rapier / MuJoCo | rapier [ms] | MuJoCo [ms] | ratio |")
+    out("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    failed, compared, agreed, differ = [], 0, 0, []
     rows = []
     for name, sim in rapier.items():
         scene = out_dir / name
         if not (scene / "scene.xml").is_file():
-            print(f"| {name} | {sim['verdict']} | | | (no grasp to export) | | | | | | | | | | | |")
+            out(f"| {name} | {sim['verdict']} | | | (no grasp to export) | | | | | | | | | | | |")
             continue
         m = mujoco_replay.replay(scene)
         agree = m["verdict"] == sim["verdict"]
+        compared += 1
+        agreed += agree
+        if not agree:
+            differ.append(name)
         fr, fm = sim.get("fidelity") or {}, m["fidelity"]
         agree_ap = fr.get("as_planned") == fm["as_planned"]
         rows.append({"agree": agree, "agree_ap": agree_ap,
@@ -189,7 +207,7 @@ def main(argv):
         # direction) against MuJoCo's simulation loop (no Python start-up, no model loading).
         ratio = sim["wall_ms"] / m["wall_ms"] if m["wall_ms"] > 0 else float("nan")
         yes = lambda ok: "yes" if ok else "**no**"  # noqa: E731
-        print(
+        out(
             f"| {name} | {sim['verdict']} | {sim['translation_mm']:.2f} | {sim['rotation_deg']:.2f} "
             f"| {m['verdict']} | {m['translation_mm']:.2f} | {m['rotation_deg']:.2f} | {yes(agree)} "
             f"| {fr.get('as_planned')} | {fm['as_planned']} | {yes(agree_ap)} "
@@ -199,9 +217,18 @@ def main(argv):
         )
         if name in required and not agree:
             failed.append(name)
-    if rows:
-        print()
-        print(agreement_summary(rows))
+    summary = (f"**Summary**: MuJoCo replays {compared} grasps and agrees with rapier on the verdict "
+               f"for {agreed}" + (f" (not on {', '.join(differ)})" if differ else "")
+               + (f"; {agreement_summary(rows)}." if rows else "."))
+    print(f"\n{summary}")
+    if write_doc:
+        head = docblock.headline_line(compared=compared, agree=agreed,
+                                      differ=",".join(differ) or "none")
+        docblock.replace(docblock.ROOT / "docs" / "MUJOCO.md", "scripts/compare_engines.py",
+                         "\n".join([head, "", f"Run at {docblock.revision()} (rapier's `fast` protocol; "
+                                     "MuJoCo's replay full-length; wall times of that run, load "
+                                     f"average {os.getloadavg()[0]:.1f} at its end):", "",
+                                     *lines, "", summary]) + "\n")
     for name in required:
         if name not in rapier:
             failed.append(name)

@@ -7,12 +7,13 @@ Prints one JSON object per scene: the verdict (hold / slip / drop: what gravity 
 hold thresholds as grasp-sim's rapier check), the object's translation and rotation relative to
 the palm during the hold, whether it still touches the hand, and the closing's fidelity
 (`fidelity`: as planned or not by `max_closing_shift_mm`, `min_on_plan_fraction` and
-`max_penetration_mm`, with the figures, as grasp-sim's `sim.fidelity`). Protocol (docs/SIM.md), read from protocol.json:
-fingers start at the `open` keyframe; gravity off; joint 1 closes towards its target (planned
+`max_penetration_mm`, with the figures, as grasp-sim's `sim.fidelity`). Protocol (docs/SIM.md),
+read from protocol.json: fingers start at the `open` keyframe; gravity off; joint 1 closes towards its target (planned
 bend plus squeeze) while joint 2 is held open; when the hand and the object have stopped
 (`close_until_stalled`), or at the latest halfway through the closing time, joint 1 locks where
 it stopped (a TorqueSwitch) and joint 2 closes, again until they stop; with `reseat` (the
-default) each locked joint 1 whose phalanx 1 is off the object moves on until it touches, until no joint 1 moves and the object has stopped; then gravity on for the hold (its
+default) each locked joint 1 whose phalanx 1 is off the object moves on until it touches, until
+no joint 1 moves and the object has stopped; then gravity on for the hold (its
 whole length: the replay is the full-length protocol).
 `--six`: the six gravity directions of `[sim] gravity = "six"`, each held from one closing.
 Perturbed samples (`[sim] samples`, issue 34) are exported as scenes of their own,

@@ -13,7 +13,7 @@
 //! the hold probability does not tell apart, may differ); anything between is a coin toss.
 //! A verdict is a single sample of a chaotic check: a 1 ppm change of the contact stiffness,
 //! every other input bit for bit the same, flips such candidates as another frame does
-//! (docs/FRAMES.md, "Measured (issue 30, session 44)"). So where the samples call a difference
+//! (docs/studies/2026-12-02-frames-verdicts.md). So where the samples call a difference
 //! decisive, the run is repeated in both frames under the five 1 ppm nulls of docs/SIM.md:
 //! if one of them flips the candidate's verdict in either frame, that verdict is a coin toss
 //! too (the samples, millimetres and degrees apart, do not see the round-off neighbourhood of

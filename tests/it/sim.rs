@@ -313,7 +313,7 @@ fn the_closing_ends_when_the_hand_and_the_object_stop() {
     // object have stopped (the reseat once the object has); the fixed schedule closes for the whole
     // 0.5 s and the reseat for another 0.25 s. On D40 both end in the same grip: joint angles
     // within 0.5°, and both hold. (0.34° apart at most since contact manifolds are checked
-    // against parry's contact query, session 49, 0.11° before; the bundled scenario, in the
+    // against parry's contact query, c78b8c2, 0.11° before; the bundled scenario, in the
     // file's frame, 0.07° now and 0.25° before: which of the two closings a few contact
     // rebuilds move is chance.)
     use grasp_sim::scenario::SimParams;
@@ -387,7 +387,7 @@ fn the_rest_rule_decides_only_a_still_object_clear_of_the_thresholds() {
     use grasp_sim::sim::protocol::{RestFrame, SAMPLE_S};
     use grasp_sim::sim::{EarlyDecision, Verdict};
     use nalgebra::{UnitQuaternion, Vector3};
-    // The rule at a 0.2 s window (ten samples; the default is 0.05 s since session 45).
+    // The rule at a 0.2 s window (ten samples; the default is 0.05 s since a629fd9).
     let mut params = SimParams::default();
     params.early.rest_window_s = 0.2;
     let rule = EarlyDecision::from_params(&params);
