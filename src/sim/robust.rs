@@ -332,21 +332,31 @@ pub fn check_nominal(case: &Case) -> SimOutcome {
 /// Runs `[sim] samples` perturbed checks of `case` in parallel and counts their verdicts.
 pub fn sample(case: &Case) -> Robust {
     let t0 = Instant::now();
-    let rp = &case.params.robust;
-    let runs: Vec<(Perturbation, SimOutcome)> = (0..rp.samples)
+    let runs: Vec<(Perturbation, SimOutcome)> = (0..case.params.robust.samples)
         .into_par_iter()
-        .map(|k| {
-            let p = Perturbation::draw(rp, k);
-            let perturbed = Perturbed::of(case, &p);
-            let out = super::check(&perturbed.case(case));
-            (p, out)
-        })
+        .map(|k| check_sample(case, k))
         .collect();
+    robust_of(case, &runs, t0.elapsed().as_secs_f64() * 1000.0)
+}
+
+/// Sample `k`'s perturbed check of `case`: one of the checks [`sample`] runs, for a caller that
+/// spreads the samples of several grasps over the cores itself (`grasp-sim label`).
+pub fn check_sample(case: &Case, k: usize) -> (Perturbation, SimOutcome) {
+    let p = Perturbation::draw(&case.params.robust, k);
+    let perturbed = Perturbed::of(case, &p);
+    let out = super::check(&perturbed.case(case));
+    (p, out)
+}
+
+/// The hold probability of `case` from its samples' checks `runs` (sample `k` at index `k`,
+/// as [`check_sample`] gives them), which took `wall_ms`.
+pub fn robust_of(case: &Case, runs: &[(Perturbation, SimOutcome)], wall_ms: f64) -> Robust {
+    let rp = &case.params.robust;
     let mut counts = Counts::default();
     let mut held_as_planned = 0;
     let mut directions: Vec<DirectionRobust> = Vec::new();
     let mut first_failure = None;
-    for (p, out) in &runs {
+    for (p, out) in runs {
         counts.add(out.verdict);
         held_as_planned += usize::from(out.held_as_planned());
         for (i, d) in out.directions.iter().enumerate() {
@@ -401,7 +411,7 @@ pub fn sample(case: &Case) -> Robust {
         as_planned: runs.iter().map(|r| r.1.fidelity.as_planned).collect(),
         first_failure,
         steps: runs.iter().map(|r| r.1.steps).sum(),
-        wall_ms: t0.elapsed().as_secs_f64() * 1000.0,
+        wall_ms,
         passes: as_planned_interval[0] >= rp.choose_min_lower_bound,
     }
 }
