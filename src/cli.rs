@@ -510,12 +510,28 @@ fn positive_seconds(s: &str) -> Result<f64, String> {
 #[derive(Debug, clap::Args)]
 pub struct TuneArgs {
     /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply, .urdf).
-    #[arg(required = true, value_name = "DIR | SCENARIO")]
+    #[arg(required_unless_present = "labels", value_name = "DIR | SCENARIO")]
     pub inputs: Vec<PathBuf>,
+    /// Tune the order's significance factors (`[planner] sf_centred`, `sf_opposed`,
+    /// `sf_spread`, `sf_margin`) against the candidates of a `grasp-sim label` file instead of
+    /// sweeping a grid: no simulation, k-fold cross-validation over objects (docs/USAGE.md
+    /// "Tuning the order").
+    #[arg(long, value_name = "FILE.jsonl", conflicts_with_all = ["inputs", "params"])]
+    pub labels: Option<PathBuf>,
+    /// With --labels: what to maximise: `first` (the first candidate's mean hold
+    /// probability), `checks` (fewest candidates checked before a hold), `auc` (the score's
+    /// AUC against a hold as planned).
+    #[arg(long, value_name = "OBJECTIVE", default_value = "first", requires = "labels",
+          value_parser = grasp_sim::tune::order::Objective::parse)]
+    pub objective: grasp_sim::tune::order::Objective,
+    /// With --labels: folds of the cross-validation over objects.
+    #[arg(long, value_name = "K", default_value_t = 5, requires = "labels",
+          value_parser = clap::value_parser!(u32).range(2..=100))]
+    pub folds: u32,
     // Help: NAME=START:END:STEP, repeatable, and the names of tune::TunedParam.
     #[arg(
         long = "param",
-        required = true,
+        required_unless_present = "labels",
         value_name = "NAME=START:END:STEP",
         value_parser = grasp_sim::tune::parse_sweep,
         help = format!("NAME=START:END:STEP, repeatable ({})", grasp_sim::tune::TunedParam::names())

@@ -21,6 +21,7 @@
 
 use crate::hand::Hand;
 use crate::mesh::{align_with_rule, AlignedObject, FrameRule, GraspAxis, MassProperties, Mesh};
+use crate::plan::order::OrderFactors;
 use crate::plan::search::{candidate_count, search_with, Grasp, Rejection};
 use crate::plan::{self, GradedDomain, RuleSet};
 use crate::report::StageTimings;
@@ -332,28 +333,64 @@ fn search_axis(
     let mut found = 0;
     let mut stopped = false;
     let available = candidate_count(&graded, p.planner);
-    let (tried, rejections) = search_with(
-        &aligned.mesh,
-        p.hand,
-        &graded,
-        p.planner,
-        rules,
-        budget,
-        |g| {
-            found += 1;
-            let check = match p.max_checked {
-                Some(max) if sel.checked() < max && !has_hold(sel) => Some((p.check)(&aligned, &g)),
-                _ => None,
-            };
-            sel.candidates.push(Candidate {
-                axis_plan: slot,
-                grasp: g,
-                check,
-            });
-            stopped = is_done(sel, p, collect);
-            !stopped
-        },
-    );
+    // Adds a feasible grasp, checked while checks remain and none has held; false once enough
+    // is known.
+    let take = |sel: &mut Selection, g: Grasp| {
+        let check = match p.max_checked {
+            Some(max) if sel.checked() < max && !has_hold(sel) => Some((p.check)(&aligned, &g)),
+            _ => None,
+        };
+        sel.candidates.push(Candidate {
+            axis_plan: slot,
+            grasp: g,
+            check,
+        });
+        !is_done(sel, p, collect)
+    };
+    let factors = OrderFactors::of(p.planner);
+    let (tried, rejections) = if factors.is_thesis() {
+        search_with(
+            &aligned.mesh,
+            p.hand,
+            &graded,
+            p.planner,
+            rules,
+            budget,
+            |g| {
+                found += 1;
+                stopped = !take(sel, g);
+                !stopped
+            },
+        )
+    } else {
+        // Issue 58: the axis's feasible grasps in the thesis's order, then taken by falling
+        // score ([`crate::plan::order`]); the candidate budget bounds the search as before.
+        let mut all = Vec::new();
+        let searched = search_with(
+            &aligned.mesh,
+            p.hand,
+            &graded,
+            p.planner,
+            rules,
+            budget,
+            |g| {
+                all.push(g);
+                true
+            },
+        );
+        found = all.len();
+        let order = crate::plan::order::reorder(&all, &aligned, p.hand, &factors);
+        let mut slots: Vec<Option<Grasp>> = all.into_iter().map(Some).collect();
+        for i in order {
+            if let Some(g) = slots[i].take() {
+                if !take(sel, g) {
+                    stopped = true;
+                    break;
+                }
+            }
+        }
+        searched
+    };
     t.search += crate::plan::timings::ms(t0);
     AxisPlan {
         aligned,

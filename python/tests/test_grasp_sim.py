@@ -162,6 +162,31 @@ def test_an_axis_the_planner_did_not_search_raises(cup, cup_plan):
         gs.check(cup, gs.Grasp.from_pose(g.palm_pose, g.joint_angles_deg, "sideways"))
 
 
+def test_a_grasp_on_an_axis_the_search_did_not_reach_is_checked_there(cup, cup_plan):
+    # The cup's plan is on its least axis; the same pose about its middle axis is aligned for
+    # the check as the planner would align it (gravity then along that frame's -Z).
+    g = cup_plan.grasp
+    c = gs.check(cup, gs.Grasp.from_pose(g.palm_pose, g.joint_angles_deg, "middle"))
+    assert c.verdict in ("hold", "slip", "drop")
+    assert c.report["sim"]["grasp_source"] == "given"
+
+
+def test_check_many_labels_each_grasp_as_the_cli_does(cup):
+    p = gs.plan(cup, candidates=40)
+    grasps = [p.candidates[0], p.candidates[39]]
+    bad = {"palm_pose": np.eye(4).tolist(), "joint_angles_deg": [[150, 150]] * 2}
+    records = gs.check_many(cup, [*grasps, bad], samples=2)
+    assert len(records) == 3
+    for r in records[:2]:
+        assert r["samples"] == 2 and 0.0 <= r["hold_probability"] <= 1.0
+        assert r["verdict"] in ("hold", "slip", "drop")
+        assert np.allclose(np.asarray(r["palm_pose"]), p.candidates[0].palm_pose if r is records[0]
+                           else p.candidates[39].palm_pose, atol=1e-6)
+    assert "error" in records[2] and "2 fingers' angles" in records[2]["error"]
+    with pytest.raises(gs.BadInputError, match="samples"):
+        gs.check_many(cup, grasps, samples=0)
+
+
 # --- Arrays in give the same plan as the file.
 
 def plan_section(p):

@@ -159,6 +159,14 @@ pub struct Grade {
     pub sf_c: f64,
     /// Per finger, in the hand's order.
     pub fingers: Vec<FingerGrade>,
+    /// The order's terms beyond the thesis (issue 58, [`crate::plan::order`]).
+    pub terms: crate::plan::order::OrderTerms,
+    /// Which axis plan of the search it came from (0: the first searched).
+    pub axis_plan: usize,
+    /// Its place in that axis plan's order (0: the first).
+    pub place: usize,
+    /// The feasible grasps that axis plan found.
+    pub found: usize,
 }
 
 /// A finger's elevation grades at its index.
@@ -174,8 +182,26 @@ pub struct FingerGrade {
     pub combined: Option<f64>,
 }
 
-/// The grade of `g`, planned on `plan`, under Sf_c `sf_c`.
-pub fn grade_of(g: &Grasp, plan: &AxisPlan, sf_c: f64) -> Grade {
+/// Where a candidate sits in the search: its axis plan, its place in that plan's order, and
+/// the grasps that plan found.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Place {
+    /// The axis plan's index.
+    pub axis_plan: usize,
+    /// The place in its order.
+    pub place: usize,
+    /// The grasps it found.
+    pub found: usize,
+}
+
+/// The grade of `g`, planned on `plan` (at `at` in the search) for `hand`, under Sf_c `sf_c`.
+pub fn grade_of(
+    g: &Grasp,
+    plan: &AxisPlan,
+    place: Place,
+    hand: &crate::hand::Hand,
+    sf_c: f64,
+) -> Grade {
     let graded = &plan.graded;
     let at = |v: &[Option<f64>], i: i64| -> Option<f64> {
         usize::try_from(i - 1)
@@ -200,6 +226,10 @@ pub fn grade_of(g: &Grasp, plan: &AxisPlan, sf_c: f64) -> Grade {
                 combined: at(&graded.grades.combined, i - o),
             })
             .collect(),
+        terms: crate::plan::order::terms(g, &plan.aligned, hand),
+        axis_plan: place.axis_plan,
+        place: place.place,
+        found: place.found,
     }
 }
 
@@ -489,6 +519,17 @@ pub fn label_object(
         summary.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
         return Ok(summary);
     }
+    // Each candidate's place in its axis plan's order.
+    let mut places = Vec::with_capacity(selection.candidates.len());
+    let mut seen = vec![0usize; selection.axes.len()];
+    for c in &selection.candidates {
+        places.push(Place {
+            axis_plan: c.axis_plan,
+            place: seen[c.axis_plan],
+            found: selection.axes[c.axis_plan].grasps_found,
+        });
+        seen[c.axis_plan] += 1;
+    }
     let t1 = Instant::now();
     let posed: Vec<Posed> = picks
         .iter()
@@ -501,7 +542,14 @@ pub fn label_object(
                 grasp_index: Some(i),
                 rules: serde_json::to_value(c.grasp.rules).ok(),
                 relaxations: serde_json::to_value(&c.grasp.relaxations).ok(),
-                grade: serde_json::to_value(grade_of(&c.grasp, plan, scenario.planner.sf_c)).ok(),
+                grade: serde_json::to_value(grade_of(
+                    &c.grasp,
+                    plan,
+                    places[i],
+                    hand,
+                    scenario.planner.sf_c,
+                ))
+                .ok(),
             };
             let line = GraspLine::of_pose(&planned, &plan.aligned, carried);
             let pose = line.pose_in(&plan.aligned);

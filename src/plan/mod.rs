@@ -18,6 +18,7 @@ pub mod diameter;
 pub mod domain;
 pub mod finger;
 pub mod geom2;
+pub mod order;
 pub use crate::hand::kinematics;
 pub mod palm;
 pub mod palm_grade;

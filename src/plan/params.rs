@@ -37,6 +37,16 @@ pub struct PlannerParams {
     /// whatever the object; a search stopped by it says so (`plan.search_stopped`). Counted in
     /// candidates, not seconds, so the answer does not depend on the machine. 0: no limit.
     pub candidate_budget: usize,
+    /// The significance factor of [`super::order::OrderTerms::centred`] (issue 58; 0: the
+    /// thesis's order). The four `sf_*` factors below reorder each axis's candidates by
+    /// [`super::order::OrderFactors::score`].
+    pub sf_centred: f64,
+    /// The factor of [`super::order::OrderTerms::opposed`].
+    pub sf_opposed: f64,
+    /// The factor of [`super::order::OrderTerms::spread`].
+    pub sf_spread: f64,
+    /// The factor of [`super::order::OrderTerms::margin`].
+    pub sf_margin: f64,
 }
 
 /// The default [`PlannerParams::candidate_budget`]: a rule set's candidates over all axes.
@@ -61,6 +71,10 @@ impl Default for PlannerParams {
             pitch_range_deg: 20.0,
             extended_rules: true,
             candidate_budget: DEFAULT_CANDIDATE_BUDGET,
+            sf_centred: 0.0,
+            sf_opposed: 0.0,
+            sf_spread: 0.0,
+            sf_margin: 0.0,
         }
     }
 }
@@ -120,6 +134,15 @@ impl PlannerParams {
                 "planner.curvature_segments",
                 "must be at least 1".to_string(),
             ));
+        }
+        for (key, v) in keyed!("planner", p; sf_centred, sf_opposed, sf_spread, sf_margin,) {
+            let m = super::order::MAX_FACTOR;
+            if !(v.is_finite() && v.abs() <= m) {
+                return Err((
+                    key,
+                    format!("must be in [-{m}, {m}] (0: the thesis's order), got {v}"),
+                ));
+            }
         }
         for (key, v) in keyed!("planner", p;
             magnify_factor,

@@ -14,6 +14,7 @@
 //! produce is simulated once (its physics does not depend on how it was found).
 
 pub mod command;
+pub mod order;
 
 use crate::batch::{scenario_for, Item};
 use crate::mesh::AlignedObject;

@@ -13,6 +13,7 @@ mod hostile;
 mod isolation;
 mod issue16;
 mod label;
+mod order;
 mod planner;
 mod quality;
 mod real_meshes;
