@@ -162,12 +162,22 @@ pub struct Measures {
 
 /// The measures of `f` on `names`.
 pub fn measure(labels: &Labels, names: &[&str], f: &OrderFactors) -> Measures {
+    measure_with(labels, names, &|_| *f)
+}
+
+/// The measures on `names`, each object ordered by its own factors `f(name)`.
+pub fn measure_with(
+    labels: &Labels,
+    names: &[&str],
+    factors: &dyn Fn(&str) -> OrderFactors,
+) -> Measures {
     let (mut first, mut checks, mut holding) = (0.0, 0.0, 0usize);
     let (mut pairs, mut wins) = (0.0f64, 0.0f64);
     for name in names {
         let Some(cands) = labels.get(*name) else {
             continue;
         };
+        let f = &factors(name);
         let order = ordered(cands, f);
         first += order.first().map_or(0.0, |c| c.hold);
         if cands.iter().any(|c| c.hold > 0.0) {
@@ -343,27 +353,7 @@ pub fn tune(labels: &Labels, objective: Objective, folds: usize) -> OrderTuning 
         });
     }
     // The cross-validated estimate: each object under its own fold's factors.
-    let mut per_object: Labels = Labels::new();
-    let mut scored: Vec<(String, Vec<Labelled>)> = Vec::new();
-    for n in &names {
-        let f = held_factors[n];
-        // Bake the object's factors into its candidates' order: the place term carries it.
-        let order = ordered(&labels[*n], &f);
-        let cands: Vec<Labelled> = order
-            .iter()
-            .enumerate()
-            .map(|(i, c)| Labelled {
-                place: i,
-                found: order.len(),
-                terms: OrderTerms::from_array([0.0; 4]),
-                axis_plan: c.axis_plan,
-                ..(*c).clone()
-            })
-            .collect();
-        scored.push((n.to_string(), cands));
-    }
-    per_object.extend(scored);
-    let held_out = measure(&per_object, &names, &thesis);
+    let held_out = measure_with(labels, &names, &|n| held_factors[n]);
     let thesis_m = measure(labels, &names, &thesis);
     let all = descend(labels, &names, objective);
     OrderTuning {
