@@ -375,7 +375,7 @@ pub fn planner_toml(t: &OrderTuning) -> String {
         t.objective, t.held_out.first, t.thesis.first
     );
     for (k, v) in &t.factors {
-        s.push_str(&format!("{k} = {v}\n"));
+        s.push_str(&format!("{k} = {v:?}\n"));
     }
     s
 }
