@@ -471,11 +471,19 @@ fn expected_headline() -> String {
         .lines()
         .find(|l| l.starts_with("**Summary**"))
         .expect("REAL_OBJECTS.md's generated block has no **Summary** line");
-    let r: Vec<&str> = summary
-        .split(|c: char| !c.is_ascii_digit())
-        .filter(|n| !n.is_empty())
-        .collect();
-    let (graspable, planned, down, six, replayed, agree) = (r[0], r[1], r[3], r[5], r[7], r[8]);
+    let numbers = |s: &str| -> Vec<String> {
+        s.split(|c: char| !c.is_ascii_digit())
+            .filter(|n| !n.is_empty())
+            .map(str::to_string)
+            .collect()
+    };
+    // The set's figures come first; MuJoCo's after "MuJoCo replays" (replays, verdicts agreed).
+    let (set, mujoco) = summary
+        .split_once("MuJoCo replays")
+        .expect("REAL_OBJECTS.md's Summary line names no MuJoCo replay");
+    let (r, q) = (numbers(set), numbers(mujoco));
+    let (graspable, planned, down, six) = (&r[0], &r[1], &r[3], &r[5]);
+    let (replayed, agree) = (&q[0], &q[1]);
     let lines = [
         format!(
             "- **The thesis.** {} of the {} thesis scenarios match the thesis's Grasp Parameter \
