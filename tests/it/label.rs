@@ -282,3 +282,70 @@ fn resume_after_a_kill_loses_no_finished_grasp() {
     let strip = |v: &[Value]| v.iter().map(without_label).collect::<Vec<_>>();
     assert_eq!(strip(&after), strip(&whole));
 }
+
+/// `scripts/slurm_array.sh` with `GRASP_SIM_COMMAND=label`: two array tasks and their merge
+/// give the plain run's lines.
+#[test]
+fn slurm_array_tasks_label_as_one_run_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = ["assets/objects/cup.stl", "assets/objects/cylinder_d40.stl"];
+    let flags = ["--grasps", "2", "--samples", "1"];
+    let plain = dir.path().join("plain.jsonl");
+    let o = grasp_sim()
+        .current_dir(root())
+        .arg("label")
+        .args(flags)
+        .args(inputs)
+        .arg("--out")
+        .arg(&plain)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let out = dir.path().join("run");
+    let slurm = |mode: &str, id: Option<u32>| {
+        let mut c = std::process::Command::new("bash");
+        c.current_dir(root())
+            .arg("scripts/slurm_array.sh")
+            .arg(mode)
+            .arg(&out)
+            .args(flags)
+            .args(inputs)
+            .env("GRASP_SIM", env!("CARGO_BIN_EXE_grasp-sim"))
+            .env("GRASP_SIM_COMMAND", "label")
+            .env("SLURM_CPUS_PER_TASK", "1");
+        if let Some(id) = id {
+            c.env("SLURM_ARRAY_JOB_ID", "7")
+                .env("SLURM_ARRAY_TASK_ID", id.to_string())
+                .env("SLURM_ARRAY_TASK_MIN", "0")
+                .env("SLURM_ARRAY_TASK_MAX", "1")
+                .env("SLURM_ARRAY_TASK_COUNT", "2");
+        }
+        c.output().unwrap()
+    };
+    for id in [1, 0] {
+        let r = slurm("task", Some(id));
+        assert_eq!(
+            r.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&r.stderr)
+        );
+    }
+    let m = slurm("merge", None);
+    assert_eq!(
+        m.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&m.stderr)
+    );
+    let strip = |v: Vec<Value>| v.iter().map(without_label).collect::<Vec<_>>();
+    assert_eq!(
+        strip(lines(&out.join("results.jsonl"))),
+        strip(lines(&plain))
+    );
+}
