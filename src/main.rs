@@ -80,7 +80,16 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
         Some(Command::Label(args)) => {
             grasp_sim::label::command::run(&args.request(), &Bar::batch())
         }
-        Some(Command::LabelWorker {
+        Some(c @ (Command::LabelWorker { .. } | Command::Check { .. })) => label_command(c),
+        None => run_inputs(cli),
+    }
+}
+
+/// `label-worker` and `check --grasps`.
+fn label_command(command: cli::Command) -> anyhow::Result<u8> {
+    use grasp_sim::label::command::{self as label, CheckRequest, WorkerArgs};
+    match command {
+        cli::Command::LabelWorker {
             path,
             input_hash,
             template,
@@ -92,8 +101,8 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
             export_mjcf,
             mujoco_fraction,
             skip,
-        }) => {
-            let args = grasp_sim::label::command::WorkerArgs {
+        } => {
+            let args = WorkerArgs {
                 template,
                 units: units.map(Into::into),
                 params: grasp_sim::label::LabelParams {
@@ -107,18 +116,17 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
                     fraction: mujoco_fraction,
                 }),
             };
-            let skip = skip.into_iter().collect();
-            grasp_sim::label::command::run_worker(&path, &input_hash, &args, &skip)
+            label::run_worker(&path, &input_hash, &args, &skip.into_iter().collect())
         }
-        Some(Command::Check {
+        cli::Command::Check {
             grasps,
             input,
             samples,
             gravity,
             units,
             out,
-        }) => {
-            let request = grasp_sim::label::command::CheckRequest {
+        } => {
+            let request = CheckRequest {
                 grasps,
                 input,
                 units: units.map(Into::into),
@@ -126,9 +134,9 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
                 gravity: gravity.map(Into::into),
                 out,
             };
-            grasp_sim::label::command::check(&request, &Bar::batch())
+            label::check(&request, &Bar::batch())
         }
-        None => run_inputs(cli),
+        _ => unreachable!("label_command is called for label-worker and check only"),
     }
 }
 

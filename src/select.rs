@@ -365,30 +365,14 @@ fn search_axis(
     } else {
         // Issue 58: the axis's feasible grasps in the thesis's order, then taken by falling
         // score ([`crate::plan::order`]); the candidate budget bounds the search as before.
-        let mut all = Vec::new();
-        let searched = search_with(
-            &aligned.mesh,
-            p.hand,
-            &graded,
-            p.planner,
-            rules,
-            budget,
-            |g| {
-                all.push(g);
-                true
-            },
-        );
+        let (all, searched) = all_feasible(p, &aligned, &graded, rules, budget);
         found = all.len();
         let order = crate::plan::order::reorder(&all, &aligned, p.hand, &factors);
         let mut slots: Vec<Option<Grasp>> = all.into_iter().map(Some).collect();
-        for i in order {
-            if let Some(g) = slots[i].take() {
-                if !take(sel, g) {
-                    stopped = true;
-                    break;
-                }
-            }
-        }
+        stopped = order
+            .into_iter()
+            .filter_map(|i| slots[i].take())
+            .any(|g| !take(sel, g));
         searched
     };
     t.search += crate::plan::timings::ms(t0);
@@ -403,6 +387,31 @@ fn search_axis(
         candidates_available: available,
         budget_stopped: !stopped && tried < available,
     }
+}
+
+/// Every feasible grasp of `graded` in the thesis's search order, within `budget` candidates;
+/// with the candidates tried and the rejections.
+fn all_feasible(
+    p: &SelectParams,
+    aligned: &AlignedObject,
+    graded: &plan::GradedDomain,
+    rules: RuleSet,
+    budget: usize,
+) -> (Vec<Grasp>, (usize, BTreeMap<Rejection, usize>)) {
+    let mut all = Vec::new();
+    let searched = search_with(
+        &aligned.mesh,
+        p.hand,
+        graded,
+        p.planner,
+        rules,
+        budget,
+        |g| {
+            all.push(g);
+            true
+        },
+    );
+    (all, searched)
 }
 
 /// Returns true if and only if enough is known: without the check, `collect` grasps; with it,

@@ -242,18 +242,7 @@ impl Held {
 /// Bad flags, a template or results file that cannot be read, an output that cannot be written.
 pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
     let template = request.worker.template()?;
-    if let Some(path) = &request.out {
-        check_output_file(path).context("--out")?;
-    }
-    if let Some(path) = &request.summary {
-        check_output_file(path).context("--summary")?;
-    }
-    if let Some(dir) = &request.npz {
-        check_output_dir(dir).context("--npz")?;
-    }
-    if let Some(e) = &request.worker.export {
-        check_output_dir(&e.dir).context("--export-mjcf")?;
-    }
+    check_outputs(request)?;
     let mut items = batch::expand(&request.inputs)?;
     if let Some(shard) = request.shard {
         items = shard.of(&items);
@@ -273,30 +262,7 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
         return merge(request, &keys);
     }
     // What the file holds, by key; and the journal to append to.
-    let mut held: HashMap<Key, Held> = HashMap::new();
-    let journal = match (&request.out, request.resume) {
-        (Some(path), true) => {
-            let (j, partial) = journal::Journal::open_lines(path)?;
-            if partial > 0 {
-                eprintln!(
-                    "grasp-sim: warning: {}: cut off a partial last line ({partial} bytes) an interrupted run left",
-                    path.display()
-                );
-            }
-            let (lines, _) = read_lines(path)?;
-            for l in lines {
-                if request.retry_errors && l.is_error {
-                    continue;
-                }
-                held.entry(l.key.clone())
-                    .or_default()
-                    .lines
-                    .insert(l.grasp_index, l);
-            }
-            Some(j)
-        }
-        _ => None,
-    };
+    let (mut held, journal) = resumed(request)?;
     let todo: Vec<usize> = (0..items.len())
         .filter(|&i| !held.get(&keys[i]).is_some_and(Held::is_complete))
         .collect();
@@ -316,8 +282,11 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
     let worker = (!request.in_process)
         .then(|| worker(request, (jobs / todo.len().max(1)).max(1)))
         .transpose()?;
-    let new_lines: Mutex<Vec<ReadLine>> = Mutex::new(Vec::new());
-    let append_error: Mutex<Option<anyhow::Error>> = Mutex::new(None);
+    let keeper = Keeper {
+        journal: journal.as_ref(),
+        lines: Mutex::new(Vec::new()),
+        error: Mutex::new(None),
+    };
     let summaries: Mutex<Vec<(usize, ObjectSummary)>> = Mutex::new(Vec::new());
     let done = std::sync::atomic::AtomicUsize::new(0);
     progress.begin(todo.len());
@@ -327,20 +296,7 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
             let item = &items[i];
             let key = &keys[i];
             let skip = held.get(key).map(Held::done).unwrap_or_default();
-            let keep = |line: Line| {
-                let Ok(r) = read_line(&line.text) else {
-                    return;
-                };
-                if let Some(j) = &journal {
-                    if let Err(e) = j.append_line(&line.text) {
-                        append_error
-                            .lock()
-                            .unwrap_or_else(|p| p.into_inner())
-                            .get_or_insert(e.into());
-                    }
-                }
-                new_lines.lock().unwrap_or_else(|p| p.into_inner()).push(r);
-            };
+            let keep = |line: Line| keeper.keep(line);
             let summary = match &worker {
                 None => run_in_process(item, key, &template, &request.worker, &skip, &keep),
                 Some(w) => run_isolated(item, key, w, &skip, &keep),
@@ -364,7 +320,8 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
         Err(_) => work(),
     }
     progress.end();
-    if let Some(e) = append_error.into_inner().unwrap_or_else(|p| p.into_inner()) {
+    let (new_lines, error) = (keeper.lines, keeper.error);
+    if let Some(e) = error.into_inner().unwrap_or_else(|p| p.into_inner()) {
         return Err(e);
     }
     for l in new_lines.into_inner().unwrap_or_else(|p| p.into_inner()) {
@@ -373,22 +330,9 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
             .lines
             .insert(l.grasp_index, l);
     }
-    let (text, errors, grasps) = ordered(&keys, &held);
-    match (&request.out, journal) {
-        (Some(_), Some(j)) => j.finish(text.as_bytes())?,
-        (Some(path), None) => journal::write_atomically(path, text.as_bytes())?,
-        _ => std::io::stdout().lock().write_all(text.as_bytes())?,
-    }
     let mut summaries = summaries.into_inner().unwrap_or_else(|p| p.into_inner());
     summaries.sort_by_key(|(i, _)| *i);
-    if let Some(path) = &request.summary {
-        let mut text = String::new();
-        for (_, s) in &summaries {
-            text.push_str(&crate::report::to_rounded_json(s)?);
-            text.push('\n');
-        }
-        journal::write_atomically(path, text.as_bytes())?;
-    }
+    let (errors, grasps) = write_all(request, &keys, &held, journal, &summaries)?;
     if let Some(dir) = &request.npz {
         write_npz(dir, &keys, &held, &template, &request.worker, &items)?;
     }
@@ -404,6 +348,108 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
         samples as f64 / seconds.max(1e-9),
     );
     Ok(if errors > 0 { 2 } else { 0 })
+}
+
+/// Checks that every output `request` names can be written, before any work.
+///
+/// # Errors
+/// The first that cannot, named by its flag.
+fn check_outputs(request: &Request) -> anyhow::Result<()> {
+    for (flag, file) in [("--out", &request.out), ("--summary", &request.summary)] {
+        if let Some(path) = file {
+            check_output_file(path).context(flag)?;
+        }
+    }
+    let export = request.worker.export.as_ref().map(|e| e.dir.clone());
+    for (flag, dir) in [("--npz", &request.npz), ("--export-mjcf", &export)] {
+        if let Some(d) = dir {
+            check_output_dir(d).context(flag)?;
+        }
+    }
+    Ok(())
+}
+
+/// Where the objects' lines go as they finish: appended to the journal (with `--resume`) and
+/// kept for the file written at the end; the first append that failed.
+struct Keeper<'a> {
+    journal: Option<&'a journal::Journal>,
+    lines: Mutex<Vec<ReadLine>>,
+    error: Mutex<Option<anyhow::Error>>,
+}
+
+impl Keeper<'_> {
+    /// Keeps `line` (a line that is not a label line is dropped).
+    fn keep(&self, line: Line) {
+        let Ok(r) = read_line(&line.text) else {
+            return;
+        };
+        if let Some(Err(e)) = self.journal.map(|j| j.append_line(&line.text)) {
+            self.error
+                .lock()
+                .unwrap_or_else(|p| p.into_inner())
+                .get_or_insert(e.into());
+        }
+        self.lines.lock().unwrap_or_else(|p| p.into_inner()).push(r);
+    }
+}
+
+/// What `--out FILE --resume` already holds, by key (error lines left out with
+/// `--retry-errors`), and the journal to append to; nothing without `--resume`.
+///
+/// # Errors
+/// The file cannot be opened, locked or read.
+fn resumed(request: &Request) -> anyhow::Result<(HashMap<Key, Held>, Option<journal::Journal>)> {
+    let mut held: HashMap<Key, Held> = HashMap::new();
+    let (Some(path), true) = (&request.out, request.resume) else {
+        return Ok((held, None));
+    };
+    let (j, partial) = journal::Journal::open_lines(path)?;
+    if partial > 0 {
+        eprintln!(
+            "grasp-sim: warning: {}: cut off a partial last line ({partial} bytes) an interrupted run left",
+            path.display()
+        );
+    }
+    let (lines, _) = read_lines(path)?;
+    for l in lines {
+        if request.retry_errors && l.is_error {
+            continue;
+        }
+        held.entry(l.key.clone())
+            .or_default()
+            .lines
+            .insert(l.grasp_index, l);
+    }
+    Ok((held, Some(j)))
+}
+
+/// Writes every line (to `--out`, through the journal when resuming, or to stdout) and the
+/// `--summary` file; returns the error lines and the grasp lines written.
+///
+/// # Errors
+/// An output that cannot be written.
+fn write_all(
+    request: &Request,
+    keys: &[Key],
+    held: &HashMap<Key, Held>,
+    journal: Option<journal::Journal>,
+    summaries: &[(usize, ObjectSummary)],
+) -> anyhow::Result<(usize, usize)> {
+    let (text, errors, grasps) = ordered(keys, held);
+    match (&request.out, journal) {
+        (Some(_), Some(j)) => j.finish(text.as_bytes())?,
+        (Some(path), None) => journal::write_atomically(path, text.as_bytes())?,
+        _ => std::io::stdout().lock().write_all(text.as_bytes())?,
+    }
+    if let Some(path) = &request.summary {
+        let mut text = String::new();
+        for (_, s) in summaries {
+            text.push_str(&crate::report::to_rounded_json(s)?);
+            text.push('\n');
+        }
+        journal::write_atomically(path, text.as_bytes())?;
+    }
+    Ok((errors, grasps))
 }
 
 /// Every line for `keys`, in input order, each object's object-level line first and then its

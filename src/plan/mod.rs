@@ -13,6 +13,7 @@
 //! Units: millimetres and degrees at the boundary (parameters, reports), radians inside. The
 //! object is in the aligned frame (principal axis +Z, bottom at Z = 0).
 
+pub mod contacts;
 pub mod curvature;
 pub mod diameter;
 pub mod domain;

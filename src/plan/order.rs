@@ -17,8 +17,8 @@
 
 use crate::hand::Hand;
 use crate::mesh::AlignedObject;
+use crate::plan::params::PlannerParams;
 use crate::plan::search::Grasp;
-use crate::scenario::PlannerParams;
 use nalgebra::{Point3, Vector3};
 use serde::Serialize;
 
@@ -121,7 +121,7 @@ impl OrderTerms {
 
 /// The terms of `g`, planned on `aligned` for `hand`.
 pub fn terms(g: &Grasp, aligned: &AlignedObject, hand: &Hand) -> OrderTerms {
-    let contacts = crate::quality::planned_contacts(g, hand);
+    let contacts = super::contacts::planned_contacts(g, hand);
     let height = aligned.height_mm.max(1e-9);
     let com = aligned.to_aligned * Point3::from(aligned.original.centroid.coords);
     let n = contacts.len().max(1) as f64;

@@ -41,14 +41,14 @@ impl SimHand {
                 .iter()
                 .map(|f| [f.centre.theta1_deg, f.centre.theta2_deg])
                 .collect(),
-            planned_contacts_mm: by_body(&crate::quality::planned_contacts(g, hand)),
+            planned_contacts_mm: by_body(&crate::plan::contacts::planned_contacts(g, hand)),
         }
     }
 }
 
 /// The points of `contacts`, a group per phalanx (finger and phalanx), in the order each
 /// first appears; the palm's left out.
-fn by_body(contacts: &[crate::quality::Contact]) -> Vec<Vec<Point3<f64>>> {
+fn by_body(contacts: &[crate::plan::contacts::Contact]) -> Vec<Vec<Point3<f64>>> {
     let mut bodies: Vec<(&str, u8)> = Vec::new();
     let mut groups: Vec<Vec<Point3<f64>>> = Vec::new();
     for c in contacts.iter().filter(|c| c.phalanx > 0) {
