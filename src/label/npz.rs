@@ -113,39 +113,14 @@ impl Array {
 pub fn npz(lines: &[serde_json::Value], fingers: usize) -> std::io::Result<Vec<u8>> {
     let k = lines.len();
     let f64_at = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
-    let flat = |key: &str, n: usize| -> Vec<f64> {
-        lines
-            .iter()
-            .flat_map(|l| {
-                let mut out: Vec<f64> = Vec::with_capacity(n);
-                flatten(&l[key], &mut out);
-                out.resize(n, f64::NAN);
-                out
-            })
-            .collect()
-    };
+    let flat = |key: &str, n: usize| flat_of(lines, key, n);
     let text = |key: &str| -> Vec<String> {
         lines
             .iter()
             .map(|l| l[key].as_str().unwrap_or("").to_string())
             .collect()
     };
-    let gravity: Vec<Vec<f64>> = lines
-        .first()
-        .and_then(|l| l["directions"].as_array())
-        .map(|d| {
-            d.iter()
-                .map(|g| {
-                    let mut v = Vec::new();
-                    flatten(&g["gravity"], &mut v);
-                    v.resize(3, f64::NAN);
-                    v
-                })
-                .collect()
-        })
-        .unwrap_or_default();
-    let dirs = gravity.len();
-    let arrays = vec![
+    let mut arrays = vec![
         Array::i64s(
             "grasp_index",
             &lines
@@ -202,6 +177,32 @@ pub fn npz(lines: &[serde_json::Value], fingers: usize) -> std::io::Result<Vec<u
             vec![k],
             lines.iter().map(|l| f64_at(&l["grade"]["palm"])),
         ),
+    ];
+    arrays.extend(direction_arrays(lines));
+    zip_of(&arrays)
+}
+
+/// The per-direction arrays: the directions' gravity (from the first line) and each grasp's
+/// hold probability under each.
+fn direction_arrays(lines: &[serde_json::Value]) -> Vec<Array> {
+    let k = lines.len();
+    let f64_at = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+    let gravity: Vec<Vec<f64>> = lines
+        .first()
+        .and_then(|l| l["directions"].as_array())
+        .map(|d| {
+            d.iter()
+                .map(|g| {
+                    let mut v = Vec::new();
+                    flatten(&g["gravity"], &mut v);
+                    v.resize(3, f64::NAN);
+                    v
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    let dirs = gravity.len();
+    vec![
         Array::f64s(
             "direction_gravity",
             vec![dirs, 3],
@@ -219,14 +220,18 @@ pub fn npz(lines: &[serde_json::Value], fingers: usize) -> std::io::Result<Vec<u
                 v
             }),
         ),
-    ];
+    ]
+}
+
+/// The stored (uncompressed) zip of `arrays`, each as `<name>.npy`, with fixed dates.
+fn zip_of(arrays: &[Array]) -> std::io::Result<Vec<u8>> {
     let mut buf = std::io::Cursor::new(Vec::new());
     {
         let mut zip = zip::ZipWriter::new(&mut buf);
         let options = zip::write::SimpleFileOptions::default()
             .compression_method(zip::CompressionMethod::Stored)
             .last_modified_time(zip::DateTime::default());
-        for a in &arrays {
+        for a in arrays {
             zip.start_file(format!("{}.npy", a.name), options)
                 .map_err(std::io::Error::other)?;
             zip.write_all(&a.npy())?;
@@ -234,6 +239,19 @@ pub fn npz(lines: &[serde_json::Value], fingers: usize) -> std::io::Result<Vec<u
         zip.finish().map_err(std::io::Error::other)?;
     }
     Ok(buf.into_inner())
+}
+
+/// `key`'s numbers of every line, `n` a line (missing ones NaN).
+fn flat_of(lines: &[serde_json::Value], key: &str, n: usize) -> Vec<f64> {
+    lines
+        .iter()
+        .flat_map(|l| {
+            let mut out: Vec<f64> = Vec::with_capacity(n);
+            flatten(&l[key], &mut out);
+            out.resize(n, f64::NAN);
+            out
+        })
+        .collect()
 }
 
 /// Every number of a nested JSON list, in order.

@@ -519,6 +519,38 @@ pub fn label_object(
         summary.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
         return Ok(summary);
     }
+    let t1 = Instant::now();
+    let todo: Vec<usize> = picks.into_iter().filter(|i| !skip.contains(i)).collect();
+    let posed = pose_picks(&scenario, &object, &selection, &todo, export)?;
+    summary.collider_ms = t1.elapsed().as_secs_f64() * 1000.0;
+    let t2 = Instant::now();
+    let (samples, held) = check_all(
+        &scenario,
+        &object,
+        &posed,
+        &|i, wall| info(i, n, wall),
+        emit,
+    );
+    summary.check_ms = t2.elapsed().as_secs_f64() * 1000.0;
+    summary.labelled = posed.len();
+    summary.samples_checked = samples;
+    summary.holding = held;
+    summary.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
+    Ok(summary)
+}
+
+/// The candidates `picks` of `selection` posed for their checks (the line as written, its pose
+/// and collider), each exported as an MJCF scene when `export` takes it.
+///
+/// # Errors
+/// [`Error::Export`] for a scene that cannot be written.
+fn pose_picks(
+    scenario: &Scenario,
+    object: &PreparedObject,
+    selection: &Selection,
+    picks: &[usize],
+    export: Option<&MjcfExport>,
+) -> Result<Vec<Posed>, Error> {
     // Each candidate's place in its axis plan's order.
     let mut places = Vec::with_capacity(selection.candidates.len());
     let mut seen = vec![0usize; selection.axes.len()];
@@ -530,10 +562,9 @@ pub fn label_object(
         });
         seen[c.axis_plan] += 1;
     }
-    let t1 = Instant::now();
-    let posed: Vec<Posed> = picks
+    let hand = &scenario.hand;
+    picks
         .iter()
-        .filter(|i| !skip.contains(i))
         .map(|&i| -> Result<Posed, Error> {
             let c = &selection.candidates[i];
             let plan = &selection.axes[c.axis_plan];
@@ -561,7 +592,7 @@ pub fn label_object(
                     &crate::export::ExportInput {
                         name: &scenario.name,
                         object: &plan.aligned,
-                        case: object.case(&scenario, &pose, &shape),
+                        case: object.case(scenario, &pose, &shape),
                     },
                 )?;
             }
@@ -572,22 +603,7 @@ pub fn label_object(
                 shape,
             })
         })
-        .collect::<Result<_, _>>()?;
-    summary.collider_ms = t1.elapsed().as_secs_f64() * 1000.0;
-    let t2 = Instant::now();
-    let (samples, held) = check_all(
-        &scenario,
-        &object,
-        &posed,
-        &|i, wall| info(i, n, wall),
-        emit,
-    );
-    summary.check_ms = t2.elapsed().as_secs_f64() * 1000.0;
-    summary.labelled = posed.len();
-    summary.samples_checked = samples;
-    summary.holding = held;
-    summary.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
-    Ok(summary)
+        .collect()
 }
 
 /// Checks given grasp lines (`lines`: each the text of one line, or why it could not be read)
