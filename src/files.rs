@@ -152,10 +152,118 @@ pub fn check_replaceable(path: &Path) -> io::Result<()> {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary file beside it (`.NAME.tmp`), synced, and a
-/// rename: `path` is then either its old self or whole. On any error, a full disk included,
-/// the temporary file is removed and `path` is left as it was. Only a regular file or a new
-/// path is replaced ([`check_replaceable`]).
+/// The most bytes one name in a path may have: the common file systems' limit (`NAME_MAX`).
+pub const MAX_NAME_BYTES: usize = 255;
+
+/// The most bytes an output folder's name may have (a scenario's `name`): room under
+/// [`MAX_NAME_BYTES`] for the `-N` a repeated name gets and a temporary file's suffix.
+pub const MAX_FOLDER_NAME_BYTES: usize = 200;
+
+/// What is wrong with `name` as the name of one folder inside an output folder (`--report
+/// DIR`, `--export-mjcf DIR`, `--export-urdf DIR`), or `None` when nothing is: it must be one
+/// name, not empty, not `.` or `..`, without `/` or `\` (an absolute name starts with `/`),
+/// NUL or other control characters, and at most [`MAX_FOLDER_NAME_BYTES`] bytes. Joined onto
+/// the folder given, such a name stays inside it.
+pub fn folder_name_problem(name: &str) -> Option<String> {
+    if name.is_empty() {
+        return Some("is empty".to_string());
+    }
+    if name == "." || name == ".." {
+        return Some(format!("is `{name}`, which names no folder of its own"));
+    }
+    if let Some(c) = name
+        .chars()
+        .find(|&c| c == '/' || c == '\\' || c.is_control())
+    {
+        let what = match c {
+            '/' => "`/`".to_string(),
+            '\\' => "`\\`".to_string(),
+            '\0' => "a NUL byte".to_string(),
+            c => format!("the control character U+{:04X}", u32::from(c)),
+        };
+        return Some(format!("contains {what}"));
+    }
+    if name.len() > MAX_FOLDER_NAME_BYTES {
+        return Some(format!(
+            "has {} bytes, more than the {MAX_FOLDER_NAME_BYTES} a folder name may have here",
+            name.len()
+        ));
+    }
+    None
+}
+
+/// `name` made a folder name ([`folder_name_problem`] finds nothing in it): each `/`, `\`
+/// and control character replaced by `_`, `.` and `..` (and an empty name) prefixed with `_`,
+/// and cut (at a character boundary) to [`MAX_FOLDER_NAME_BYTES`]. What a mesh's file stem
+/// becomes when it names a run; a name that is one already is kept as it is.
+pub fn folder_name(name: &str) -> String {
+    let mut out: String = name
+        .chars()
+        .map(|c| {
+            if c == '/' || c == '\\' || c.is_control() {
+                '_'
+            } else {
+                c
+            }
+        })
+        .collect();
+    if out.is_empty() || out == "." || out == ".." {
+        out.insert(0, '_');
+    }
+    let mut keep = out.len().min(MAX_FOLDER_NAME_BYTES);
+    while !out.is_char_boundary(keep) {
+        keep -= 1;
+    }
+    out.truncate(keep);
+    out
+}
+
+/// A name no other writer of this or another process is using in `dir`: `.NAME.PID.N.tmp`,
+/// `NAME` shortened (at a character boundary) to keep the whole within [`MAX_NAME_BYTES`].
+fn temporary_name(dir: &Path, name: &str, what: &str) -> std::path::PathBuf {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let suffix = format!(".{}.{n}.{what}", std::process::id());
+    let mut keep = MAX_NAME_BYTES
+        .saturating_sub(1 + suffix.len())
+        .min(name.len());
+    while !name.is_char_boundary(keep) {
+        keep -= 1;
+    }
+    dir.join(format!(".{}{suffix}", &name[..keep]))
+}
+
+/// Creates a new file at a name no one else uses in `dir` (see [`temporary_name`]), never
+/// through an existing file or link (`O_EXCL`); returns it with its path.
+///
+/// # Errors
+/// The operating system's error creating it.
+pub fn create_private(
+    dir: &Path,
+    name: &str,
+    what: &str,
+) -> io::Result<(std::fs::File, std::path::PathBuf)> {
+    loop {
+        let path = temporary_name(dir, name, what);
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&path)
+        {
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+            Ok(f) => return Ok((f, path)),
+        }
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file beside it (`.NAME.PID.N.tmp`, made new,
+/// so that two writers never share one and no link is followed), synced, and a rename: `path`
+/// is then either its old self or whole. On any error, a full disk included, the temporary
+/// file is removed and `path` is left as it was. Only a regular file or a new path is replaced
+/// ([`check_replaceable`], checked before the write and again before the rename): never a
+/// symbolic link, a device or a FIFO, and nothing is ever opened at `path` itself, so a FIFO
+/// there cannot block the write. Every output file of grasp-sim is written here.
 ///
 /// Test hook, debug builds only: with `GRASP_SIM_TEST_FAULT=enospc:NAME`, writing a file whose
 /// path contains `NAME` writes half its bytes and then fails as a full disk does (`ENOSPC`),
@@ -174,20 +282,37 @@ pub fn write_replacing(path: &Path, bytes: &[u8]) -> io::Result<()> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp"));
-    let written = std::fs::File::create(&tmp).and_then(|mut f| {
-        if full_disk_fault(path) {
-            f.write_all(&bytes[..bytes.len() / 2])?;
-            return Err(io::Error::from_raw_os_error(28));
-        }
-        f.write_all(bytes)?;
-        f.sync_data()
-    });
+    if name.len() > MAX_NAME_BYTES {
+        return Err(io::Error::other(format!(
+            "its name has {} bytes, more than the {MAX_NAME_BYTES} a file system takes",
+            name.len()
+        )));
+    }
+    let (mut f, tmp) = create_private(dir, &name, "tmp")?;
+    let written = if full_disk_fault(path) {
+        f.write_all(&bytes[..bytes.len() / 2])
+            .and_then(|()| Err(io::Error::from_raw_os_error(28)))
+    } else {
+        f.write_all(bytes).and_then(|()| f.sync_data())
+    };
+    drop(f);
     written
+        .and_then(|()| check_replaceable(path))
         .and_then(|()| std::fs::rename(&tmp, path))
         .inspect_err(|_| {
             let _ = std::fs::remove_file(&tmp);
         })
+}
+
+/// Checks that a file can be made in the folder `dir`: makes one at a name no one else uses
+/// and removes it (two runs checking one folder at once do not see each other's).
+///
+/// # Errors
+/// The operating system's error.
+pub fn check_writable_dir(dir: &Path) -> io::Result<()> {
+    let (f, probe) = create_private(dir, ".grasp-sim-write-test", "probe")?;
+    drop(f);
+    std::fs::remove_file(&probe)
 }
 
 /// Whether the debug-build fault hook of [`write_replacing`] asks this write to fail.
@@ -231,6 +356,36 @@ mod tests {
         assert_eq!(e.kind(), io::ErrorKind::InvalidData);
         assert_eq!(size(MAX_MESH_BYTES), "256 MiB");
         assert_eq!(size(MAX_RESULTS_BYTES), "1 GiB");
+    }
+
+    #[test]
+    fn folder_names_stay_inside_their_folder() {
+        for bad in [
+            "",
+            ".",
+            "..",
+            "../../escape",
+            "/abs",
+            "a\\b",
+            "a\0b",
+            "a\nb",
+        ] {
+            assert!(folder_name_problem(bad).is_some(), "{bad:?}");
+            let fixed = folder_name(bad);
+            assert_eq!(folder_name_problem(&fixed), None, "{bad:?} -> {fixed:?}");
+            let joined = Path::new("/out").join(&fixed);
+            assert_eq!(joined.parent(), Some(Path::new("/out")), "{fixed:?}");
+        }
+        assert_eq!(folder_name("../../escape"), ".._.._escape");
+        assert_eq!(folder_name(".."), "_..");
+        assert_eq!(folder_name_problem("a\0b").unwrap(), "contains a NUL byte");
+        for good in ["cup", "cup 2", "textured", ".hidden", "a..b", "é"] {
+            assert_eq!(folder_name_problem(good), None, "{good:?}");
+            assert_eq!(folder_name(good), good);
+        }
+        let long = "é".repeat(150);
+        assert!(folder_name_problem(&long).unwrap().contains("300 bytes"));
+        assert_eq!(folder_name(&long).len(), MAX_FOLDER_NAME_BYTES);
     }
 
     #[test]
