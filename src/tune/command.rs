@@ -32,6 +32,16 @@ pub struct Request {
 /// # Errors
 /// A bad template or input list, an output that cannot be written, or every setting invalid.
 pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
+    // One parameter swept twice would make a grid whose two columns set the same value, the
+    // second overwriting the first at every setting.
+    for (k, sweep) in request.sweeps.iter().enumerate() {
+        if request.sweeps[..k].iter().any(|s| s.name == sweep.name) {
+            anyhow::bail!(
+                "--param: `{}` is given twice; sweep each parameter once (NAME=START:END:STEP)",
+                sweep.name
+            );
+        }
+    }
     let settings = super::grid_size(&request.sweeps);
     if settings > super::MAX_SETTINGS {
         let sizes: Vec<String> = request
