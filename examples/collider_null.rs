@@ -1,5 +1,5 @@
-//! Issue 30's study of the physics check's object across frames (docs/FRAMES.md, "Measured
-//! (issue 30, session 44)"): what the check is given, the volume, mass, collider, and the
+//! Issue 30's study of the physics check's object across frames (docs/studies/
+//! 2026-12-02-frames-verdicts.md): what the check is given, the volume, mass, collider, and the
 //! collider's centre of mass and inertia, for the scenario's mesh as it loads and for each STL
 //! given (the same mesh written in other frames, as the frame test dumps them with
 //! `GRASP_SIM_FRAMES_DUMP`), with the largest distance of an aligned vertex from the first

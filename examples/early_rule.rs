@@ -40,8 +40,7 @@ const RULES: [(f64, f64); 11] = [
 
 /// Where the rule with `window_s` and `margin` decides `t`'s hold: (verdict by motion, time,
 /// translation, rotation) at the decision, or `None` if it runs to the end. The verdict is
-/// `hold` for a rest within the thresholds, `slip` for a rest beyond them, or anywhere for a
-/// grasp whose closing ended deeper than `max_penetration_mm` in the object (a rest under
+/// `hold` for a rest within the thresholds, `slip` for a rest beyond them (a rest under
 /// gravity is a rest on the hand).
 fn decide(
     t: &HoldTrace,
@@ -60,9 +59,7 @@ fn decide(
         if remaining <= 1e-9 {
             return None;
         }
-        let penetrated = t.outcome.closing_penetration_mm > params.hold.max_penetration_mm;
-        let Some(verdict) = rule.decide(&t.samples[..=i], &t.frame, remaining, params, penetrated)
-        else {
+        let Some(verdict) = rule.decide(&t.samples[..=i], &t.frame, remaining, params) else {
             continue;
         };
         let (p, q) = t.samples[i];

@@ -1,5 +1,5 @@
-//! Issue 30's study of the physics check's verdicts across frames (docs/FRAMES.md, "Measured
-//! (issue 30, session 44)"): runs a scenario several times under a null perturbation, a change
+//! Issue 30's study of the physics check's verdicts across frames (docs/studies/
+//! 2026-12-02-frames-verdicts.md): runs a scenario several times under a null perturbation, a change
 //! no measurement could tell from none, and prints each run's candidates in search order with
 //! their verdicts, so that a verdict that flips under a null can be told from one that a frame
 //! changes.

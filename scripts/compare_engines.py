@@ -4,24 +4,36 @@
     python3 scripts/compare_engines.py GRASP_SIM_BINARY OUT_DIR [--require NAME ...] SCENARIO...
 
 Runs `GRASP_SIM_BINARY --json --export-mjcf OUT_DIR SCENARIO...`, replays every exported scene
-with scripts/mujoco_replay.py, and prints a Markdown table of both engines' verdicts and numbers.
-Exits 1 if a scenario named with --require gets different verdicts (CI requires D40 and the cup).
+with scripts/mujoco_replay.py, and prints a Markdown table of both engines' answers to each of
+the check's two questions apart (issue 55): the verdict (what gravity did) and the fidelity
+(`as_planned`), with the figures behind the second (the closing's shift, the phalanges on
+plan), then the agreement on each and the distributions of the differences, so that a
+disagreement across a threshold by a hair and one by 20 mm do not look alike. Exits 1 if a
+scenario named with --require gets different verdicts (CI requires D40 and the cup).
+With --write-doc the table and its count replace the generated block of docs/MUJOCO.md
+("Agreement"), whose headline line the README's headline copies (scripts/headline.py):
+
+    python3 scripts/compare_engines.py target/release/grasp-sim out/ --write-doc \
+        scenarios/*.toml assets/objects/train/*.toml
 
     python3 scripts/compare_engines.py GRASP_SIM_BINARY OUT_DIR --robust N [--six] [--jsonl F] SCENARIO...
 
 Issue 34: runs the binary with `--samples N` (and `--gravity six`), replays each perturbed
 sample's exported scene (OUT_DIR/<scenario>/samples/<k>/) in MuJoCo, and prints per grasp both
-engines' hold probabilities, their difference, the per-sample agreement, and over all grasps
-the mean absolute difference, the Brier score of each engine's probability against the other's
+engines' hold probabilities and probabilities of a hold as planned, their differences, the
+per-sample agreement, and over all grasps the mean absolute difference of each, the Brier score of each engine's probability against the other's
 per-sample outcomes, and how often one says >= 0.9 while the other says < 0.5. `--jsonl F`
 writes one line per grasp with both engines' per-sample verdicts.
 """
 import json
+import math
+import os
 import pathlib
 import subprocess
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import docblock  # noqa: E402
 import mujoco_replay  # noqa: E402
 
 
@@ -37,8 +49,8 @@ def robust(binary, out_dir, n, six, jsonl, scenarios):
         if not run.stdout.strip():
             return 2
     print("| scenario | main check | rapier p [95 % interval] | MuJoCo p | difference | samples agreeing "
-          "| rapier [ms] | MuJoCo [ms] |")
-    print("|---|---|---|---|---|---|---|---|")
+          "| rapier p as planned | MuJoCo p as planned | rapier [ms] | MuJoCo [ms] |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
     rows = []
     out = open(jsonl, "w") if jsonl else None
     for line in run.stdout.splitlines():
@@ -46,22 +58,27 @@ def robust(binary, out_dir, n, six, jsonl, scenarios):
         name, sim = d["scenario"], d["sim"]
         r = sim.get("robust")
         if r is None:
-            print(f"| {name} | {sim['verdict']} | (not sampled) | | | | | |")
+            print(f"| {name} | {sim['verdict']} | (not sampled) | | | | | | | |")
             continue
-        verdicts, wall = [], 0.0
+        verdicts, planned, wall = [], [], 0.0
         for k in range(r["samples"]):
             m = mujoco_replay.replay(out_dir / name / "samples" / str(k),
                                      mujoco_replay.SIX if six else None)
             verdicts.append(m["verdict"])
+            planned.append(m["fidelity"]["as_planned"])
             wall += m["wall_ms"]
         pm = sum(v == "hold" for v in verdicts) / len(verdicts)
+        pm_ap = sum(v == "hold" and a for v, a in zip(verdicts, planned)) / len(verdicts)
         pr = r["hold_probability"]
+        pr_ap = r.get("as_planned_probability", pr)
         agree = sum(a == b for a, b in zip(verdicts, r["verdicts"]))
         lo, hi = r["interval"]
         print(f"| {name} | {sim['verdict']} | {pr:.3f} [{lo:.2f}, {hi:.2f}] | {pm:.3f} | {pr - pm:+.3f} "
-              f"| {agree} of {len(verdicts)} | {r['wall_ms']:.0f} | {wall:.0f} |")
+              f"| {agree} of {len(verdicts)} | {pr_ap:.3f} | {pm_ap:.3f} | {r['wall_ms']:.0f} | {wall:.0f} |")
         row = {"scenario": name, "main": sim["verdict"], "rapier_p": pr, "rapier_interval": r["interval"],
                "mujoco_p": pm, "rapier": r["verdicts"], "mujoco": verdicts,
+               "rapier_p_as_planned": pr_ap, "mujoco_p_as_planned": pm_ap,
+               "rapier_as_planned": r.get("as_planned"), "mujoco_as_planned": planned,
                "rapier_ms": r["wall_ms"], "mujoco_ms": wall}
         rows.append(row)
         if out:
@@ -73,6 +90,7 @@ def robust(binary, out_dir, n, six, jsonl, scenarios):
             terms = [(row[p_key] - (v == "hold")) ** 2 for row in rows for v in row[outcomes_key]]
             return sum(terms) / len(terms)
         diff = sum(abs(r["rapier_p"] - r["mujoco_p"]) for r in rows) / len(rows)
+        diff_ap = sum(abs(r["rapier_p_as_planned"] - r["mujoco_p_as_planned"]) for r in rows) / len(rows)
         split = sum((r["rapier_p"] >= 0.9 and r["mujoco_p"] < 0.5) or
                     (r["mujoco_p"] >= 0.9 and r["rapier_p"] < 0.5) for r in rows)
         weak = sum(r["main"] == "hold" and r["rapier_interval"][0] < 0.9 for r in rows)
@@ -80,8 +98,39 @@ def robust(binary, out_dir, n, six, jsonl, scenarios):
         print(f"{len(rows)} grasps, {n} samples each{', six directions' if six else ''}: mean |p_rapier - p_mujoco| "
               f"{diff:.3f}; Brier score of rapier's p against MuJoCo's samples {brier('rapier_p', 'mujoco'):.3f}, "
               f"of MuJoCo's p against rapier's {brier('mujoco_p', 'rapier'):.3f}; one engine >= 0.9 while the "
-              f"other < 0.5: {split}; main-check holds with a lower bound under 0.9: {weak}")
+              f"other < 0.5: {split}; main-check holds with a lower bound under 0.9: {weak}; "
+              f"mean |p_rapier - p_mujoco| of a hold as planned {diff_ap:.3f}")
     return 0
+
+
+def quantiles(xs):
+    """Median, 90th percentile and largest of `xs` (nearest rank), or None for none."""
+    xs = sorted(xs)
+    if not xs:
+        return None
+    rank = lambda q: xs[min(len(xs) - 1, max(0, math.ceil(q * len(xs)) - 1))]  # noqa: E731
+    return rank(0.5), rank(0.9), xs[-1]
+
+
+def agreement_summary(rows):
+    """One paragraph: agreement on the verdict and on `as_planned`, and the distributions of the
+    engines' differences in the closing's shift and in the phalanges on plan."""
+    n = len(rows)
+    verdicts = sum(r["agree"] for r in rows)
+    planned = sum(r["agree_ap"] for r in rows)
+    shifts = [abs(a - b) for a, b in (r["shift"] for r in rows) if a is not None and b is not None]
+    on_plan = [abs(a - b) for a, b in (r["on_plan"] for r in rows) if a is not None and b is not None]
+    words = [f"{n} grasps: the verdicts agree on {verdicts} ({100 * verdicts / n:.0f} %), "
+             f"as_planned on {planned} ({100 * planned / n:.0f} %)"]
+    q = quantiles(shifts)
+    if q:
+        words.append(f"|shift difference| median {q[0]:.1f} mm, p90 {q[1]:.1f} mm, max {q[2]:.1f} mm")
+    q = quantiles(on_plan)
+    if q:
+        hist = {k: on_plan.count(k) for k in sorted(set(on_plan))}
+        words.append("|phalanges on plan difference| " +
+                     ", ".join(f"{k}: {v}" for k, v in hist.items()))
+    return "; ".join(words)
 
 
 def main(argv):
@@ -102,10 +151,13 @@ def main(argv):
             del args[j:j + 2]
         return robust(argv[1], pathlib.Path(argv[2]), n, six, jsonl, args)
     binary, out_dir, rest = argv[1], pathlib.Path(argv[2]), argv[3:]
-    required, scenarios = [], []
+    required, scenarios, write_doc = [], [], False
     i = 0
     while i < len(rest):
-        if rest[i] == "--require":
+        if rest[i] == "--write-doc":
+            write_doc = True
+            i += 1
+        elif rest[i] == "--require":
             required.append(rest[i + 1])
             i += 2
         else:
@@ -123,29 +175,60 @@ def main(argv):
     for line in run.stdout.splitlines():
         d = json.loads(line)
         rapier[d["scenario"]] = d["sim"]
-    print(
-        "| scenario | rapier | translation [mm] | rotation [deg] | MuJoCo | translation [mm] "
-        "| rotation [deg] | agree | rapier [ms] | MuJoCo [ms] | ratio |"
-    )
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
-    failed = []
+    lines = []
+
+    def out(text):
+        lines.append(text)
+        print(text)
+
+    out("| scenario | rapier | translation [mm] | rotation [deg] | MuJoCo | translation [mm] "
+        "| rotation [deg] | verdicts agree | rapier as planned | MuJoCo as planned | as planned agree "
+        "| shift rapier / MuJoCo [mm] | on plan rapier / MuJoCo | rapier [ms] | MuJoCo [ms] | ratio |")
+    out("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    failed, compared, agreed, differ = [], 0, 0, []
+    rows = []
     for name, sim in rapier.items():
         scene = out_dir / name
         if not (scene / "scene.xml").is_file():
-            print(f"| {name} | {sim['verdict']} | | | (no grasp to export) | | | | | | |")
+            out(f"| {name} | {sim['verdict']} | | | (no grasp to export) | | | | | | | | | | | |")
             continue
         m = mujoco_replay.replay(scene)
         agree = m["verdict"] == sim["verdict"]
+        compared += 1
+        agreed += agree
+        if not agree:
+            differ.append(name)
+        fr, fm = sim.get("fidelity") or {}, m["fidelity"]
+        agree_ap = fr.get("as_planned") == fm["as_planned"]
+        rows.append({"agree": agree, "agree_ap": agree_ap,
+                     "shift": (fr.get("shift_mm"), fm["shift_mm"]),
+                     "on_plan": (fr.get("phalanges_on_plan"), fm["phalanges_on_plan"])})
         # Wall times of the same check, in the same run: rapier's whole check (closing and every
         # direction) against MuJoCo's simulation loop (no Python start-up, no model loading).
         ratio = sim["wall_ms"] / m["wall_ms"] if m["wall_ms"] > 0 else float("nan")
-        print(
+        yes = lambda ok: "yes" if ok else "**no**"  # noqa: E731
+        out(
             f"| {name} | {sim['verdict']} | {sim['translation_mm']:.2f} | {sim['rotation_deg']:.2f} "
-            f"| {m['verdict']} | {m['translation_mm']:.2f} | {m['rotation_deg']:.2f} | {'yes' if agree else 'no'} "
+            f"| {m['verdict']} | {m['translation_mm']:.2f} | {m['rotation_deg']:.2f} | {yes(agree)} "
+            f"| {fr.get('as_planned')} | {fm['as_planned']} | {yes(agree_ap)} "
+            f"| {fr.get('shift_mm', float('nan')):.1f} / {fm['shift_mm']:.1f} "
+            f"| {fr.get('phalanges_on_plan')} / {fm['phalanges_on_plan']} "
             f"| {sim['wall_ms']:.1f} | {m['wall_ms']:.1f} | {ratio:.3f} |"
         )
         if name in required and not agree:
             failed.append(name)
+    summary = (f"**Summary**: MuJoCo replays {compared} grasps and agrees with rapier on the verdict "
+               f"for {agreed}" + (f" (not on {', '.join(differ)})" if differ else "")
+               + (f"; {agreement_summary(rows)}." if rows else "."))
+    print(f"\n{summary}")
+    if write_doc:
+        head = docblock.headline_line(compared=compared, agree=agreed,
+                                      differ=",".join(differ) or "none")
+        docblock.replace(docblock.ROOT / "docs" / "MUJOCO.md", "scripts/compare_engines.py",
+                         "\n".join([head, "", f"Run at {docblock.revision()} (rapier's `fast` protocol; "
+                                     "MuJoCo's replay full-length; wall times of that run, load "
+                                     f"average {os.getloadavg()[0]:.1f} at its end):", "",
+                                     *lines, "", summary]) + "\n")
     for name in required:
         if name not in rapier:
             failed.append(name)

@@ -1,9 +1,9 @@
 #!/usr/bin/env python3
 """Compare the planner's first N candidates of every object across the frames its mesh was written in.
 
-    GRASP_SIM_FRAMES_NO_SIM=1 GRASP_SIM_FRAMES_DUMP=/tmp/fd \\
+    GRASP_SIM_FRAMES_NO_SIM=1 GRASP_SIM_FRAMES_DUMP=out/fd \\
         cargo test --release --test it frames::every -- --ignored      # writes NAME_SHIFT.stl
-    python3 scripts/frames_candidates.py target/release/grasp-sim /tmp/fd [N]
+    python3 scripts/frames_candidates.py target/release/grasp-sim out/fd [N]
 
 The frame test (tests/it/frames.rs) compares the grasp a run reports; with the physics check a
 run may go on to later candidates when the earlier ones fail, so their order matters too

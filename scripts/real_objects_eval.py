@@ -77,6 +77,9 @@ def summary_of(r):
         "candidates_tried": plan["candidates_tried"],
         "candidates_checked": plan.get("candidates_checked", 0),
         "verdict": sim["verdict"],
+        # Whether the closing kept the planned grasp (issue 55): the verdict is gravity's alone.
+        "as_planned": (sim.get("fidelity") or {}).get("as_planned"),
+        "fidelity_reasons": (sim.get("fidelity") or {}).get("reasons"),
         "translation_mm": sim.get("translation_mm"),
         "rotation_deg": sim.get("rotation_deg"),
         "wall_s": r["wall_s"],
@@ -215,6 +218,8 @@ def main():
                     r["mujoco"] = {k: m.get(k) for k in ("verdict", "translation_mm", "rotation_deg",
                                                          "closing_shift_mm", "closing_pushed",
                                                          "closing_off_plan", "phalanges_on_plan")}
+                    r["mujoco"]["as_planned"] = m["fidelity"]["as_planned"]
+                    r["mujoco"]["fidelity_reasons"] = m["fidelity"]["reasons"]
                 except Exception as e:  # noqa: BLE001 - a scene MuJoCo refuses is a finding
                     r["mujoco"] = {"verdict": f"error: {str(e).splitlines()[0][:80]}"}
     (out / "results.json").write_text(json.dumps(results, indent=1, sort_keys=True))
@@ -301,27 +306,38 @@ def share_line(results, before=None):
     return text + (f"; before: {share(before)}." if before is not None else ".")
 
 
+def planned_word(x):
+    """`as planned` / `**not**` / empty, for a fidelity (issue 55) known or not."""
+    return "" if x is None else ("yes" if x else "**no**")
+
+
 def table(results, no_mujoco, before=None):
     cols = "| closing shift [mm] | worst phalanx | on plan |" if before is None else \
         "| closing shift [mm], before → after | worst phalanx, before → after | on plan, before → after |"
     rows = [
         "| object | label | triangles | axis | rules (relaxations) | plan | down: verdict, mm, deg "
-        "| six: verdict, mm, deg | MuJoCo (down) | checked | penetration [mm] " + cols + " time [s] |",
-        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+        "| down: as planned | six: verdict, mm, deg | six: as planned | MuJoCo (down): verdict "
+        "| MuJoCo: as planned | checked | penetration [mm] " + cols + " time [s] |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
-    n = {"graspable": 0, "planned": 0, "down": 0, "six": 0, "mj": 0, "agree": 0}
+    n = {"graspable": 0, "planned": 0, "down": 0, "six": 0, "down_ap": 0, "six_ap": 0,
+         "mj": 0, "agree": 0, "agree_ap": 0}
     for name, r in sorted(results.items()):
         d, s = r["down"], r["six"]
         rel = ", ".join(d.get("relaxations", [])) if d.get("rules") == "extended" else ""
         plan = d["status"] if d["status"] == "feasible" else f"{d['status']}: {(d.get('reason') or '')[:90]}"
         mj = r.get("mujoco")
         agree = mj is not None and mj["verdict"] == d["verdict"]
+        agree_ap = mj is not None and mj.get("as_planned") == d.get("as_planned")
         rows.append(
             f"| {name} | {r['label']} | {d.get('triangles', '')} | {d.get('axis', '')} "
             f"| {d.get('rules', '')}{f' ({rel})' if rel else ''} | {plan} "
             f"| {d['verdict']}, {fmt(d.get('translation_mm'))}, {fmt(d.get('rotation_deg'))} "
+            f"| {planned_word(d.get('as_planned'))} "
             f"| {s.get('verdict')}, {fmt(s.get('translation_mm'))}, {fmt(s.get('rotation_deg'))} "
+            f"| {planned_word(s.get('as_planned'))} "
             f"| {'' if mj is None else mj['verdict'] + ('' if agree else ' (differs)')} "
+            f"| {'' if mj is None else planned_word(mj.get('as_planned')) + ('' if agree_ap else ' (differs)')} "
             f"| {d.get('candidates_checked', '')} | {fmt(d.get('penetration_mm'), 2)} "
             + (f"| {fmt(d.get('closing_shift_mm'))} | {worst(d)} | {on_plan(d)} " if before is None else
                f"| {fmt(before.get(name, {}).get('down', {}).get('closing_shift_mm'))} → "
@@ -336,19 +352,24 @@ def table(results, no_mujoco, before=None):
                 n["planned"] += 1
                 n["down"] += d["verdict"] == "hold"
                 n["six"] += s.get("verdict") == "hold"
+                n["down_ap"] += d["verdict"] == "hold" and d.get("as_planned") is True
+                n["six_ap"] += s.get("verdict") == "hold" and s.get("as_planned") is True
         if mj is not None:
             n["mj"] += 1
             n["agree"] += agree
+            n["agree_ap"] += agree_ap
     pct = lambda a, b: f"{100.0 * a / b:.0f} %" if b else "n/a"  # noqa: E731
     line = (
         f"**Summary**: of {n['graspable']} objects labelled graspable, {n['planned']} get a planned "
         f"grasp ({pct(n['planned'], n['graspable'])}); of those, {n['down']} hold with gravity down "
         f"({pct(n['down'], n['planned'])}) and {n['six']} in all six directions "
-        f"({pct(n['six'], n['planned'])})."
+        f"({pct(n['six'], n['planned'])}); held as planned: {n['down_ap']} down, {n['six_ap']} in "
+        f"all six."
     )
     if not no_mujoco:
-        line += (f" MuJoCo replays {n['mj']} checked grasps and agrees on {n['agree']} "
-                 f"({pct(n['agree'], n['mj'])}).")
+        line += (f" MuJoCo replays {n['mj']} checked grasps and agrees on the verdict for "
+                 f"{n['agree']} ({pct(n['agree'], n['mj'])}), on `as_planned` for {n['agree_ap']} "
+                 f"({pct(n['agree_ap'], n['mj'])}).")
     line += "\n\n" + stats_line("**Closing** (this run)", closing_stats(results))
     mj = sorted(r["mujoco"]["closing_shift_mm"] for r in results.values()
                 if r.get("mujoco", {}).get("closing_shift_mm") is not None

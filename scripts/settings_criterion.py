@@ -6,9 +6,12 @@
 
 Each .jsonl is one run of `cargo run --release --example protocols -- --only fast --six
 --set max_checked=1 [--set KEY=VALUE] --jsonl FILE SCENARIO...` (one line per scenario, six
-directions each). The null set is the union of the directions whose verdict a null
-perturbation (a 1 ppm change of a constant) changes against BASE. A candidate passes the first
-half of the criterion when every direction whose verdict it changes is in the null set. The
+directions each). The two questions of a check are judged apart (issue 55): the null set of
+verdicts is the union of the directions whose verdict a null perturbation (a 1 ppm change of a
+constant) changes against BASE, and the null set of fidelity the union of those whose
+`as_planned` a null changes. A candidate passes the first half of the criterion when every
+direction whose verdict it changes is in the first, and every one whose `as_planned` it changes
+in the second. The
 second half, agreement with MuJoCo not dropping, takes `--mujoco`: the file
 `scripts/engine_agreement.py --json` writes, whose variant `base` is the defaults and whose
 other variants are named as the candidates here. Prints a Markdown table: changed, changed outside the
@@ -24,9 +27,11 @@ import sys
 
 
 def load(path, substeps=(8, 8)):
-    """{(scenario, direction index): verdict}, total steps, total wall [ms], total substeps
-    (`substeps`: per step while closing, while holding)."""
-    verdicts, steps, wall, sub = {}, 0, 0.0, 0.0
+    """({(scenario, direction index): verdict}, {(scenario, direction index): as_planned}),
+    total steps, total wall [ms], total substeps (`substeps`: per step while closing, while
+    holding). A file written before issue 55 has no `as_planned`: its fidelity is unknown
+    (None) and compares equal to itself only."""
+    verdicts, planned, steps, wall, sub = {}, {}, 0, 0.0, 0.0
     with open(path) as f:
         for line in f:
             d = json.loads(line)
@@ -42,13 +47,19 @@ def load(path, substeps=(8, 8)):
             sub += closing * substeps[0] + (n - closing) * substeps[1]
             for k, dr in enumerate(dirs):
                 verdicts[(d["scenario"], k)] = dr["verdict"]
-    return verdicts, steps, wall, sub
+                planned[(d["scenario"], k)] = dr.get("as_planned")
+    return (verdicts, planned), steps, wall, sub
 
 
 def changed(base, other):
-    """The directions both runs checked whose verdicts differ (a run cut short, such as a
+    """The directions both runs checked whose answers differ (a run cut short, such as a
     null stopped early, contributes the scenarios it reached)."""
     return {k for k in set(base) & set(other) if base[k] != other[k]}
+
+
+def changes(base, other):
+    """(verdicts changed, `as_planned` changed) between two `load` results."""
+    return changed(base[0], other[0]), changed(base[1], other[1])
 
 
 def main():
@@ -65,14 +76,15 @@ def main():
         c, h = v.split("/")
         subs[name] = (int(c), int(h))
     base, bsteps, bwall, bsub = load(a.base)
-    null_set = set()
+    null_set, null_planned = set(), set()
     rows = []
     for path in a.null:
         v, s, w, _ = load(path)
-        c = changed(base, v)
-        rows.append((f"null: {path}", c, s, w))
+        c, cp = changes(base, v)
+        rows.append((f"null: {path}", c, cp, s, w))
         null_set |= c
-    nulls = [c for _, c, _, _ in rows]
+        null_planned |= cp
+    nulls = [c for _, c, _, _, _ in rows]
     mj = {}
     for path in a.mujoco:
         for name, by_scenario in json.load(open(path)).items():
@@ -84,36 +96,41 @@ def main():
             return ""
         return f"{sum(1 for x in m.values() if x)} of {len(m)}"
 
-    print(f"directions: {len(base)}; null set: {len(null_set)} directions of "
-          f"{len({k[0] for k in null_set})} objects from {len(a.null)} nulls")
+    print(f"directions: {len(base[0])}; null set: {len(null_set)} directions of "
+          f"{len({k[0] for k in null_set})} objects from {len(a.null)} nulls (verdicts), "
+          f"{len(null_planned)} directions of {len({k[0] for k in null_planned})} objects "
+          f"(as_planned)")
     print()
-    print("| run | verdicts changed | outside the null set | objects | steps / base "
-          "| substeps / base | wall / base | MuJoCo agrees (`down`) | passes |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    print(f"| base: {a.base} | 0 | 0 | 0 | {bsteps:,} | {bsub:,.0f} | {bwall / 1000:.1f} s "
+    print("| run | verdicts changed | outside the null set | as_planned changed | outside its null set "
+          "| objects | steps / base | substeps / base | wall / base | MuJoCo agrees (`down`) | passes |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print(f"| base: {a.base} | 0 | 0 | 0 | 0 | 0 | {bsteps:,} | {bsub:,.0f} | {bwall / 1000:.1f} s "
           f"| {agreement('base')} | |")
-    for i, (name, c, s, w) in enumerate(rows):
+    for i, (name, c, cp, s, w) in enumerate(rows):
         others = set().union(*[n for j, n in enumerate(nulls) if j != i])
-        print(f"| {name} | {len(c)} | {len(c - others)} outside the other nulls | "
+        print(f"| {name} | {len(c)} | {len(c - others)} outside the other nulls | {len(cp)} | | "
               f"{len({k[0] for k in c})} | {s / bsteps:.3f} | | {w / bwall:.3f} | | |")
     failed = False
     for kv in a.candidates:
         name, path = kv.split("=", 1)
         v, s, w, sub = load(path, subs.get(name, (8, 8)))
-        c = changed(base, v)
+        c, cp = changes(base, v)
         out = c - null_set
-        ok = not out
+        out_planned = cp - null_planned
+        ok = not out and not out_planned
         if name in mj and "base" in mj:
             agree_c = sum(1 for x in mj[name].values() if x)
             agree_b = sum(1 for x in mj["base"].values() if x)
             ok = ok and agree_c >= agree_b
         failed |= not ok
-        print(f"| {name} | {len(c)} | {len(out)} | {len({k[0] for k in c})} | {s / bsteps:.3f} "
+        print(f"| {name} | {len(c)} | {len(out)} | {len(cp)} | {len(out_planned)} "
+              f"| {len({k[0] for k in c | cp})} | {s / bsteps:.3f} "
               f"| {sub / bsub:.3f} | {w / bwall:.3f} | {agreement(name)} "
               f"| {'yes' if ok else '**no**'} |")
-        if out:
+        if out or out_planned:
             objs = sorted({k[0] for k in out})
-            print(f"|  outside: {', '.join(objs)} | | | | | | | | |")
+            objs_p = sorted({k[0] for k in out_planned})
+            print(f"|  outside: {', '.join(objs)} | | | {', '.join(objs_p)} | | | | | | | |")
     return 1 if failed else 0
 
 

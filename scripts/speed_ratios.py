@@ -30,9 +30,14 @@ grasp's scene, `gravity = "six"`), and MuJoCo replays the exported scenes in six
 per CPU-second of the workers, and the sum of the replays' simulation loops against the sum of
 grasp-sim's `sim.wall_ms` for the same grasps (the physics of the same six-direction checks,
 one thread).
+
+With --write-doc, the table (and the MuJoCo line) replaces the generated block of BENCHMARKS.md
+("Physics check"), whose headline line gives the README's speed figures (scripts/headline.py:
+the `base` variant's medians and batch rate).
 """
 import argparse
 import concurrent.futures
+import datetime
 import json
 import os
 import pathlib
@@ -44,6 +49,7 @@ import tempfile
 import time
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
+import docblock  # noqa: E402
 import mujoco_replay  # noqa: E402
 from engine_agreement import with_sim  # noqa: E402
 
@@ -213,18 +219,27 @@ def main():
     ap.add_argument("--batch-only", action="append", default=[], metavar="NAME",
                     help="run the batch for these variants only (default: all)")
     ap.add_argument("--json")
+    ap.add_argument("--write-doc", action="store_true",
+                    help="replace BENCHMARKS.md's generated block with this run's table")
     a = ap.parse_args()
     variants = parse_variants(a.variant)
     result = {}
     with tempfile.TemporaryDirectory() as tmp:
-        print(f"load at the start: {load()}", file=sys.stderr)
+        start_load = load()
+        print(f"load at the start: {start_load}", file=sys.stderr)
         r = ratios(a, variants, tmp) if a.rounds > 0 else {}
         b = {n: batch(a, keys, tmp, n) for n, keys in variants
              if a.batch and (not a.batch_only or n in a.batch_only)}
         m = batch_mujoco(a, tmp) if a.batch_mujoco else None
-    print(f"| variant | `down` / MuJoCo (target ≤ 0.1) | `six` / MuJoCo's `down` (≤ 0.15) | "
-          f"steps down, six | six-direction checks a second, batch --jobs {a.jobs} (≥ 20) |")
-    print("|---|---|---|---|---|")
+    lines = []
+
+    def out(text=""):
+        lines.append(text)
+        print(text)
+
+    out(f"| variant | `down` / MuJoCo (target ≤ 0.1) | `six` / MuJoCo's `down` (≤ 0.15) | "
+        f"steps down, six | six-direction checks a second, batch --jobs {a.jobs} (≥ 20) |")
+    out("|---|---|---|---|---|")
     for n, _ in variants:
         cells = ["", "", "", ""]
         if n in r:
@@ -240,20 +255,36 @@ def main():
             cells[3] = (f"{x['rate']:.2f} ({x['checks']} checks of {x['objects']} objects in "
                         f"{x['wall_s']:.0f} s; {x['per_cpu_s']:.2f} per CPU-second; load "
                         f"{x['load']})")
-        print(f"| {n} | " + " | ".join(cells) + " |")
+        out(f"| {n} | " + " | ".join(cells) + " |")
         result[n] = {"ratios": r.get(n), "batch": b.get(n)}
     if m is not None:
-        print(f"\nMuJoCo, the same set's {m['scenes']} reported grasps replayed in six directions, "
-              f"{a.jobs} at a time: {m['rate']:.2f} a second ({m['wall_s']:.0f} s wall; "
-              f"{m['per_cpu_s']:.2f} per CPU-second; load {m['load']}); its simulation loops "
-              f"{m['mujoco_loops_ms'] / 1000:.1f} s in all against grasp-sim's physics of the "
-              f"same six-direction checks {m['rapier_sim_ms'] / 1000:.1f} s (ratio "
-              f"{m['ratio']:.3f})")
+        out(f"\nMuJoCo, the same set's {m['scenes']} reported grasps replayed in six directions, "
+            f"{a.jobs} at a time: {m['rate']:.2f} a second ({m['wall_s']:.0f} s wall; "
+            f"{m['per_cpu_s']:.2f} per CPU-second; load {m['load']}); its simulation loops "
+            f"{m['mujoco_loops_ms'] / 1000:.1f} s in all against grasp-sim's physics of the "
+            f"same six-direction checks {m['rapier_sim_ms'] / 1000:.1f} s (ratio "
+            f"{m['ratio']:.3f})")
         result["mujoco_batch"] = m
-    print(f"\n{a.rounds} rounds alternating; load at the end: {load()}; "
-          f"{os.cpu_count()} CPUs")
+    out(f"\n{a.rounds} rounds alternating; load at the end: {load()}; "
+        f"{os.cpu_count()} CPUs")
     if a.json:
         pathlib.Path(a.json).write_text(json.dumps(result, indent=1))
+    if a.write_doc:
+        if "base" not in r or "base" not in b:
+            sys.exit("speed_ratios: --write-doc needs --rounds 1 or more and --batch")
+        o, x = r["base"], b["base"]
+        head = docblock.headline_line(
+            down_ratio=f"{statistics.median(o['down']):.3f}",
+            six_ratio=f"{statistics.median(o['six']):.3f}",
+            down_ms=f"{statistics.median(o['down_ms']):.1f}",
+            six_ms=f"{statistics.median(o['six_ms']):.1f}",
+            checks_per_s=f"{x['rate']:.2f}", checks_per_cpu_s=f"{x['per_cpu_s']:.2f}",
+            load=f"{float(start_load.split()[0]):.1f}–{float(load().split()[0]):.1f}")
+        intro = (f"Run at {docblock.revision()} on {datetime.date.today()} "
+                 f"(`{' '.join(['python3', 'scripts/speed_ratios.py'] + sys.argv[1:])}`), "
+                 f"{a.rounds} rounds on {pathlib.Path(a.scenario).stem}:")
+        docblock.replace(ROOT / "BENCHMARKS.md", "scripts/speed_ratios.py",
+                         "\n".join([head, "", intro, ""] + lines))
     return 0
 
 

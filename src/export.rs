@@ -482,6 +482,7 @@ fn protocol(input: &ExportInput, keys: &Keyframes) -> serde_json::Value {
         "hold_rotation_deg": sim.hold.hold_rotation_deg,
         "max_closing_shift_mm": sim.hold.max_closing_shift_mm,
         "min_on_plan_fraction": sim.hold.min_on_plan_fraction,
+        "max_penetration_mm": sim.hold.max_penetration_mm,
         "approach": sim.closing.approach,
         "reseat": sim.closing.reseat,
         "ramp_s": crate::sim::RAMP_S,

@@ -201,6 +201,14 @@ pub struct Expect {
     /// Wilson interval's lower bound (issue 34): 8 of 8 held is a lower bound of 0.68.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub min_hold_probability: Option<f64>,
+    /// True: the grasp must also hold as planned (`sim.fidelity.as_planned`, issue 55), not
+    /// only hold; `outcome` must then be `hold`. Default: the verdict alone is judged.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub as_planned: bool,
+    /// The least probability of a hold as planned under `[sim] samples` perturbed checks,
+    /// judged on its 95 % Wilson interval's lower bound, as `min_hold_probability` is.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min_as_planned_probability: Option<f64>,
 }
 
 fn default_index_tolerance() -> i64 {
@@ -355,11 +363,29 @@ impl Scenario {
         raw.sim
             .validate(hand.finger_list.len())
             .map_err(|(key, problem)| invalid(key, problem))?;
-        if let Some(p) = raw.expect.as_ref().and_then(|e| e.min_hold_probability) {
-            if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
+        for (key, p) in raw.expect.as_ref().map_or(vec![], |e| {
+            vec![
+                ("expect.min_hold_probability", e.min_hold_probability),
+                (
+                    "expect.min_as_planned_probability",
+                    e.min_as_planned_probability,
+                ),
+            ]
+        }) {
+            if let Some(p) = p {
+                if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
+                    return Err(invalid(key, format!("must be in [0, 1], got {p}")));
+                }
+            }
+        }
+        if let Some(e) = raw.expect.as_ref().filter(|e| e.as_planned) {
+            if e.outcome != Outcome::Hold {
                 return Err(invalid(
-                    "expect.min_hold_probability",
-                    format!("must be in [0, 1], got {p}"),
+                    "expect.as_planned",
+                    format!(
+                        "asks for a hold as planned, but outcome is \"{}\": set outcome = \"hold\"",
+                        e.outcome.as_str()
+                    ),
                 ));
             }
         }

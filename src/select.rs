@@ -10,11 +10,13 @@
 //! fingertip pinch ([`RuleSet::Pinch`]) last, on the same terms after the extended rules.
 //!
 //! Without the physics check the first feasible grasp is the answer, as in the thesis
-//! (`--candidates N` collects N). With it, candidates are checked one by one until one holds or
-//! `max_checked` have been checked; the first that holds is the answer (else the first that
-//! slipped, else the first checked), and every candidate checked is reported with its verdict.
-//! Under `[sim] closing_decides` a candidate whose closing failed is judged without a hold,
-//! and checked again in full where the choice or the report needs it
+//! (`--candidates N` collects N). With it, candidates are checked one by one until one holds as
+//! planned or `max_checked` have been checked; the first that holds as planned is the answer,
+//! else the first that held (the closing took it off its plan: its closed joint angles are the
+//! grasp to command), else the first that slipped, else the first checked (issue 55), and
+//! every candidate checked is reported with its verdict and fidelity. Under `[sim]
+//! closing_decides` a candidate whose closing left the plan is not held under gravity at once,
+//! and is checked again in full where the choice or the report needs it
 //! ([`SelectParams::recheck`]).
 
 use crate::hand::Hand;
@@ -226,14 +228,13 @@ fn recheck_if_closing_decided(
     }
 }
 
-/// Under `[sim] closing_decides`, a candidate whose closing failed was judged `slip` or `drop`
-/// by where the object was when the closing ended; the full check holds it under gravity
-/// first. That changes nothing while some candidate succeeds ([`choose`] takes the first that
-/// did), but when none does, [`choose`] takes the first that held (under `choose = "robust"`
-/// a nominal hold can fail its samples), else the first that slipped: so, in order, each such
-/// candidate is checked again in full until the first `hold` or `slip` is known, and
-/// [`choose`] then reports what the full checks would have (the same candidate, the same
-/// check).
+/// Under `[sim] closing_decides`, a candidate whose closing left the plan got a provisional
+/// `slip` or `drop` by where the object was when the closing ended; the full check holds it
+/// under gravity. That changes nothing while some candidate succeeds ([`choose`] takes the
+/// first that did), but when none does, [`choose`] takes the first that held (as planned,
+/// else not), else the first that slipped: so, in order, each such candidate is checked again
+/// in full until the first `hold` is known (or all are), and [`choose`] then reports what the
+/// full checks would have (the same candidate, the same check).
 #[allow(clippy::type_complexity)]
 fn recheck_failed_closings(
     sel: &mut Selection,
@@ -253,7 +254,7 @@ fn recheck_failed_closings(
         if sel.candidates[i]
             .check
             .as_ref()
-            .is_some_and(|o| matches!(o.verdict, Verdict::Hold | Verdict::Slip))
+            .is_some_and(|o| o.verdict == Verdict::Hold)
         {
             return;
         }
@@ -390,17 +391,19 @@ fn wants_extended(sel: &Selection, p: &SelectParams) -> bool {
 }
 
 /// Returns true if and only if a checked candidate succeeded ([`SimOutcome::succeeded`]: it
-/// held, or under `[sim] choose = "robust"` its hold probability's lower bound passed).
+/// held as planned, or under `[sim] choose = "robust"` the lower bound of its probability of a
+/// hold as planned passed).
 fn has_hold(sel: &Selection) -> bool {
     sel.candidates
         .iter()
         .any(|c| c.check.as_ref().is_some_and(SimOutcome::succeeded))
 }
 
-/// The first candidate that succeeded; else, when candidates were sampled (`choose =
-/// "robust"`), the one with the highest lower bound of its hold probability (then the highest
-/// probability, then the first) if any sample of it held; else the first that held, else the
-/// first that slipped, else the first found.
+/// The first candidate that succeeded (held as planned; under `choose = "robust"`, the lower
+/// bound of its probability of a hold as planned passed); else, when candidates were sampled,
+/// the one ranked highest by its samples ([`crate::sim::Robust::rank`]: the lower bound of a
+/// hold as planned, then of a hold; the first on a tie) if any sample of it held; else the
+/// first by the preference held as planned, held, slip, drop (issue 55), else the first found.
 fn choose(candidates: &[Candidate]) -> Option<usize> {
     if let Some(i) = candidates
         .iter()
@@ -414,21 +417,24 @@ fn choose(candidates: &[Candidate]) -> Option<usize> {
         .filter_map(|(i, c)| Some((i, c.check.as_ref()?.robust.as_ref()?)))
         .filter(|(_, r)| r.counts.hold > 0);
     let best = sampled.max_by(|(i, a), (j, b)| {
-        a.interval[0]
-            .total_cmp(&b.interval[0])
-            .then(a.hold_probability.total_cmp(&b.hold_probability))
+        let (ra, rb) = (a.rank(), b.rank());
+        ra.iter()
+            .zip(&rb)
+            .map(|(x, y)| x.total_cmp(y))
+            .find(|o| o.is_ne())
+            .unwrap_or(std::cmp::Ordering::Equal)
             .then(j.cmp(i))
     });
     if let Some((i, _)) = best {
         return Some(i);
     }
-    let first_with = |v: Verdict| {
-        candidates
-            .iter()
-            .position(|c| c.check.as_ref().is_some_and(|o| o.verdict == v))
-    };
-    first_with(Verdict::Hold)
-        .or_else(|| first_with(Verdict::Slip))
+    let checked = candidates
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| Some((i, c.check.as_ref()?.preference())));
+    checked
+        .min_by_key(|&(i, p)| (p, i))
+        .map(|(i, _)| i)
         .or_else(|| (!candidates.is_empty()).then_some(0))
 }
 

@@ -426,7 +426,11 @@ class Check:
     """The physics check's result (``check(...)``): the report's ``sim`` section, typed."""
 
     verdict: str
-    """``"hold"``, ``"slip"``, ``"drop"`` or ``"not_run"``."""
+    """``"hold"``, ``"slip"``, ``"drop"`` or ``"not_run"``: what gravity did."""
+    fidelity: Optional[Dict[str, Any]]
+    """Whether the grasp the closing made is the one planned: ``as_planned``, ``shift_mm``,
+    ``turn_deg``, ``phalanges_on_plan``, ``phalanges``, ``worst_joint_error_deg``,
+    ``penetration_mm``, ``reasons`` (the report's ``sim.fidelity``; ``None`` when not run)."""
     reason: Optional[str]
     translation_mm: Optional[float]
     """The object's largest translation relative to the palm during the hold."""
@@ -443,6 +447,9 @@ class Check:
     [lo, hi], ``counts``, per direction, the first failing sample's perturbation)."""
     hold_probability: Optional[float]
     """``robust["hold_probability"]`` (``None`` with one sample)."""
+    as_planned_probability: Optional[float]
+    """``robust["as_planned_probability"]``: the samples that held as planned (``None`` with
+    one sample)."""
     grasp: Optional[Grasp]
     """The grasp checked."""
     sim: Dict[str, Any]
@@ -454,6 +461,7 @@ class Check:
         self.report = report
         s = self.sim = report["sim"]
         self.verdict = s["verdict"]
+        self.fidelity = s.get("fidelity")
         self.reason = s.get("reason")
         self.translation_mm = s.get("translation_mm")
         self.rotation_deg = s.get("rotation_deg")
@@ -462,6 +470,8 @@ class Check:
         self.closing = s.get("closing")
         self.robust = s.get("robust")
         self.hold_probability = self.robust["hold_probability"] if self.robust else None
+        self.as_planned_probability = (self.robust.get("as_planned_probability")
+                                       if self.robust else None)
         g = report["plan"].get("grasp")
         self.grasp = Grasp(g) if g else None
 
@@ -470,8 +480,15 @@ class Check:
         """True if and only if the verdict is ``hold``."""
         return self.verdict == "hold"
 
+    @property
+    def as_planned(self) -> Optional[bool]:
+        """True if and only if the closing kept the planned grasp (``None`` when not run)."""
+        return self.fidelity["as_planned"] if self.fidelity else None
+
     def __repr__(self) -> str:
-        return f"Check({self.verdict!r}, translation {self.translation_mm} mm, rotation {self.rotation_deg}°)"
+        planned = "" if self.as_planned in (None, True) else ", not as planned"
+        return (f"Check({self.verdict!r}{planned}, translation {self.translation_mm} mm, "
+                f"rotation {self.rotation_deg}°)")
 
 
 def _scenario(obj: Object, hand: Hand, planner: Mapping[str, Any], sim: Mapping[str, Any]) -> Dict[str, Any]:

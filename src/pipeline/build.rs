@@ -182,6 +182,7 @@ pub(super) fn checked_report(
             .then(|| payload.map_or(0.0, |(held, _)| held)),
         payload_fails_at: payload.and_then(|(_, failed)| failed),
         closing: Some(out.closing),
+        fidelity: Some(out.fidelity),
         directions: out.directions,
         robust: out.robust,
         replay: out.replay,
@@ -311,7 +312,17 @@ fn grasp_report(
         rules: g.rules,
         relaxations: g.relaxations.clone(),
         check: check.map(|o| report::CandidateCheck {
-            verdict: o.verdict,
+            verdict: if o.decided_by_closing() {
+                SimVerdict::NotRun {
+                    reason: "the closing left the plan and [sim] closing_decides is on: not \
+                             held under gravity"
+                        .to_string(),
+                }
+            } else {
+                SimVerdict::Ran(o.verdict)
+            },
+            fidelity: o.fidelity.clone(),
+            closed_joint_angles_deg: o.closing.fingers.iter().map(|f| f.final_deg).collect(),
             translation_mm: o.translation_mm,
             rotation_deg: o.rotation_deg,
             robust: o.robust.as_ref().map(|r| report::CandidateRobust {
@@ -319,6 +330,8 @@ fn grasp_report(
                 samples: r.samples,
                 hold_probability: r.hold_probability,
                 interval: r.interval,
+                as_planned_probability: r.as_planned_probability,
+                as_planned_interval: r.as_planned_interval,
             }),
         }),
         quality: None,

@@ -255,8 +255,16 @@ impl GraspQuality {
 /// The physics check's verdict on one candidate grasp.
 #[derive(Debug, Clone, Serialize)]
 pub struct CandidateCheck {
-    /// `hold`, `slip` or `drop`.
-    pub verdict: Verdict,
+    /// `verdict`: `hold`, `slip` or `drop`, what gravity did; `not_run` (with its `reason`)
+    /// for a candidate whose closing left the plan under `[sim] closing_decides`, which was not
+    /// held under gravity.
+    #[serde(flatten)]
+    pub verdict: SimVerdict,
+    /// Whether the grasp the closing made is the one planned (issue 55).
+    pub fidelity: crate::sim::Fidelity,
+    /// Per finger, `[θ1, θ2]` where the closing left the joints `[deg]`: the grasp to command
+    /// when it held but not as planned.
+    pub closed_joint_angles_deg: Vec<[f64; 2]>,
     /// Worst direction's translation relative to the palm `[mm]`.
     pub translation_mm: f64,
     /// Worst direction's rotation relative to the palm `[deg]`.
@@ -265,6 +273,13 @@ pub struct CandidateCheck {
     /// that held, of how many, and the 95 % Wilson interval of the hold probability.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub robust: Option<CandidateRobust>,
+}
+
+impl CandidateCheck {
+    /// The verdict, when the candidate was held under gravity.
+    pub fn ran(&self) -> Option<Verdict> {
+        self.verdict.verdict()
+    }
 }
 
 /// A checked candidate's hold probability under perturbation, in brief (`sim.robust` has the
@@ -279,6 +294,10 @@ pub struct CandidateRobust {
     pub hold_probability: f64,
     /// 95 % Wilson score interval of the hold probability.
     pub interval: [f64; 2],
+    /// Samples that held with a closing that kept the planned grasp, over `samples`.
+    pub as_planned_probability: f64,
+    /// Its 95 % Wilson score interval.
+    pub as_planned_interval: [f64; 2],
 }
 
 /// What the planner found about one principal axis under one rule set.
@@ -476,11 +495,16 @@ pub struct SimReport {
     /// final joint angles, and the first touch.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub closing: Option<crate::sim::ClosingOutcome>,
+    /// Whether the grasp that held is the one planned (issue 55): `as_planned` by
+    /// `max_closing_shift_mm`, `min_on_plan_fraction` and `max_penetration_mm`, with the
+    /// figures that decided it. The verdict is gravity's alone.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fidelity: Option<crate::sim::Fidelity>,
     /// Per gravity direction.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub directions: Vec<crate::sim::DirectionOutcome>,
-    /// The limits the verdict was judged by (`[sim] hold_translation_mm`, `hold_rotation_deg`,
-    /// `max_penetration_mm`).
+    /// The limits the verdict (`translation_mm`, `rotation_deg`) and the fidelity
+    /// (`penetration_mm`, `closing_shift_mm`, `on_plan_fraction`) were judged by.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub limits: Option<HoldLimits>,
     /// The hold probability under `[sim] samples` perturbed checks (issue 34); absent with one
@@ -528,6 +552,7 @@ impl SimReport {
             payload_margin: None,
             payload_fails_at: None,
             closing: None,
+            fidelity: None,
             directions: Vec::new(),
             limits: None,
             robust: None,

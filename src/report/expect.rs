@@ -27,19 +27,36 @@ impl ExpectReport {
     /// Judges `[expect]`: the planning part (status and reference values), then, when the
     /// physics check ran, its verdict against the expected outcome. A scenario that fixes the
     /// joint angles (`override_angles`) or checks a given grasp is judged on the verdict alone.
+    ///
+    /// Then, in order, each further expectation given, while all so far are met: `as_planned`
+    /// (the fidelity of the check reported), `min_hold_probability` and
+    /// `min_as_planned_probability` (each on its 95 % lower bound).
     pub fn judge(expect: &Expect, plan: &PlanReport, sim: &SimReport) -> ExpectReport {
-        let report = Self::judge_verdict(expect, plan, sim);
-        match (expect.min_hold_probability, report.met) {
-            (Some(p), Some(true)) if expect.outcome != Outcome::Ungraspable => {
-                let (met, words) = judge_probability(p, sim);
-                ExpectReport {
-                    met: Some(met),
-                    details: format!("{}; {words}", report.details),
-                    ..report
-                }
-            }
-            _ => report,
+        let mut report = Self::judge_verdict(expect, plan, sim);
+        if expect.outcome == Outcome::Ungraspable {
+            return report;
         }
+        let mut further: Vec<Box<dyn Fn() -> (bool, String)>> = Vec::new();
+        if expect.as_planned {
+            further.push(Box::new(|| judge_as_planned(sim)));
+        }
+        if let Some(p) = expect.min_hold_probability {
+            further.push(Box::new(move || judge_probability(p, sim, Question::Hold)));
+        }
+        if let Some(p) = expect.min_as_planned_probability {
+            further.push(Box::new(move || {
+                judge_probability(p, sim, Question::AsPlanned)
+            }));
+        }
+        for judge in further {
+            if report.met != Some(true) {
+                break;
+            }
+            let (met, words) = judge();
+            report.met = Some(met);
+            report.details = format!("{}; {words}", report.details);
+        }
+        report
     }
 
     /// [`ExpectReport::judge`] without `min_hold_probability`.
@@ -83,25 +100,66 @@ impl ExpectReport {
     }
 }
 
-/// `[expect] min_hold_probability = p` against the check: the 95 % Wilson lower bound of the
-/// hold probability must reach `p`. With one sample (no `sim.robust`) the main check is the one
-/// sample; a check that did not run cannot meet it.
-fn judge_probability(p: f64, sim: &SimReport) -> (bool, String) {
+/// Which probability an expectation judges.
+#[derive(Clone, Copy)]
+enum Question {
+    /// `min_hold_probability`: the samples that held.
+    Hold,
+    /// `min_as_planned_probability`: the samples that held with a closing that kept the plan.
+    AsPlanned,
+}
+
+/// `[expect] as_planned = true` against the check reported: its closing kept the planned grasp.
+fn judge_as_planned(sim: &SimReport) -> (bool, String) {
+    match &sim.fidelity {
+        Some(f) if f.as_planned => (true, "as planned".to_string()),
+        Some(f) => {
+            let reasons: Vec<&str> = f.reasons.iter().map(|r| r.as_str()).collect();
+            (
+                false,
+                format!(
+                    "NOT as planned ({}), expected as planned",
+                    reasons.join(", ")
+                ),
+            )
+        }
+        None => (
+            false,
+            "fidelity not measured (physics check not run); expected as planned".to_string(),
+        ),
+    }
+}
+
+/// `[expect] min_hold_probability = p` (or `min_as_planned_probability`) against the check:
+/// the 95 % Wilson lower bound of the probability must reach `p`. With one sample (no
+/// `sim.robust`) the main check is the one sample; a check that did not run cannot meet it.
+fn judge_probability(p: f64, sim: &SimReport, q: Question) -> (bool, String) {
+    let (what, key) = match q {
+        Question::Hold => ("held", "hold probability"),
+        Question::AsPlanned => ("held as planned", "probability of a hold as planned"),
+    };
     let (held, n, lo) = match (&sim.robust, sim.verdict.verdict()) {
-        (Some(r), _) => (r.counts.hold, r.samples, r.interval[0]),
+        (Some(r), _) => match q {
+            Question::Hold => (r.counts.hold, r.samples, r.interval[0]),
+            Question::AsPlanned => (r.held_as_planned, r.samples, r.as_planned_interval[0]),
+        },
         (None, Some(v)) => {
-            let held = usize::from(v == crate::sim::Verdict::Hold);
+            let as_planned = sim.fidelity.as_ref().is_some_and(|f| f.as_planned);
+            let held = usize::from(
+                v == crate::sim::Verdict::Hold
+                    && (matches!(q, Question::Hold) || as_planned),
+            );
             (held, 1, crate::sim::robust::wilson(held, 1)[0])
         }
         (None, None) => {
             return (
                 false,
-                format!("hold probability not measured (physics check not run); expected a lower bound of at least {p}"),
+                format!("{key} not measured (physics check not run); expected a lower bound of at least {p}"),
             )
         }
     };
     let words = format!(
-        "held in {held} of {n} perturbed checks, 95 % lower bound {lo:.3} (expected at least {p})"
+        "{what} in {held} of {n} perturbed checks, 95 % lower bound {lo:.3} (expected at least {p})"
     );
     (lo >= p, words)
 }

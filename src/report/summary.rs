@@ -54,8 +54,15 @@ impl GraspReport {
             .collect();
         let check = match &self.check {
             Some(c) => format!(
-                "; check: {} ({:.2} mm, {:.2} deg)",
-                c.verdict, c.translation_mm, c.rotation_deg
+                "; check: {}{} ({:.2} mm, {:.2} deg)",
+                c.verdict,
+                if c.fidelity.as_planned {
+                    ""
+                } else {
+                    ", not as planned"
+                },
+                c.translation_mm,
+                c.rotation_deg
             ),
             None => "; not checked".to_string(),
         };
@@ -230,6 +237,9 @@ impl RunReport {
             let _ = writeln!(s, "    theta1/theta2 planned {} deg", planned.join(", "));
             let _ = writeln!(s, "    theta1/theta2 closed  {} deg", closed.join(", "));
         }
+        if let Some(f) = &self.sim.fidelity {
+            let _ = writeln!(s, "  Fidelity    {}", fidelity_line(f, &self.sim));
+        }
     }
 
     /// The physics check in one line: the verdict, how far the object moved, the steps and
@@ -303,40 +313,23 @@ impl RunReport {
             sim.rotation_deg.unwrap_or(0.0)
         );
         match &sim.verdict {
-            SimVerdict::Ran(Verdict::Hold) => {
-                format!("{grasp}: HELD under gravity (moved {moved})")
-            }
-            SimVerdict::Ran(Verdict::Slip) => match (penetrated_slip(sim), failed_closing(sim)) {
-                (None, Some(c)) if c.pushed => format!(
-                    "{grasp}: NOT held as planned: the closing pushed the object {:.1} mm, more \
-                     than max_closing_shift_mm ({} mm), before the fingers caught it, so the \
-                     grasp that held is not the one planned (the object then moved {moved})",
-                    c.shift_mm, c.max_shift_mm
-                ),
-                (None, Some(c)) => format!(
-                    "{grasp}: NOT held as planned: only {} of {} phalanges ended the closing on \
-                     the object within {} deg of their plan, fewer than min_on_plan_fraction \
-                     asks ({}), so the grasp that held is not the one planned (the object then \
-                     moved {moved})",
-                    c.phalanges_on_plan,
-                    2 * c.fingers.len(),
-                    crate::sim::protocol::WITHIN_PLAN_DEG,
-                    c.min_on_plan
-                ),
-                (Some((depth, limit)), _) => format!(
-                    "{grasp}: NOT held: a finger ended the closing {depth:.2} mm inside the \
-                     object, more than max_penetration_mm ({limit} mm), so the grip is not one a \
-                     real hand makes (the object moved {moved})"
-                ),
-                (None, None) => format!(
-                    "{grasp}: NOT held: the object slipped {moved}, beyond the hold limits{}, but \
-                     stayed in the hand",
-                    sim.limits.map_or(String::new(), |l| format!(
-                        " ({} mm, {} deg)",
-                        l.translation_mm, l.rotation_deg
-                    ))
+            SimVerdict::Ran(Verdict::Hold) => match sim.fidelity.as_ref().filter(|f| !f.as_planned)
+            {
+                None => format!("{grasp}: HELD under gravity (moved {moved})"),
+                Some(f) => format!(
+                    "{grasp}: HELD under gravity (moved {moved}), but NOT as planned ({}): \
+                     command the closed joint angles",
+                    reasons_words(f)
                 ),
             },
+            SimVerdict::Ran(Verdict::Slip) => format!(
+                "{grasp}: NOT held: the object slipped {moved}, beyond the hold limits{}, but \
+                 stayed in the hand",
+                sim.limits.map_or(String::new(), |l| format!(
+                    " ({} mm, {} deg)",
+                    l.translation_mm, l.rotation_deg
+                ))
+            ),
             SimVerdict::Ran(Verdict::Drop) => {
                 format!("{grasp}: NOT held: the object fell out of the hand (moved {moved})")
             }
@@ -347,34 +340,75 @@ impl RunReport {
     }
 }
 
-/// For a `slip` that moved within the hold limits in every direction: it is a slip because a
-/// finger ended the closing deeper in the object than the limit. Returns the depth and the
-/// limit `[mm]`.
-fn penetrated_slip(sim: &SimReport) -> Option<(f64, f64)> {
-    let l = sim.limits?;
-    let within = sim.directions.iter().all(|d| {
-        d.verdict != Verdict::Slip
-            || (d.translation_mm <= l.translation_mm && d.rotation_deg <= l.rotation_deg)
-    });
-    let depth = sim
-        .directions
+/// The reasons a closing left the plan, in words: "pushed 6.2 mm", "2 of 6 phalanges on plan",
+/// "a finger 2.40 mm inside".
+fn reasons_words(f: &crate::sim::Fidelity) -> String {
+    let words: Vec<String> = f
+        .reasons
         .iter()
-        .map(|d| d.closing_penetration_mm)
-        .fold(0.0, f64::max);
-    (within && depth > l.penetration_mm).then_some((depth, l.penetration_mm))
+        .map(|r| match r {
+            crate::sim::FidelityReason::Pushed => format!("pushed {:.1} mm", f.shift_mm),
+            crate::sim::FidelityReason::OffPlan => format!(
+                "{} of {} phalanges on plan",
+                f.phalanges_on_plan, f.phalanges
+            ),
+            crate::sim::FidelityReason::Penetrated => {
+                format!("a finger {:.2} mm inside", f.penetration_mm)
+            }
+        })
+        .collect();
+    words.join(", ")
 }
 
-/// For a `slip` that moved within the hold limits in every direction and left no finger too
-/// deep: it is a slip because the closing pushed the object farther than its bound, or left
-/// fewer phalanges on their plan than `min_on_plan_fraction` asks.
-fn failed_closing(sim: &SimReport) -> Option<&crate::sim::ClosingOutcome> {
-    let l = sim.limits?;
-    let c = sim.closing.as_ref().filter(|c| c.pushed || c.off_plan)?;
-    let within = sim.directions.iter().all(|d| {
-        d.verdict != Verdict::Slip
-            || (d.translation_mm <= l.translation_mm && d.rotation_deg <= l.rotation_deg)
-    });
-    within.then_some(c)
+/// The summary's fidelity line (issue 55): whether the grasp the closing made is the one
+/// planned, how far the closing took it from the plan, and each bound it crossed, e.g. "NOT as
+/// planned: the closing took the object 6.2 mm and 1.3 deg from the plan (at most 5 mm);
+/// 2 of 6 phalanges end on plan (at least 3); worst joint 12.0 deg short".
+pub fn fidelity_line(f: &crate::sim::Fidelity, sim: &SimReport) -> String {
+    use crate::sim::FidelityReason;
+    let has = |r| f.reasons.contains(&r);
+    let limits = sim.limits;
+    let min_on_plan = sim.closing.as_ref().map(|c| c.min_on_plan);
+    let mut s = format!(
+        "{}: the closing took the object {:.1} mm and {:.1} deg from the plan",
+        if f.as_planned {
+            "as planned"
+        } else {
+            "NOT as planned"
+        },
+        f.shift_mm,
+        f.turn_deg
+    );
+    if let (true, Some(l)) = (has(FidelityReason::Pushed), limits) {
+        s += &format!(" (at most {} mm: max_closing_shift_mm)", l.closing_shift_mm);
+    }
+    s += &format!(
+        "; {} of {} phalanges end on plan",
+        f.phalanges_on_plan, f.phalanges
+    );
+    if let (true, Some(n)) = (has(FidelityReason::OffPlan), min_on_plan) {
+        s += &format!(" (at least {n}: min_on_plan_fraction)");
+    }
+    let e = f.worst_joint_error_deg;
+    s += &format!(
+        "; worst joint {:.1} deg {}",
+        e.abs(),
+        if e < 0.0 { "short" } else { "past" }
+    );
+    if has(FidelityReason::Penetrated) {
+        s += &format!(
+            "; a finger ended {:.2} mm inside the object{}",
+            f.penetration_mm,
+            limits.map_or(String::new(), |l| format!(
+                " (at most {} mm: max_penetration_mm)",
+                l.penetration_mm
+            ))
+        );
+    }
+    if !f.as_planned && sim.verdict.verdict() == Some(Verdict::Hold) {
+        s += "; the grasp that held is the closed one: command its joint angles";
+    }
+    s
 }
 
 /// The summary's closing line (issue 33): how far the closing pushed and turned the object,
@@ -387,7 +421,7 @@ pub fn closing_line(c: &crate::sim::ClosingOutcome) -> String {
         c.turn_deg,
         if c.pushed {
             format!(
-                " (more than max_closing_shift_mm, {} mm: not a hold of the planned grasp)",
+                " (more than max_closing_shift_mm, {} mm: not as planned)",
                 c.max_shift_mm
             )
         } else {
@@ -407,10 +441,7 @@ pub fn closing_line(c: &crate::sim::ClosingOutcome) -> String {
         c.phalanges_on_plan,
         crate::sim::protocol::WITHIN_PLAN_DEG,
         if c.off_plan {
-            format!(
-                " (fewer than {}: not a hold of the planned grasp)",
-                c.min_on_plan
-            )
+            format!(" (fewer than {}: not as planned)", c.min_on_plan)
         } else {
             String::new()
         }

@@ -6,7 +6,7 @@
 //! penetration left. Units: millimetres and degrees in what it reports, SI inside rapier.
 
 use super::convert;
-use super::outcome::{ClosingOutcome, FingerClosing, FirstTouch, WITHIN_PLAN_DEG};
+use super::outcome::{ClosingOutcome, Fidelity, FingerClosing, FirstTouch, WITHIN_PLAN_DEG};
 use super::scene::{poses, relative, Case, Scene};
 use nalgebra::{UnitQuaternion, Vector3};
 use rapier3d::prelude::*;
@@ -66,18 +66,17 @@ pub(super) struct Closing {
     pub(super) steps: usize,
     /// The contacts carrying the grip when closing ended.
     pub(super) contacts: Vec<super::contacts::GripContact>,
+    /// Whether the closing kept the planned grasp.
+    pub(super) fidelity: Fidelity,
 }
 
 impl Closing {
-    /// True if the closing failed: it pushed the object beyond `max_closing_shift_mm`, left
-    /// fewer phalanges on their plan than `min_on_plan_fraction` asks, or left a finger deeper
-    /// than `max_penetration_mm` (or a depth that is no number). Such a grasp is no `hold`
-    /// whatever gravity does.
-    pub(super) fn failed(&self, params: &super::params::SimParams) -> bool {
-        self.outcome.pushed
-            || self.outcome.off_plan
-            || self.penetration_mm.is_nan()
-            || self.penetration_mm > params.hold.max_penetration_mm
+    /// True if the closing did not keep the planned grasp: it pushed the object beyond
+    /// `max_closing_shift_mm`, left fewer phalanges on their plan than `min_on_plan_fraction`
+    /// asks, or left a finger deeper than `max_penetration_mm` (or a depth that is no number).
+    /// Gravity's verdict does not depend on it; the fidelity reports it.
+    pub(super) fn failed(&self) -> bool {
+        !self.fidelity.as_planned
     }
 }
 
@@ -317,12 +316,19 @@ fn closed(
         ((pc - p0).norm(), q0.angle_to(&qc).to_degrees()),
         steps as f64 * dt,
     );
+    let penetration_mm = penetration_mm(scene);
+    let fidelity = Fidelity::of(
+        &outcome,
+        penetration_mm,
+        case.params.hold.max_penetration_mm,
+    );
     Closing {
         p0,
         q0,
         pc,
         qc,
-        penetration_mm: penetration_mm(scene),
+        penetration_mm,
+        fidelity,
         joint_errors_deg,
         steps,
         contacts: super::contacts::grip_contacts(scene),

@@ -129,13 +129,13 @@ impl EarlyDecision {
     /// mean drift and its spread at `safety` times their size continued for `remaining_s`,
     /// decides now, provided it keeps the numbers reported now within what they may differ from
     /// the full protocol's:
-    /// - `Hold` when the object stays within `margin` of the hold thresholds (a hold by motion;
-    ///   the verdict is `slip` all the same if the closing left a finger too deep);
+    /// - `Hold` when the object stays within `margin` of the hold thresholds;
     /// - `Slip` when it cannot come back within `1 / margin` of a threshold (the distance to the
     ///   pose after closing moves by no more than the object does, and so does the judged
-    ///   rotation), or, for a grasp the closing left too deep in the object (`penetrated`),
-    ///   wherever it is: such a grasp is `slip` whatever it does while on the hand;
+    ///   rotation);
     /// - `None` otherwise.
+    ///
+    /// Motion alone decides: whether the closing kept the plan is the fidelity's question.
     ///
     /// A `Slip` holds only for an object on the hand, which the caller checks.
     pub fn decide(
@@ -144,7 +144,6 @@ impl EarlyDecision {
         frame: &RestFrame,
         remaining_s: f64,
         params: &SimParams,
-        penetrated: bool,
     ) -> Option<Verdict> {
         let s = self.settling(samples, frame, remaining_s)?;
         if !self.reportable(&s) {
@@ -157,7 +156,7 @@ impl EarlyDecision {
         }
         let beyond = s.now_mm - s.more_mm >= params.hold.hold_translation_mm / self.margin
             || s.now_deg - s.more_deg >= params.hold.hold_rotation_deg / self.margin;
-        (beyond || penetrated).then_some(Verdict::Slip)
+        beyond.then_some(Verdict::Slip)
     }
 }
 
@@ -202,9 +201,9 @@ mod tests {
         let f = frame(false);
         // round(0.2 s / (1/48 s)) = 10 samples, plus the one the window starts from.
         let still = Vector3::new(1.0, 0.0, 0.0);
-        assert_eq!(r.decide(&at_rest(10, still), &f, 1.0, &params, false), None);
+        assert_eq!(r.decide(&at_rest(10, still), &f, 1.0, &params), None);
         assert_eq!(
-            r.decide(&at_rest(11, still), &f, 1.0, &params, false),
+            r.decide(&at_rest(11, still), &f, 1.0, &params),
             Some(Verdict::Hold)
         );
     }
@@ -213,24 +212,12 @@ mod tests {
     fn at_rest_the_distance_from_the_closed_pose_decides() {
         let (r, params) = rule();
         let f = frame(false);
-        let decide = |x: f64, penetrated| {
-            r.decide(
-                &at_rest(20, Vector3::new(x, 0.0, 0.0)),
-                &f,
-                1.5,
-                &params,
-                penetrated,
-            )
-        };
+        let decide = |x: f64| r.decide(&at_rest(20, Vector3::new(x, 0.0, 0.0)), &f, 1.5, &params);
         // Within 0.8 × 5 mm: hold; beyond 5 mm / 0.8 = 6.25 mm: slip; between: undecided.
-        assert_eq!(decide(3.9, false), Some(Verdict::Hold));
-        assert_eq!(decide(4.1, false), None);
-        assert_eq!(decide(6.2, false), None);
-        assert_eq!(decide(6.3, false), Some(Verdict::Slip));
-        // A grasp the closing left too deep is `slip` wherever it rests.
-        assert_eq!(decide(4.1, true), Some(Verdict::Slip));
-        // ... but one within the thresholds is still decided `hold` by motion.
-        assert_eq!(decide(1.0, true), Some(Verdict::Hold));
+        assert_eq!(decide(3.9), Some(Verdict::Hold));
+        assert_eq!(decide(4.1), None);
+        assert_eq!(decide(6.2), None);
+        assert_eq!(decide(6.3), Some(Verdict::Slip));
     }
 
     #[test]
@@ -282,11 +269,11 @@ mod tests {
         let (r, params) = rule();
         let spun = vec![(Vector3::zeros(), spin); 20];
         assert_eq!(
-            r.decide(&spun, &frame(true), 1.0, &params, false),
+            r.decide(&spun, &frame(true), 1.0, &params),
             Some(Verdict::Hold)
         );
         assert_eq!(
-            r.decide(&spun, &frame(false), 1.0, &params, false),
+            r.decide(&spun, &frame(false), 1.0, &params),
             Some(Verdict::Slip)
         );
     }

@@ -260,7 +260,7 @@ impl Flyer<'_> {
                 // parry's convex distance stops within about 1.1e-3 of the true one, from above.
                 // Where its GJK does not converge it reads 0 (`contacts::separation_m`), which
                 // only delays a drop here; measuring with `separation_m` instead changed no
-                // verdict and no step of the real-object batch (session 47), so this stays.
+                // verdict and no step of the real-object batch (2026-12-03), so this stays.
                 f64::from(d.distance) * (1.0 - 2e-3) - turned
             } else {
                 f64::NEG_INFINITY

@@ -92,7 +92,7 @@ pub(super) fn hold(
     });
     let mut steps = 0;
     // `closing_decides`: a failed closing is decided before any step of the hold.
-    if watch.is_some() && params.hold.closing_decides && closing.failed(params) {
+    if watch.is_some() && params.hold.closing_decides && closing.failed() {
         decided = Some(Decision::Closing);
     }
     while steps < hold_steps && decided.is_none() {
@@ -177,15 +177,7 @@ impl EarlyWatch<'_> {
         }
         self.hand_was_still = hand_still;
         let remaining_s = (hold_steps - steps) as f64 * params.solver.timestep_s;
-        // A grasp the closing left too deep in the object, pushed too far or left off its
-        // plan is `slip` whatever it does while on the hand.
-        match rule.decide(
-            samples,
-            &self.frame,
-            remaining_s,
-            params,
-            closing.failed(params),
-        ) {
+        match rule.decide(samples, &self.frame, remaining_s, params) {
             Some(Verdict::Hold) => {}
             Some(_) if touches_hand(scene) => {}
             _ => return None,
@@ -246,9 +238,16 @@ fn direction_outcome(
     };
     let verdict = if decided_by.is_drop() {
         Verdict::Drop
+    } else if decided_by == DecidedBy::Closing {
+        // No hold ran (`closing_decides`): a provisional verdict by contact alone, which the
+        // candidate search replaces by a full check before it reports or chooses the grasp.
+        if in_contact {
+            Verdict::Slip
+        } else {
+            Verdict::Drop
+        }
     } else if translation_mm <= params.hold.hold_translation_mm
         && judged_rotation <= params.hold.hold_rotation_deg
-        && !closing.failed(params)
     {
         Verdict::Hold
     } else if in_contact {
@@ -267,6 +266,7 @@ fn direction_outcome(
         closing_rotation_deg: closing.q0.angle_to(&qc).to_degrees(),
         closing_pushed: closing.outcome.pushed,
         closing_off_plan: closing.outcome.off_plan,
+        as_planned: closing.fidelity.as_planned,
         closing_penetration_mm: closing.penetration_mm,
         closed_at_s: closing.steps as f64 * dt,
         joint_error_deg,

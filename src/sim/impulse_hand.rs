@@ -157,9 +157,9 @@ mod tests {
     #[test]
     fn the_impulse_hand_closes_where_the_multibody_hand_does_on_d40() {
         // Same bodies, limits and motors: on D40 the fingers stop within 1.5° of each other
-        // under the 10° squeeze the study used, within 2.5° under session 46's default closing
+        // under the 10° squeeze the study used, within 2.5° under the default closing of ff19c34
         // (1.76° on finger_3's joint 2; 2.04° since contact manifolds are checked against
-        // parry's contact query, session 49), and both hold (docs/SIM.md, "The impulse-joint
+        // parry's contact query, c78b8c2), and both hold (docs/SIM.md, "The impulse-joint
         // hand": elsewhere they part).
         let squeeze = |kind| {
             let mut p = with_joints(kind);

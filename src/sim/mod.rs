@@ -60,7 +60,8 @@ pub use collider::{
 };
 pub use early::EarlyDecision;
 pub use outcome::{
-    ClosingOutcome, DecidedBy, DirectionOutcome, FingerClosing, FirstTouch, SimOutcome, Verdict,
+    ClosingOutcome, DecidedBy, DirectionOutcome, Fidelity, FidelityReason, FingerClosing,
+    FirstTouch, SimOutcome, Verdict,
 };
 pub use payload::{check_with_payload, payload_bracket, payload_margin};
 pub use protocol::{check, check_closed, Closed};

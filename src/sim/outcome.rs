@@ -1,20 +1,23 @@
 //! What the physics check reports: the verdict, the outcome per gravity direction and over all of
-//! them, and what the closing did to the planned grasp. Units as in the JSON: millimetres,
-//! degrees, seconds.
+//! them, what the closing did to the planned grasp, and whether the grasp that held is the one
+//! planned (its fidelity). Units as in the JSON: millimetres, degrees, seconds.
+//!
+//! Two questions, two fields (issue 55): the [`Verdict`] says what gravity did (the hold
+//! thresholds alone); the [`Fidelity`] says whether the closing kept the planned grasp
+//! (`max_closing_shift_mm`, `min_on_plan_fraction`, `max_penetration_mm`), with the continuous
+//! figures that decided it.
 
 use nalgebra::Vector3;
 
-/// The verdict of the hold test.
+/// The verdict of the hold test: what gravity did to the object in the hand, judged by the hold
+/// thresholds alone (`hold_translation_mm`, `hold_rotation_deg`). Whether the grasp that held
+/// is the one planned is the [`Fidelity`]'s question, not this one's.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Verdict {
-    /// The object stayed within the thresholds, no hand collider ended the closing deeper
-    /// inside it than `max_penetration_mm`, and the closing pushed it no farther than
-    /// `max_closing_shift_mm`.
+    /// The object stayed within the thresholds relative to the palm.
     Hold,
-    /// It moved beyond them but still touches the hand, or it stayed but a finger ended the
-    /// closing deeper inside it than `max_penetration_mm` (not a grasp a real hand makes), or
-    /// the closing pushed it farther than `max_closing_shift_mm` (not the grasp planned).
+    /// It moved beyond them but still touches the hand.
     Slip,
     /// It left the hand.
     Drop,
@@ -58,13 +61,15 @@ pub struct DirectionOutcome {
     /// Object rotation relative to the palm while the fingers closed `[deg]` (the full
     /// rotation).
     pub closing_rotation_deg: f64,
-    /// True if and only if the closing pushed the object farther than `max_closing_shift_mm`:
-    /// then the verdict is not `hold` (issue 33), whatever the hold did.
+    /// True if and only if the closing pushed the object farther than `max_closing_shift_mm`
+    /// (the grasp is then not as planned; the verdict is gravity's alone).
     pub closing_pushed: bool,
     /// True if and only if fewer phalanges ended the closing on their plan than
-    /// `min_on_plan_fraction` asks: then the verdict is not `hold` (issue 33), whatever the
-    /// hold did.
+    /// `min_on_plan_fraction` asks (the grasp is then not as planned).
     pub closing_off_plan: bool,
+    /// True if and only if the closing this direction continued from kept the planned grasp
+    /// ([`Fidelity::as_planned`]).
+    pub as_planned: bool,
     /// Deepest penetration of a finger or the palm into the object at the end of closing `[mm]`
     /// (rapier's contact depth): a grasp that holds only because a finger passed into the object
     /// shows here (issue 14).
@@ -107,9 +112,10 @@ pub enum DecidedBy {
     OutOfReach,
     /// The object flies clear of the resting hand for good: `drop`.
     ClearOfHand,
-    /// The closing failed (pushed the object beyond `max_closing_shift_mm`, or left a finger
-    /// deeper than `max_penetration_mm`) and `[sim] closing_decides` is on: no hold was run;
-    /// `slip` if the object touches the hand after the closing, else `drop`.
+    /// The closing did not keep the planned grasp ([`Fidelity::as_planned`] false) and `[sim]
+    /// closing_decides` is on: no hold was run, so the verdict (`slip` if the object touches
+    /// the hand after the closing, else `drop`) is provisional, not gravity's. The candidate
+    /// search checks such a candidate again in full before it reports or chooses it.
     Closing,
 }
 
@@ -143,6 +149,9 @@ impl std::fmt::Display for DecidedBy {
 pub struct SimOutcome {
     /// The worst verdict over the gravity directions.
     pub verdict: Verdict,
+    /// Whether the grasp that held is the one planned (the first direction's closing; under
+    /// the `full` protocol, `as_planned` only if every direction's closing kept the plan).
+    pub fidelity: Fidelity,
     /// The worst direction's translation `[mm]`.
     pub translation_mm: f64,
     /// The worst direction's rotation `[deg]`.
@@ -175,12 +184,30 @@ pub struct SimOutcome {
 
 impl SimOutcome {
     /// Returns true if and only if the check counts as a success for the candidate search: the
-    /// hold probability's lower bound reaches `[sim] choose_min_lower_bound` when the samples
-    /// ran for it (`choose = "robust"`), else the main check's verdict is `hold`.
+    /// lower bound of the probability of a hold as planned reaches `[sim]
+    /// choose_min_lower_bound` when the samples ran for it (`choose = "robust"`), else the main
+    /// check held as planned.
     pub fn succeeded(&self) -> bool {
         match &self.robust {
             Some(r) => r.passes,
-            None => self.verdict == Verdict::Hold,
+            None => self.held_as_planned(),
+        }
+    }
+
+    /// Returns true if and only if the main check's verdict is `hold` and its closing kept the
+    /// planned grasp.
+    pub fn held_as_planned(&self) -> bool {
+        self.verdict == Verdict::Hold && self.fidelity.as_planned
+    }
+
+    /// The candidate search's preference (issue 55), best first: 0 held as planned, 1 held
+    /// (not as planned), 2 slip, 3 drop.
+    pub fn preference(&self) -> u8 {
+        match self.verdict {
+            Verdict::Hold if self.fidelity.as_planned => 0,
+            Verdict::Hold => 1,
+            Verdict::Slip => 2,
+            Verdict::Drop => 3,
         }
     }
 
@@ -282,6 +309,103 @@ impl ClosingOutcome {
             }
         }
         worst
+    }
+}
+
+/// Why a closing did not keep the planned grasp: one entry of [`Fidelity::reasons`], named in
+/// the JSON by the key that bounds it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FidelityReason {
+    /// The closing pushed the object farther than `max_closing_shift_mm`.
+    Pushed,
+    /// Fewer phalanges ended on their plan than `min_on_plan_fraction` asks.
+    OffPlan,
+    /// A hand collider ended the closing deeper inside the object than `max_penetration_mm`
+    /// (or at a depth that is no number): not a grip a real hand makes.
+    Penetrated,
+}
+
+impl FidelityReason {
+    /// The name used in JSON.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FidelityReason::Pushed => "pushed",
+            FidelityReason::OffPlan => "off_plan",
+            FidelityReason::Penetrated => "penetrated",
+        }
+    }
+}
+
+impl std::fmt::Display for FidelityReason {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.pad(self.as_str())
+    }
+}
+
+/// Whether the grasp the closing made is the one planned (issue 55; `sim.fidelity` in the JSON,
+/// also per candidate): the bounds as a yes or no, and the continuous figures that decided it,
+/// for an engine comparison or a tuning to use.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct Fidelity {
+    /// True if and only if `reasons` is empty: the closing pushed the object no farther than
+    /// `max_closing_shift_mm`, left at least `min_on_plan_fraction` of the phalanges on their
+    /// plan and no hand collider deeper in the object than `max_penetration_mm`.
+    pub as_planned: bool,
+    /// Object translation relative to the palm over the closing `[mm]`.
+    pub shift_mm: f64,
+    /// Object rotation relative to the palm over the closing `[deg]`.
+    pub turn_deg: f64,
+    /// Phalanges that end the closing touching the object within [`WITHIN_PLAN_DEG`] of their
+    /// planned bend.
+    pub phalanges_on_plan: usize,
+    /// The hand's phalanges.
+    pub phalanges: usize,
+    /// The largest joint error against the plan, by magnitude, signed (negative: stopped
+    /// short of the plan) `[deg]`; 0 for a hand without fingers.
+    pub worst_joint_error_deg: f64,
+    /// Deepest penetration of a hand collider into the object at the end of the closing `[mm]`.
+    pub penetration_mm: f64,
+    /// Why not as planned, in the order pushed, off plan, penetrated (empty when as planned).
+    pub reasons: Vec<FidelityReason>,
+}
+
+impl Fidelity {
+    /// The fidelity of `closing`, which left a hand collider `penetration_mm` deep, judged by
+    /// `max_penetration_mm` and the closing's own bounds (`pushed`, `off_plan`).
+    pub fn of(closing: &ClosingOutcome, penetration_mm: f64, max_penetration_mm: f64) -> Fidelity {
+        let mut reasons = Vec::new();
+        if closing.pushed {
+            reasons.push(FidelityReason::Pushed);
+        }
+        if closing.off_plan {
+            reasons.push(FidelityReason::OffPlan);
+        }
+        if penetration_mm.is_nan() || penetration_mm > max_penetration_mm {
+            reasons.push(FidelityReason::Penetrated);
+        }
+        Fidelity {
+            as_planned: reasons.is_empty(),
+            shift_mm: closing.shift_mm,
+            turn_deg: closing.turn_deg,
+            phalanges_on_plan: closing.phalanges_on_plan,
+            phalanges: 2 * closing.fingers.len(),
+            worst_joint_error_deg: closing.worst_joint().map_or(0.0, |w| w.2),
+            penetration_mm,
+            reasons,
+        }
+    }
+
+    /// Adds what another closing of the same check (another direction under the `full`
+    /// protocol) did: not as planned if either was not, every reason of either.
+    pub fn merge(&mut self, other: &Fidelity) {
+        for r in &other.reasons {
+            if !self.reasons.contains(r) {
+                self.reasons.push(*r);
+            }
+        }
+        self.reasons.sort();
+        self.as_planned = self.reasons.is_empty();
     }
 }
 

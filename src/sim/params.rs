@@ -202,7 +202,7 @@ impl Default for SolverParams {
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct FingerParams {
     /// Joint 1's motor target closes this far past its planned angle `[deg]` (3°, 10° before
-    /// session 46: docs/SIM.md "The closing, adopted").
+    /// 2026-12-03, ff19c34: docs/SIM.md "The closing, adopted").
     pub squeeze_deg: f64,
     /// Joint 2's motor target closes this far past its planned angle `[deg]`.
     pub squeeze2_deg: f64,
@@ -253,7 +253,7 @@ pub struct ClosingParams {
     /// The fingers start this much more open than planned at each joint `[deg]`.
     pub open_margin_deg: f64,
     /// How joint 1 closes: `squeeze` (each finger straight to its target, the default before
-    /// session 46), `together` (the default: a finger that touches the object stops there until
+    /// ff19c34), `together` (the default: a finger that touches the object stops there until
     /// every finger has touched, or the others have stopped, then all squeeze at once) or `timed`
     /// (every finger's target ramps to its planned bend in the same time, then the squeeze).
     pub approach: Approach,
@@ -269,7 +269,7 @@ pub struct ClosingParams {
     /// After joint 2 has closed, each locked joint 1 whose phalanx 1 does not touch the object
     /// moves on under its lock until it touches or reaches its squeeze target (`sim::closing`,
     /// docs/SIM.md "Why the phalanges miss their plan"): phalanx 1 comes back onto an object
-    /// that joint 2 seated away from it. On by default since session 46. Left out of the
+    /// that joint 2 seated away from it. On by default since ff19c34. Left out of the
     /// serialised parameters when off.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub reseat: bool,
@@ -394,7 +394,7 @@ pub struct InputParams {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Approach {
-    /// Every finger closes straight to its squeeze target (the default before session 46).
+    /// Every finger closes straight to its squeeze target (the default before ff19c34).
     Squeeze,
     /// A finger stops where it touches until every finger has touched (or the hand has
     /// stopped), then all squeeze together (the default).

@@ -87,9 +87,14 @@ pub(super) fn check_full(case: &Case) -> SimOutcome {
     let mut steps = 0;
     let mut final_poses = Vec::new();
     let mut first_closing: Option<Closing> = None;
+    let mut fidelity: Option<super::outcome::Fidelity> = None;
     for g in directions(params.gravity) {
         let mut scene = build(case);
         let closing = close(&mut scene, case);
+        match fidelity.as_mut() {
+            None => fidelity = Some(closing.fidelity.clone()),
+            Some(f) => f.merge(&closing.fidelity),
+        }
         first_closing.get_or_insert_with(|| closing.clone());
         let (o, n) = hold(
             &mut scene,
@@ -110,6 +115,7 @@ pub(super) fn check_full(case: &Case) -> SimOutcome {
         grip_contacts: closing.contacts,
         closing: closing.outcome,
         closed_poses: closing.poses,
+        fidelity: fidelity.expect("at least one direction"),
         ..summarise(outcomes, steps, params, t0, final_poses)
     }
 }
@@ -143,6 +149,7 @@ pub fn check_closed(closed: &Closed, case: &Case, k: f64, t0: Instant) -> SimOut
         grip_contacts: closed.closing.contacts.clone(),
         closing: closed.closing.outcome.clone(),
         closed_poses: closed.closing.poses.clone(),
+        fidelity: closed.closing.fidelity.clone(),
         ..summarise(
             runs.into_iter().map(|r| r.0).collect(),
             steps,
@@ -171,6 +178,16 @@ fn summarise(
         .clone();
     SimOutcome {
         verdict: worst.verdict,
+        fidelity: super::outcome::Fidelity {
+            as_planned: true,
+            shift_mm: 0.0,
+            turn_deg: 0.0,
+            phalanges_on_plan: 0,
+            phalanges: 0,
+            worst_joint_error_deg: 0.0,
+            penetration_mm: 0.0,
+            reasons: Vec::new(),
+        },
         translation_mm: worst.translation_mm,
         rotation_deg: worst.rotation_deg,
         simulated_s: steps as f64 * params.solver.timestep_s,

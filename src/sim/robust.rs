@@ -11,10 +11,12 @@
 //! a copy of its closed scene (the `fast` protocol's [`super::protocol::Closed`]); no closing is
 //! shared between samples, since every sample moves the object relative to the hand.
 //!
-//! The probability is the fraction of samples whose every gravity direction held, with its
+//! The hold probability is the fraction of samples whose every gravity direction held, with its
 //! 95 % Wilson score interval: with few samples an all-held count is far from certainty (8 of 8
-//! gives a lower bound of 0.68), which is what `[expect] min_hold_probability` and
-//! `[sim] choose = "robust"` judge.
+//! gives a lower bound of 0.68), which is what `[expect] min_hold_probability` judges. The
+//! probability of a hold as planned (issue 55) counts, of the same samples, those that held and
+//! whose closing kept the planned grasp; `[expect] min_as_planned_probability` and `[sim] choose
+//! = "robust"` judge its interval.
 
 use super::outcome::{SimOutcome, Verdict};
 use super::params::{RobustParams, SimParams};
@@ -201,6 +203,8 @@ pub struct DirectionRobust {
     pub hold_probability: f64,
     /// Its 95 % Wilson interval.
     pub interval: [f64; 2],
+    /// Samples that held under it with a closing that kept the planned grasp.
+    pub held_as_planned: usize,
 }
 
 /// The first sample that did not hold: enough to replay it (`[sim] replay_sample`).
@@ -246,10 +250,18 @@ pub struct Robust {
     pub hold_probability: f64,
     /// Its 95 % Wilson interval `[lo, hi]`.
     pub interval: [f64; 2],
+    /// Samples that held in every direction with a closing that kept the planned grasp.
+    pub held_as_planned: usize,
+    /// `held_as_planned / samples`: the probability of a hold as planned.
+    pub as_planned_probability: f64,
+    /// Its 95 % Wilson interval `[lo, hi]`.
+    pub as_planned_interval: [f64; 2],
     /// Per gravity direction.
     pub directions: Vec<DirectionRobust>,
     /// Each sample's verdict, in sample order.
     pub verdicts: Vec<Verdict>,
+    /// Each sample's fidelity (`true`: its closing kept the planned grasp), in sample order.
+    pub as_planned: Vec<bool>,
     /// The first sample that did not hold (`None`: all held).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub first_failure: Option<FirstFailure>,
@@ -257,24 +269,48 @@ pub struct Robust {
     pub steps: usize,
     /// Wall time of the samples `[ms]`.
     pub wall_ms: f64,
-    /// True if and only if the interval's lower bound reaches `[sim] choose_min_lower_bound`
-    /// (what `choose = "robust"` takes as a success).
+    /// True if and only if the lower bound of `as_planned_interval` reaches `[sim]
+    /// choose_min_lower_bound` (what `choose = "robust"` takes as a success).
     #[serde(skip)]
     pub passes: bool,
 }
 
 impl Robust {
-    /// The summary's words: "held in 14 of 16 perturbed checks (88 %, 95 % interval 64–97 %)".
+    /// The summary's words: "held in 14 of 16 perturbed checks (88 %, 95 % interval 64–97 %)",
+    /// and, when some of those holds were not as planned, "; as planned in 12 (75 %, 95 %
+    /// interval 51–90 %)".
     pub fn in_words(&self) -> String {
         let pct = |x: f64| (100.0 * x).round();
-        format!(
+        let mut words = format!(
             "held in {} of {} perturbed checks ({} %, 95 % interval {}–{} %)",
             self.counts.hold,
             self.samples,
             pct(self.hold_probability),
             pct(self.interval[0]),
             pct(self.interval[1])
-        )
+        );
+        if self.held_as_planned != self.counts.hold {
+            words += &format!(
+                "; as planned in {} ({} %, 95 % interval {}–{} %)",
+                self.held_as_planned,
+                pct(self.as_planned_probability),
+                pct(self.as_planned_interval[0]),
+                pct(self.as_planned_interval[1])
+            );
+        }
+        words
+    }
+
+    /// The candidate search's rank of a sampled candidate, larger better: the lower bound of
+    /// the probability of a hold as planned, then of the hold probability, then the two
+    /// probabilities.
+    pub fn rank(&self) -> [f64; 4] {
+        [
+            self.as_planned_interval[0],
+            self.interval[0],
+            self.as_planned_probability,
+            self.hold_probability,
+        ]
     }
 }
 
@@ -296,21 +332,33 @@ pub fn check_nominal(case: &Case) -> SimOutcome {
 /// Runs `[sim] samples` perturbed checks of `case` in parallel and counts their verdicts.
 pub fn sample(case: &Case) -> Robust {
     let t0 = Instant::now();
-    let rp = &case.params.robust;
-    let runs: Vec<(Perturbation, SimOutcome)> = (0..rp.samples)
+    let runs: Vec<(Perturbation, SimOutcome)> = (0..case.params.robust.samples)
         .into_par_iter()
-        .map(|k| {
-            let p = Perturbation::draw(rp, k);
-            let perturbed = Perturbed::of(case, &p);
-            let out = super::check(&perturbed.case(case));
-            (p, out)
-        })
+        .map(|k| check_sample(case, k))
         .collect();
+    robust_of(case, &runs, t0.elapsed().as_secs_f64() * 1000.0)
+}
+
+/// Sample `k`'s perturbed check of `case`: one of the checks [`sample`] runs, for a caller that
+/// spreads the samples of several grasps over the cores itself (`grasp-sim label`).
+pub fn check_sample(case: &Case, k: usize) -> (Perturbation, SimOutcome) {
+    let p = Perturbation::draw(&case.params.robust, k);
+    let perturbed = Perturbed::of(case, &p);
+    let out = super::check(&perturbed.case(case));
+    (p, out)
+}
+
+/// The hold probability of `case` from its samples' checks `runs` (sample `k` at index `k`,
+/// as [`check_sample`] gives them), which took `wall_ms`.
+pub fn robust_of(case: &Case, runs: &[(Perturbation, SimOutcome)], wall_ms: f64) -> Robust {
+    let rp = &case.params.robust;
     let mut counts = Counts::default();
+    let mut held_as_planned = 0;
     let mut directions: Vec<DirectionRobust> = Vec::new();
     let mut first_failure = None;
-    for (p, out) in &runs {
+    for (p, out) in runs {
         counts.add(out.verdict);
+        held_as_planned += usize::from(out.held_as_planned());
         for (i, d) in out.directions.iter().enumerate() {
             if directions.len() <= i {
                 directions.push(DirectionRobust {
@@ -318,9 +366,12 @@ pub fn sample(case: &Case) -> Robust {
                     counts: Counts::default(),
                     hold_probability: 0.0,
                     interval: [0.0, 1.0],
+                    held_as_planned: 0,
                 });
             }
             directions[i].counts.add(d.verdict);
+            directions[i].held_as_planned +=
+                usize::from(d.verdict == Verdict::Hold && d.as_planned);
         }
         if out.verdict != Verdict::Hold && first_failure.is_none() {
             let failed = out.directions.iter().find(|d| d.verdict != Verdict::Hold);
@@ -338,6 +389,7 @@ pub fn sample(case: &Case) -> Robust {
         d.interval = wilson(d.counts.hold, n);
     }
     let interval = wilson(counts.hold, rp.samples);
+    let as_planned_interval = wilson(held_as_planned, rp.samples);
     Robust {
         samples: rp.samples,
         seed: rp.seed,
@@ -351,12 +403,16 @@ pub fn sample(case: &Case) -> Robust {
         counts,
         hold_probability: counts.hold as f64 / rp.samples.max(1) as f64,
         interval,
+        held_as_planned,
+        as_planned_probability: held_as_planned as f64 / rp.samples.max(1) as f64,
+        as_planned_interval,
         directions,
         verdicts: runs.iter().map(|r| r.1.verdict).collect(),
+        as_planned: runs.iter().map(|r| r.1.fidelity.as_planned).collect(),
         first_failure,
         steps: runs.iter().map(|r| r.1.steps).sum(),
-        wall_ms: t0.elapsed().as_secs_f64() * 1000.0,
-        passes: interval[0] >= rp.choose_min_lower_bound,
+        wall_ms,
+        passes: as_planned_interval[0] >= rp.choose_min_lower_bound,
     }
 }
 
@@ -496,8 +552,12 @@ mod tests {
             },
             hold_probability: 14.0 / 16.0,
             interval: wilson(14, 16),
+            held_as_planned: 14,
+            as_planned_probability: 14.0 / 16.0,
+            as_planned_interval: wilson(14, 16),
             directions: Vec::new(),
             verdicts: Vec::new(),
+            as_planned: Vec::new(),
             first_failure: None,
             steps: 0,
             wall_ms: 0.0,
@@ -506,6 +566,18 @@ mod tests {
         assert_eq!(
             r.in_words(),
             "held in 14 of 16 perturbed checks (88 %, 95 % interval 64–97 %)"
+        );
+        // 12 of the 14 holds as planned: 75 %, Wilson 51–90 %.
+        let r = Robust {
+            held_as_planned: 12,
+            as_planned_probability: 12.0 / 16.0,
+            as_planned_interval: wilson(12, 16),
+            ..r
+        };
+        assert_eq!(
+            r.in_words(),
+            "held in 14 of 16 perturbed checks (88 %, 95 % interval 64–97 %); as planned in 12 \
+             (75 %, 95 % interval 51–90 %)"
         );
     }
 }

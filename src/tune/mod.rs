@@ -264,6 +264,14 @@ pub struct ObjectResult {
     /// one sample).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub hold_probability: Option<f64>,
+    /// True if and only if the chosen grasp's closing kept the plan (`sim.fidelity`); absent
+    /// when the check did not run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub as_planned: Option<bool>,
+    /// The chosen grasp's probability of a hold as planned under the same samples (absent with
+    /// one sample).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub as_planned_probability: Option<f64>,
     /// Why the setting is `invalid` for this object's hand.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reason: Option<String>,
@@ -276,6 +284,8 @@ pub struct SettingResult {
     pub values: Vec<f64>,
     /// Objects held / objects.
     pub hold_rate: f64,
+    /// Objects held as planned / objects.
+    pub as_planned_rate: f64,
     /// Mean payload margin over all objects (0 for an object not held).
     pub mean_payload_margin: f64,
     /// Mean translation of the held objects `[mm]` (`null` when none is held).
@@ -284,6 +294,10 @@ pub struct SettingResult {
     /// object was sampled (`[sim] samples` above 1); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mean_hold_probability: Option<f64>,
+    /// Mean probability of a hold as planned over all objects (0 for one without), when any
+    /// object was sampled; absent otherwise.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub mean_as_planned_probability: Option<f64>,
     /// Per object.
     pub objects: Vec<ObjectResult>,
     /// Why the setting is invalid (it breaks a rule for an object's hand, e.g. a HeightStep
@@ -505,10 +519,16 @@ pub fn tune_with_progress(
     })
 }
 
-/// Orders settings best first.
+/// Orders settings best first: by the mean probability of a hold as planned, the mean hold
+/// probability, the share held as planned, the share held, the payload margin, then the least
+/// translation.
 pub fn rank(a: &SettingResult, b: &SettingResult) -> std::cmp::Ordering {
+    let ap = |s: &SettingResult| s.mean_as_planned_probability.unwrap_or(0.0);
     let p = |s: &SettingResult| s.mean_hold_probability.unwrap_or(0.0);
-    p(b).total_cmp(&p(a))
+    ap(b)
+        .total_cmp(&ap(a))
+        .then(p(b).total_cmp(&p(a)))
+        .then(b.as_planned_rate.total_cmp(&a.as_planned_rate))
         .then(b.hold_rate.total_cmp(&a.hold_rate))
         .then(b.mean_payload_margin.total_cmp(&a.mean_payload_margin))
         .then(
@@ -530,17 +550,18 @@ fn score(values: Vec<f64>, objects: Vec<ObjectResult>) -> SettingResult {
     let mean_translation_mm = (!held.is_empty())
         .then(|| held.iter().filter_map(|o| o.translation_mm).sum::<f64>() / held.len() as f64);
     let sampled = objects.iter().any(|o| o.hold_probability.is_some());
-    let mean_hold_probability = sampled.then(|| {
-        objects
-            .iter()
-            .filter_map(|o| o.hold_probability)
-            .fold(0.0, |a, p| a + p)
-            / n
-    });
+    let mean = |p: fn(&ObjectResult) -> Option<f64>| {
+        sampled.then(|| objects.iter().filter_map(p).fold(0.0, |a, p| a + p) / n)
+    };
+    let mean_hold_probability = mean(|o| o.hold_probability);
+    let mean_as_planned_probability = mean(|o| o.as_planned_probability);
+    let as_planned = held.iter().filter(|o| o.as_planned == Some(true)).count();
     SettingResult {
         values,
         hold_rate: held.len() as f64 / n,
+        as_planned_rate: as_planned as f64 / n,
         mean_hold_probability,
+        mean_as_planned_probability,
         // Folded from +0.0: an empty f64 sum is -0.0, printed "-0.00".
         mean_payload_margin: objects
             .iter()
@@ -615,6 +636,9 @@ fn object_result(
         payload_margin: outcome.and_then(|o| o.payload_margin),
         hold_probability: outcome
             .and_then(|o| o.outcome.robust.as_ref().map(|r| r.hold_probability)),
+        as_planned: outcome.map(|o| o.outcome.fidelity.as_planned),
+        as_planned_probability: outcome
+            .and_then(|o| o.outcome.robust.as_ref().map(|r| r.as_planned_probability)),
         reason,
     }
 }

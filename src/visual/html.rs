@@ -193,6 +193,12 @@ fn headline(report: &RunReport) -> String {
         "<p class=\"verdict\">{}</p>",
         esc(&verdict_sentence(report))
     ));
+    if let Some(f) = &report.sim.fidelity {
+        s.push_str(&format!(
+            "<p class=\"verdict\">Fidelity: {}</p>",
+            esc(&crate::report::summary::fidelity_line(f, &report.sim))
+        ));
+    }
     if let Some(r) = &report.sim.robust {
         s.push_str(&format!(
             "<p class=\"verdict\">Hold probability {:.2}: {}</p>",

@@ -438,7 +438,7 @@ fn duplicated_faces_are_counted_once_and_warned_about() {
     );
 }
 
-/// A closed shell with some faces written the wrong way round (session 43's own probe): a
+/// A closed shell with some faces written the wrong way round (a probe of issue 32, 2026-12-02): a
 /// 40 mm cube with one of its 12 triangles turned read as 32 cm³ and half the mass, with only a
 /// warning about misoriented edges. The turned faces are now wound as their neighbours are,
 /// the volume is the cube's, and a warning says how many were turned; a cube with all but two
@@ -932,15 +932,15 @@ fn probe_findings_are_plain_errors() {
 /// Rings thinner than 1 µm are no material (`mesh::polygon_limits::MIN_RING_WIDTH_MM`), so each
 /// now ends at once with its one-line reason: no grasp, or, for the sliver, which encloses no
 /// volume once its empty rings are left out, the refusal of a surface that is not a solid.
-/// The third session's two STLs (`mesh_stl_slow_*`, four triangles each) cross themselves in
+/// Two STLs of a later run (`mesh_stl_slow_*`, four triangles each) cross themselves in
 /// their slices along near-collinear edges, where i_overlay's default snap radius cascades
 /// (`mesh::polygon_limits`, `a_self_crossing_near_collinear_ring_unites_without_a_cascade`);
-/// each plans to its reason: too short for the hand. The fourth session's three
+/// each plans to its reason: too short for the hand. The next run's three
 /// (`mesh_stl_slow_{660abe42,b9d68fee,fb63b0b2}`, 4-5 s each, one of them libFuzzer's timeout
 /// under load) are the same class in the union-based mass properties' 400 slices, where
 /// i_overlay's `MEDIUM` step still cascaded (1552 pieces from an 8-point ring); with the ×256
 /// step each plans in about 0.05 s. Since an open surface's volume is taken about its area
-/// centroid (issue 30's frame rule, session 43), the 135-byte OBJ of faces flattened onto a
+/// centroid (issue 30's frame rule, 93eb102), the 135-byte OBJ of faces flattened onto a
 /// line (`mesh_obj_timeout_4d16f9e5`) encloses 0 mm³ and is refused, and the sliver STL
 /// (`mesh_stl_timeout_333e974d`) encloses 0.0013 mm³ and plans to its reason, too short.
 #[test]

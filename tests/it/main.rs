@@ -15,6 +15,7 @@ mod issue16;
 mod planner;
 mod quality;
 mod real_meshes;
+mod repository;
 mod resume;
 mod robust;
 mod settings;
@@ -34,7 +35,7 @@ pub fn grasp_sim() -> std::process::Command {
     c
 }
 
-/// The closing before the default changed in session 46 (docs/SIM.md "The closing,
+/// The closing before the default changed on 2026-12-03, ff19c34 (docs/SIM.md "The closing,
 /// adopted"): each finger straight at its planned bend plus a 10° squeeze, joint 1 locked where
 /// it stopped, no reseat. Tests of mechanisms measured under it use it.
 pub fn squeeze_closing() -> grasp_sim::scenario::SimParams {

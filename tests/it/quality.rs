@@ -50,7 +50,7 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
     );
     let q = r.quality.unwrap();
     assert_eq!(q.source, "sim");
-    // Six or more: the grasp chosen (the first candidate since session 46's closing; the second
+    // Six or more: the grasp chosen (the first candidate under the default closing; the second
     // with the 10° squeeze, whose closing pushed the first 6 mm) holds by both phalanges of
     // every finger.
     assert!(q.contacts.len() >= 6, "{} contacts", q.contacts.len());
@@ -73,7 +73,7 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
     let far = farthest_from_surface(&aligned.mesh, &points);
     assert!(far < 6.0, "a contact {far:.2} mm from the surface");
     // The grip is force closure: measured 0.082 (L1, 8 cone edges) on the first candidate with
-    // session 46's closing (0.054 on the second with the 10° squeeze, 0.111 on the first before
+    // the default closing (0.054 on the second with the 10° squeeze, 0.111 on the first before
     // issue 33; the cup's is 0.125).
     assert!(q.force_closure, "{:?}", q.note);
     assert!(

@@ -47,7 +47,7 @@ fn the_holds_substeps_leave_the_closing_bit_for_bit() {
 
 #[test]
 fn a_shorter_rest_window_decides_a_still_grasp_sooner_with_the_same_numbers() {
-    // D40 hardly moves in its hold: the 0.05 s window (the default since session 45) decides
+    // D40 hardly moves in its hold: the 0.05 s window (the default since a629fd9) decides
     // every direction at rest 0.0625 s in (three samples of 1/48 s), the 0.1 s window (the
     // default before) at 0.125 s, the 0.2 s window at 0.229 s, and the verdicts and
     // translations agree within 0.05 mm.
