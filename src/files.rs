@@ -288,7 +288,13 @@ pub fn write_replacing(path: &Path, bytes: &[u8]) -> io::Result<()> {
             name.len()
         )));
     }
-    let (mut f, tmp) = create_private(dir, &name, "tmp")?;
+    let (mut f, tmp) = create_private(dir, &name, "tmp").map_err(|e| {
+        if e.kind() == io::ErrorKind::NotFound {
+            io::Error::other(format!("no folder {}", dir.display()))
+        } else {
+            e
+        }
+    })?;
     let written = if full_disk_fault(path) {
         f.write_all(&bytes[..bytes.len() / 2])
             .and_then(|()| Err(io::Error::from_raw_os_error(28)))
@@ -325,6 +331,96 @@ fn full_disk_fault(path: &Path) -> bool {
     }
     let _ = path;
     false
+}
+
+/// The lock one run holds on an output folder (`--report DIR`, `--export-mjcf DIR`,
+/// `--export-urdf DIR`, `tune --out DIR`) for as long as it writes there: a file
+/// `.grasp-sim.lock` in the folder, locked with `flock` (released if the run dies) and removed
+/// when the run ends. A second run into the same folder is refused at once with the lock's
+/// message, instead of the two runs' files mixing (or one run's check of the folder seeing the
+/// other's files come and go).
+#[derive(Debug)]
+pub struct FolderLock {
+    path: std::path::PathBuf,
+    file: Option<std::fs::File>,
+}
+
+impl FolderLock {
+    /// Locks the folder `dir`, which must exist.
+    ///
+    /// # Errors
+    /// [`io::ErrorKind::WouldBlock`] with a message saying another run holds the folder, or
+    /// the operating system's error making the lock file.
+    pub fn take(dir: &Path) -> io::Result<FolderLock> {
+        let path = dir.join(".grasp-sim.lock");
+        // A run that ends removes the lock file while it holds it; a run that opened the name
+        // just before would then hold a removed file. The lock counts only on the file the name
+        // still is; otherwise the open is tried again.
+        loop {
+            let mut options = std::fs::OpenOptions::new();
+            options.write(true).create(true).truncate(false);
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::OpenOptionsExt;
+                options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+            }
+            let file = options.open(&path)?;
+            if !lock_exclusive(&file)? {
+                return Err(io::Error::new(
+                    io::ErrorKind::WouldBlock,
+                    "in use by another grasp-sim run (locked); one run per output folder",
+                ));
+            }
+            if is_same_file(&file, &path) {
+                return Ok(FolderLock {
+                    path,
+                    file: Some(file),
+                });
+            }
+        }
+    }
+}
+
+impl Drop for FolderLock {
+    fn drop(&mut self) {
+        // Removed while still held, so no other run can lock the name being removed.
+        let _ = std::fs::remove_file(&self.path);
+        drop(self.file.take());
+    }
+}
+
+/// Takes `flock`'s exclusive lock on `file` without waiting: false if another holds it. A
+/// file system without locks (some network mounts) counts as locked by this run.
+#[cfg(unix)]
+fn lock_exclusive(file: &std::fs::File) -> io::Result<bool> {
+    use std::os::fd::AsRawFd;
+    // SAFETY: flock on a file descriptor borrowed for the call; no memory is passed.
+    let r = unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+    if r == 0 {
+        return Ok(true);
+    }
+    let e = io::Error::last_os_error();
+    Ok(e.raw_os_error() != Some(libc::EWOULDBLOCK))
+}
+
+#[cfg(not(unix))]
+fn lock_exclusive(_file: &std::fs::File) -> io::Result<bool> {
+    Ok(true)
+}
+
+/// Returns true if and only if `path` is (still) the file `file` has open.
+#[cfg(unix)]
+fn is_same_file(file: &std::fs::File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::symlink_metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn is_same_file(_file: &std::fs::File, _path: &Path) -> bool {
+    true
 }
 
 #[cfg(test)]

@@ -674,6 +674,26 @@ pub fn check_output_dir(dir: &std::path::Path) -> anyhow::Result<()> {
     })
 }
 
+/// [`check_output_dir`], then the folder locked for this run ([`crate::files::FolderLock`]):
+/// a second run into the same folder is refused with the lock's message while this one runs.
+///
+/// # Errors
+/// [`check_output_dir`]'s, or another run holding the folder, or the lock file not made.
+pub fn lock_output_dir(dir: &std::path::Path) -> anyhow::Result<crate::files::FolderLock> {
+    check_output_dir(dir)?;
+    crate::files::FolderLock::take(dir).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::WouldBlock {
+            anyhow::anyhow!("{}: {e}", dir.display())
+        } else {
+            anyhow::anyhow!(
+                "{}: cannot lock the folder: {}",
+                dir.display(),
+                crate::messages::io_message(&e)
+            )
+        }
+    })
+}
+
 /// Checks that `file` can be written later: its folder exists and takes a file.
 ///
 /// # Errors

@@ -3,7 +3,7 @@
 
 use super::{Sweep, TuneResult};
 use crate::batch::{self, plural};
-use crate::pipeline::{check_output_dir, Progress};
+use crate::pipeline::{lock_output_dir, Progress};
 use crate::scenario::Scenario;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -60,7 +60,8 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
         None => batch::default_template(),
     };
     let items = batch::expand(&request.inputs)?;
-    check_output_dir(&request.out).context("--out")?;
+    // Held to the end of the sweep: a second tune into the same folder is refused.
+    let _lock = lock_output_dir(&request.out).context("--out")?;
     let jobs = request
         .jobs
         .unwrap_or_else(batch::command::default_jobs)
