@@ -943,6 +943,22 @@ pub fn collider_inertia(
 mod tests {
     use super::*;
 
+    /// Issue 56: parry merged every hull face of a UV sphere of 300 × 150 segments (89,400
+    /// triangles, 60 mm) away, and the scene's support scan indexed an empty face list (a
+    /// panic in the physics check). Its collider is now a polyhedron with faces, or another
+    /// usable shape, and a point's depth is found on it.
+    #[test]
+    fn a_finely_divided_sphere_gets_a_collider_with_faces() {
+        let mesh = crate::mesh::primitives::uv_sphere(30.0, 300);
+        assert_eq!(mesh.triangles.len(), 89_400);
+        let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
+        let shape = ObjectShape::from_mesh(&mesh, volume);
+        assert!(usable_shape(&shape.shape), "{:?}", shape.kind);
+        let inside = nalgebra::Point3::new(29.0, 0.0, 0.0);
+        let depth = shape.depth_mm(&[inside]);
+        assert!((depth - 1.0).abs() < 0.06, "depth {depth} mm, expected 1");
+    }
+
     #[test]
     fn a_hull_that_bridges_a_planned_contact_gives_way_to_the_decomposition() {
         // A bottle: a body 60 mm across and 300 mm tall, a cone to a neck 28 mm across at
