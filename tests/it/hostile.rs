@@ -988,7 +988,7 @@ fn a_name_that_would_leave_the_report_folder_is_refused() {
     for (name, needle) in [
         ("../../escape", "contains `/`"),
         ("..", "is `..`"),
-        ("/tmp/abs", "contains `/`"),
+        ("/abs/name", "contains `/`"),
         ("a\\u0000b", "contains a NUL byte"),
     ] {
         let s = dir.path().join("s.toml");
