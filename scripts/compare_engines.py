@@ -24,6 +24,16 @@ engines' hold probabilities and probabilities of a hold as planned, their differ
 per-sample agreement, and over all grasps the mean absolute difference of each, the Brier score of each engine's probability against the other's
 per-sample outcomes, and how often one says >= 0.9 while the other says < 0.5. `--jsonl F`
 writes one line per grasp with both engines' per-sample verdicts.
+
+    python3 scripts/compare_engines.py --labels LABELS.jsonl SCENES_DIR [--jsonl F]
+
+Issue 57: the agreement over a labelled dataset. `grasp-sim label ... --out LABELS.jsonl
+--export-mjcf SCENES_DIR --mujoco-fraction F` writes the scene of a deterministic fraction of
+its grasps into SCENES_DIR/<object>/<grasp_index>/; this replays each (in the record's gravity
+directions) and prints how often MuJoCo's verdict and as_planned agree with the nominal check
+`label` recorded, per object and over the dataset, and both engines' rates: rapier's perturbed
+checks a second over the labelled grasps (from the lines' wall times) and MuJoCo's replays a
+second.
 """
 import json
 import math
@@ -133,7 +143,85 @@ def agreement_summary(rows):
     return "; ".join(words)
 
 
+def folder_name(name):
+    """A scenario name as grasp-sim makes it a folder name: `/`, `\\` and control characters
+    as `_`, a leading `.` or an empty name prefixed with `_`."""
+    s = "".join("_" if c in "/\\" or ord(c) < 32 or ord(c) == 127 else c for c in name)
+    return "_" + s if not s or s.startswith(".") else s
+
+
+def labels(path, scenes, jsonl):
+    """`--labels`: MuJoCo's replay of the exported grasps of a label file against its records."""
+    records = {}
+    for line in pathlib.Path(path).read_text().splitlines():
+        r = json.loads(line)
+        if "grasp_index" in r and "verdict" in r:
+            records[(r["object"], r["grasp_index"])] = r
+    dirs = sorted(p.parent for p in pathlib.Path(scenes).glob("*/*/scene.xml"))
+    per_object, rows, mujoco_ms, rapier = {}, [], 0.0, [0.0, 0]
+    # A grasp's scene is in <object as a folder name>/<grasp_index>/ (`label --export-mjcf`).
+    by_folder = {(folder_name(o), i): r for (o, i), r in records.items()}
+    for d in dirs:
+        r = by_folder.get((d.parent.name, int(d.name))) if d.name.isdigit() else None
+        if r is None:
+            print(f"{d}: no label record for it", file=sys.stderr)
+            continue
+        idx = r["grasp_index"]
+        directions = [x["gravity"] for x in r["directions"]] if len(r["directions"]) > 1 else None
+        m = mujoco_replay.replay(d, directions)
+        mujoco_ms += m["wall_ms"]
+        rapier[0] += r["label"]["wall_ms"]
+        rapier[1] += r["samples"] + 1
+        row = {"object": r["object"], "grasp_index": idx,
+               "rapier": r["verdict"], "mujoco": m["verdict"],
+               "rapier_as_planned": r["fidelity"]["as_planned"],
+               "mujoco_as_planned": m["fidelity"]["as_planned"],
+               "hold_probability": r["hold_probability"],
+               "shift": (r["fidelity"]["shift_mm"], m["fidelity"]["shift_mm"]),
+               "on_plan": (r["fidelity"]["phalanges_on_plan"], m["fidelity"]["phalanges_on_plan"])}
+        row["agree"] = row["rapier"] == row["mujoco"]
+        row["agree_ap"] = row["rapier_as_planned"] == row["mujoco_as_planned"]
+        rows.append(row)
+        o = per_object.setdefault(r["object"], [0, 0, 0])
+        o[0] += 1
+        o[1] += row["agree"]
+        o[2] += row["agree_ap"]
+    if jsonl:
+        with open(jsonl, "w") as f:
+            for row in rows:
+                f.write(json.dumps(row) + "\n")
+    print("| object | grasps replayed | verdicts agree | as planned agree |")
+    print("|---|---|---|---|")
+    for name, (n, a, ap) in sorted(per_object.items()):
+        print(f"| {name} | {n} | {a} | {ap} |")
+    n = len(rows)
+    if n == 0:
+        print("no exported grasp matched a label record", file=sys.stderr)
+        return 2
+    held = [r for r in rows if r["rapier"] == "hold"]
+    print(f"\n**Summary**: MuJoCo replays labelled grasps of {len(per_object)} objects; "
+          f"{agreement_summary(rows)}; of rapier's {len(held)} holds MuJoCo holds "
+          f"{sum(r['mujoco'] == 'hold' for r in held)}.")
+    # rapier's grasp wall time is its nominal check and samples on the object's share of the
+    # cores; MuJoCo's is the one replay's simulation loop, on one core.
+    if rapier[1] and mujoco_ms > 0:
+        print(f"Rates: rapier {1000.0 * rapier[1] / rapier[0]:.2f} checks a second of grasp wall time "
+              f"(nominal and samples), MuJoCo {1000.0 * n / mujoco_ms:.2f} replays a second.")
+    return 0
+
+
 def main(argv):
+    if len(argv) >= 2 and argv[1] == "--labels":
+        args = argv[2:]
+        jsonl = None
+        if "--jsonl" in args:
+            j = args.index("--jsonl")
+            jsonl = args[j + 1]
+            del args[j:j + 2]
+        if len(args) != 2:
+            print(__doc__, file=sys.stderr)
+            return 2
+        return labels(args[0], args[1], jsonl)
     if len(argv) < 4:
         print(__doc__, file=sys.stderr)
         return 2

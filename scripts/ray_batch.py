@@ -51,19 +51,19 @@ def shard_file(work_dir, k, n):
     return os.path.join(work_dir, f"shard-{k:05d}-of-{n:05d}.jsonl")
 
 
-def run_shard(binary, k, n, inputs, flags, work_dir, jobs, cwd):
+def run_shard(binary, k, n, inputs, flags, work_dir, jobs, cwd, command="batch"):
     """One Ray task: one shard, resumed from its file if an earlier attempt left one.
     Returns (k, the shard file's bytes, the batch's last stderr lines)."""
     os.makedirs(work_dir, exist_ok=True)
     out = shard_file(work_dir, k, n)
-    cmd = [binary, "batch", "--shard", f"{k}/{n}", "--resume", "--out", out,
+    cmd = [binary, command, "--shard", f"{k}/{n}", "--resume", "--out", out,
            "--jobs", str(jobs), *flags, *inputs]
     # From the driver's folder, so the inputs' paths (and the lines' `batch.input`) read as
     # they do for a plain `batch` run there.
     p = subprocess.run(cmd, cwd=cwd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                        stderr=subprocess.PIPE, preexec_fn=die_with_parent())
     err = p.stderr.decode("utf-8", "replace").strip().splitlines()
-    summary = [l for l in err if l.startswith("batch: ")]
+    summary = [l for l in err if l.startswith(f"{command}: ")]
     tail = summary[-1:] or [l for l in err if not l.startswith("[")][-3:]
     # 0, 1 and 2 are the batch's answers (2: an object has an error line) when it got to its
     # summary; anything else (a signal, a batch that stopped before running) is a failure
@@ -107,6 +107,10 @@ def main():
                     help="number of tasks (default: 4 per task slot of the cluster)")
     ap.add_argument("--max-retries", type=int, default=3,
                     help="Ray max_retries of each task (default: %(default)s)")
+    ap.add_argument("--command", choices=["batch", "label"], default="batch",
+                    help="the grasp-sim command each task runs: `batch` (one line per object) "
+                         "or `label` (one line per labelled grasp; its flags after --) "
+                         "(default: %(default)s)")
     ap.add_argument("--work-dir", default=None,
                     help="where tasks write their shard files (default: OUT.shards)")
     args = ap.parse_args(argv)
@@ -149,7 +153,8 @@ def main():
 
     task = ray.remote(run_shard).options(
         num_cpus=args.cpus_per_task, max_retries=args.max_retries, retry_exceptions=True)
-    pending = [task.remote(binary, k, n, inputs, flags, work_dir, args.cpus_per_task, cwd)
+    pending = [task.remote(binary, k, n, inputs, flags, work_dir, args.cpus_per_task, cwd,
+                           args.command)
                for k in range(1, n + 1)]
     os.makedirs(gathered, exist_ok=True)
     for old in os.listdir(gathered):
@@ -171,7 +176,7 @@ def main():
     for f in failed:
         print(f"ray_batch: error: {f}", file=sys.stderr)
 
-    merge = subprocess.run([binary, "batch", "--merge", gathered, "--out", out, *flags, *inputs],
+    merge = subprocess.run([binary, args.command, "--merge", gathered, "--out", out, *flags, *inputs],
                            stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                            stderr=subprocess.PIPE)
     merge_err = merge.stderr.decode("utf-8", "replace")

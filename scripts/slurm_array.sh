@@ -19,8 +19,9 @@
 # shard is complete. The array must be a plain range (`0-15`, `1-64`, `0-30:2`; a `%4`
 # throttle is fine), not a list.
 #
-# The binary: $GRASP_SIM, else grasp-sim on the PATH. Other settings are ordinary sbatch
-# options: change them here or on the sbatch command line.
+# The binary: $GRASP_SIM, else grasp-sim on the PATH; GRASP_SIM_COMMAND=label labels grasps
+# (`grasp-sim label`, its flags in place of the batch flags) instead of running a batch.
+# Other settings are ordinary sbatch options: change them here or on the sbatch command line.
 #
 #SBATCH --job-name=grasp-sim
 #SBATCH --array=0-15
@@ -41,6 +42,9 @@ mode=$1
 out=$2
 shift 2
 grasp_sim=${GRASP_SIM:-grasp-sim}
+# The command each task runs: batch (one line per object) or label (one line per grasp).
+command=${GRASP_SIM_COMMAND:-batch}
+case $command in batch | label) ;; *) die "GRASP_SIM_COMMAND is batch or label, not \`$command\`" ;; esac
 
 case $mode in
 task)
@@ -57,7 +61,7 @@ task)
     shard=$(printf '%s/shards/shard-%05d-of-%05d.jsonl' "$out" "$k" "$n")
     mkdir -p "$out/shards"
     echo "slurm_array.sh: job ${SLURM_ARRAY_JOB_ID:-?} task $id: shard $k/$n -> $shard" >&2
-    exec "$grasp_sim" batch --shard "$k/$n" --resume --out "$shard" \
+    exec "$grasp_sim" "$command" --shard "$k/$n" --resume --out "$shard" \
         --jobs "${SLURM_CPUS_PER_TASK:-1}" "$@"
     ;;
 merge)
@@ -65,8 +69,8 @@ merge)
     # A failed check writes nothing: no results from an earlier merge may stand in for them.
     rm -f "$out/results.jsonl" "$out/results.csv"
     status=0
-    "$grasp_sim" batch --merge "$out/shards" --out "$out/results.jsonl" "$@" || status=$?
-    if [ -f "$out/results.jsonl" ]; then
+    "$grasp_sim" "$command" --merge "$out/shards" --out "$out/results.jsonl" "$@" || status=$?
+    if [ "$command" = batch ] && [ -f "$out/results.jsonl" ]; then
         "$grasp_sim" summarize "$out/results.jsonl" --csv "$out/results.csv"
     fi
     exit "$status"

@@ -212,6 +212,79 @@ pub enum Command {
     /// rate, then mean payload margin, then mean translation); writes tune.csv, tune.json and
     /// score_<param>.svg into --out.
     Tune(TuneArgs),
+    /// Label many diverse grasps per object with their hold probability (a grasp dataset):
+    /// per object, plan up to --candidates feasible grasps, pick --grasps diverse ones
+    /// (farthest-point over the palm pose and the finger contacts, the first candidate always
+    /// among them), check each with --samples perturbed checks, and write one JSON line per
+    /// grasp (docs/OUTPUT.md "Label lines"). Inputs, workers, --resume, --merge and shards as
+    /// for `batch`; --resume continues grasp by grasp.
+    ///
+    /// Exit status: 0 every grasp labelled, 2 an object or a grasp could not be (its line has an
+    /// `error`; the others are still labelled).
+    Label(LabelArgs),
+    /// Internal: label one object in a process of its own, printing its lines as they finish
+    /// (`label` starts it for each object; see `label --in-process`).
+    #[command(hide = true)]
+    LabelWorker {
+        /// The scenario or mesh.
+        path: PathBuf,
+        /// The input hash the run computed for it.
+        #[arg(long)]
+        input_hash: String,
+        /// As `label --template`.
+        #[arg(long)]
+        template: Option<PathBuf>,
+        /// As `label --units`.
+        #[arg(long, value_enum)]
+        units: Option<Units>,
+        /// As `label --gravity`.
+        #[arg(long, value_enum)]
+        gravity: Option<Gravity>,
+        /// As `label --grasps`.
+        #[arg(long)]
+        grasps: usize,
+        /// As `label --samples`.
+        #[arg(long)]
+        samples: usize,
+        /// As `label --candidates`.
+        #[arg(long)]
+        candidates: usize,
+        /// As `label --export-mjcf`.
+        #[arg(long)]
+        export_mjcf: Option<PathBuf>,
+        /// As `label --mujoco-fraction`.
+        #[arg(long, default_value_t = 1.0)]
+        mujoco_fraction: f64,
+        /// Grasp indices already labelled, comma-separated.
+        #[arg(long, value_delimiter = ',')]
+        skip: Vec<usize>,
+    },
+    /// Check given grasps: every line of --grasps FILE (JSON Lines with `palm_pose` 4 x 4 in
+    /// the object file's frame [mm] and `joint_angles_deg`, one [θ1, θ2] per finger; a `label`
+    /// file is valid input) on the object, one record per line, as `label` writes them.
+    ///
+    /// Exit status: 0 every line checked, 2 a line could not be (its record has an `error`;
+    /// the other lines are still checked).
+    Check {
+        /// The grasps, one JSON object per line.
+        #[arg(long, value_name = "FILE.jsonl")]
+        grasps: PathBuf,
+        /// The object: a scenario (its hand, friction and protocol too) or a bare mesh.
+        #[arg(value_name = "SCENARIO | MESH")]
+        input: PathBuf,
+        /// Perturbed checks per grasp (the hold probability's samples).
+        #[arg(long, value_name = "N", default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1000))]
+        samples: u32,
+        /// Gravity directions (default: the scenario's `[sim] gravity`, `down` for a mesh).
+        #[arg(long, value_name = "DIRECTIONS", value_enum)]
+        gravity: Option<Gravity>,
+        /// Length unit of a bare mesh.
+        #[arg(long, value_name = "UNIT", value_enum)]
+        units: Option<Units>,
+        /// Write the records to this file instead of stdout (written whole, or not at all).
+        #[arg(long, value_name = "FILE")]
+        out: Option<PathBuf>,
+    },
     /// Hand files (issue 37): `hand show FILE` prints the model grasp-sim derives from a hand's
     /// URDF or MJCF (or from the one a scenario's `[hand]` names, with its mapping) and writes
     /// a figure of it over the file's link geometry.
@@ -297,6 +370,126 @@ pub struct BatchArgs {
     /// What each object's run computes.
     #[command(flatten)]
     pub flags: RunFlags,
+}
+
+/// `grasp-sim label` flags.
+#[derive(Debug, clap::Args)]
+pub struct LabelArgs {
+    /// Folders, scenario files (.toml) or meshes (.stl, .obj, .ply, .urdf).
+    #[arg(required = true, value_name = "DIR | SCENARIO")]
+    pub inputs: Vec<PathBuf>,
+    /// Grasps to label per object (fewer where the planner finds fewer).
+    #[arg(long, value_name = "K", default_value_t = 16, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub grasps: u32,
+    /// Perturbed checks per grasp (docs/SIM.md "Hold probability").
+    #[arg(long, value_name = "S", default_value_t = 8, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    pub samples: u32,
+    /// Gravity directions for every input (default: each scenario's `[sim] gravity`, `down`
+    /// for a bare mesh).
+    #[arg(long, value_name = "DIRECTIONS", value_enum)]
+    pub gravity: Option<Gravity>,
+    /// Feasible candidates to plan per object at most, to pick from.
+    #[arg(long, value_name = "N", default_value_t = grasp_sim::label::object::DEFAULT_CANDIDATES as u32,
+          value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub candidates: u32,
+    /// Scenario used for bare meshes (default: the thesis hand and defaults).
+    #[arg(long, value_name = "SCENARIO")]
+    pub template: Option<PathBuf>,
+    /// Length unit of bare meshes (overrides the template's).
+    #[arg(long, value_name = "UNIT", value_enum)]
+    pub units: Option<Units>,
+    /// Write the JSON lines to this file instead of stdout (written whole, or not at all;
+    /// with --resume, appended as grasps finish).
+    #[arg(long, value_name = "FILE")]
+    pub out: Option<PathBuf>,
+    /// Continue the run in --out FILE: keep the grasps it already holds (same input, contents,
+    /// flags and template), label the others, and end with the file as one uninterrupted run
+    /// writes it.
+    #[arg(long, requires = "out")]
+    pub resume: bool,
+    /// With --resume: label again the objects and grasps whose line is an error.
+    #[arg(long, requires = "resume")]
+    pub retry_errors: bool,
+    /// Stop an object still running after this many seconds; its finished grasps are kept
+    /// and the object gets an error line.
+    #[arg(long, value_name = "SECONDS", value_parser = positive_seconds)]
+    pub object_timeout: Option<f64>,
+    /// Limit each object's worker process to this much memory (address space, MiB).
+    #[arg(long, value_name = "MIB", value_parser = clap::value_parser!(u64).range(16..))]
+    pub object_memory: Option<u64>,
+    /// Label the objects on threads of this process instead of a worker process each.
+    #[arg(long, conflicts_with_all = ["object_timeout", "object_memory"])]
+    pub in_process: bool,
+    /// Run nothing: put together the lines of these shard files (or folders of *.jsonl) in
+    /// input order, checking that every input's grasps are there exactly once. Repeatable.
+    #[arg(long, value_name = "FILE | DIR", conflicts_with_all = ["resume", "in_process"])]
+    pub merge: Vec<PathBuf>,
+    /// Objects labelled at once (default: all cores; each object's checks also spread over
+    /// the cores).
+    #[arg(long, value_name = "N")]
+    pub jobs: Option<usize>,
+    /// Label only the K-th of N contiguous blocks of the inputs (e.g. a Slurm array task).
+    #[arg(long, value_name = "K/N", value_parser = grasp_sim::batch::parse_shard)]
+    pub shard: Option<grasp_sim::batch::Shard>,
+    /// Also write one numpy .npz per object (arrays of the lines' fields) into DIR.
+    #[arg(long, value_name = "DIR")]
+    pub npz: Option<PathBuf>,
+    /// Also write each object's summary (candidates, picks and their spread, times) as one JSON
+    /// line per object to FILE.
+    #[arg(long, value_name = "FILE")]
+    pub summary: Option<PathBuf>,
+    /// Write the MJCF scene of a fraction of the labelled grasps into DIR/<object>/<grasp
+    /// index>/, for `scripts/compare_engines.py --labels` (MuJoCo's answers beside rapier's).
+    #[arg(long, value_name = "DIR")]
+    pub export_mjcf: Option<PathBuf>,
+    /// With --export-mjcf: the fraction of the grasps exported (the same grasps every run: a
+    /// hash of the object and the grasp index decides).
+    #[arg(long, value_name = "F", default_value_t = 1.0, requires = "export_mjcf",
+          value_parser = fraction)]
+    pub mujoco_fraction: f64,
+}
+
+fn fraction(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(f) if (0.0..=1.0).contains(&f) => Ok(f),
+        _ => Err(format!("`{s}` is not a fraction from 0 to 1")),
+    }
+}
+
+impl LabelArgs {
+    /// The library's request for these flags.
+    pub fn request(self) -> grasp_sim::label::command::Request {
+        grasp_sim::label::command::Request {
+            inputs: self.inputs,
+            worker: grasp_sim::label::command::WorkerArgs {
+                template: self.template,
+                units: self.units.map(Into::into),
+                params: grasp_sim::label::LabelParams {
+                    grasps: self.grasps as usize,
+                    samples: self.samples as usize,
+                    candidates: self.candidates as usize,
+                },
+                gravity: self.gravity.map(Into::into),
+                export: self
+                    .export_mjcf
+                    .map(|dir| grasp_sim::label::object::MjcfExport {
+                        dir,
+                        fraction: self.mujoco_fraction,
+                    }),
+            },
+            out: self.out,
+            resume: self.resume,
+            retry_errors: self.retry_errors,
+            object_timeout: self.object_timeout,
+            object_memory: self.object_memory,
+            in_process: self.in_process,
+            merge: self.merge,
+            jobs: self.jobs,
+            shard: self.shard,
+            npz: self.npz,
+            summary: self.summary,
+        }
+    }
 }
 
 /// The longest time bound accepted `[s]`: a year (a larger one overflowed the timer and

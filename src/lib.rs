@@ -29,6 +29,7 @@ pub mod export;
 pub mod files;
 pub mod hand;
 pub mod hand_show;
+pub mod label;
 pub mod mesh;
 mod messages;
 pub mod objects;

@@ -74,6 +74,57 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
             action: cli::HandCommand::Show { file, svg },
         }) => grasp_sim::hand_show::run(&file, svg.as_deref()),
         Some(Command::Tune(args)) => grasp_sim::tune::command::run(&args.request(), &Bar::tune()),
+        Some(Command::Label(args)) => {
+            grasp_sim::label::command::run(&args.request(), &Bar::batch())
+        }
+        Some(Command::LabelWorker {
+            path,
+            input_hash,
+            template,
+            units,
+            gravity,
+            grasps,
+            samples,
+            candidates,
+            export_mjcf,
+            mujoco_fraction,
+            skip,
+        }) => {
+            let args = grasp_sim::label::command::WorkerArgs {
+                template,
+                units: units.map(Into::into),
+                params: grasp_sim::label::LabelParams {
+                    grasps,
+                    samples,
+                    candidates,
+                },
+                gravity: gravity.map(Into::into),
+                export: export_mjcf.map(|dir| grasp_sim::label::object::MjcfExport {
+                    dir,
+                    fraction: mujoco_fraction,
+                }),
+            };
+            let skip = skip.into_iter().collect();
+            grasp_sim::label::command::run_worker(&path, &input_hash, &args, &skip)
+        }
+        Some(Command::Check {
+            grasps,
+            input,
+            samples,
+            gravity,
+            units,
+            out,
+        }) => {
+            let request = grasp_sim::label::command::CheckRequest {
+                grasps,
+                input,
+                units: units.map(Into::into),
+                samples: samples as usize,
+                gravity: gravity.map(Into::into),
+                out,
+            };
+            grasp_sim::label::command::check(&request, &Bar::batch())
+        }
         None => run_inputs(cli),
     }
 }

@@ -40,6 +40,7 @@ __all__ = [
     "Check",
     "plan",
     "check",
+    "check_many",
     "run_scenario",
     "batch",
     "__version__",
@@ -652,6 +653,66 @@ def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
         if not same:
             raise GraspSimError("check: the grasp checked is not the plan's (the object, hand or planner parameters differ)")
     return result
+
+
+def _grasp_line(g: Any, k: int) -> str:
+    """A grasp as a line of ``grasp-sim check --grasps``: a :class:`Grasp`, or a mapping with
+    ``palm_pose`` (4 × 4) and ``joint_angles_deg`` (a label line is one)."""
+    if isinstance(g, Grasp):
+        # The report's pose (position and quaternion) as written, not the matrix made of it.
+        line: Dict[str, Any] = {"palm_pose": g.raw["palm_pose"],
+                                "joint_angles_deg": np.asarray(g.joint_angles_deg, dtype=float).tolist()}
+        if g.axis_name:
+            line["axis_name"] = g.axis_name
+    elif isinstance(g, Mapping):
+        line = dict(g)
+    else:
+        raise BadInputError(f"check_many: grasp {k}: not a Grasp or a mapping: {type(g).__name__}")
+    try:
+        return json.dumps(line, allow_nan=True, default=_plain)
+    except (TypeError, ValueError) as e:
+        raise BadInputError(f"check_many: grasp {k}: {e}") from None
+
+
+def check_many(obj: Any, grasps: Iterable[Any], samples: int = 8,
+               hand: Union[None, str, "os.PathLike[str]", Hand] = None, gravity: str = "down",
+               **sim_params: Any) -> List[Dict[str, Any]]:
+    """Checks many grasps of one object in-process, as ``grasp-sim check --grasps`` does:
+    the object loaded, aligned and its collider made once, every check spread over the cores.
+
+    Args:
+        obj: the object the grasps are on.
+        grasps: :class:`Grasp` objects (``plan.candidates``, :meth:`Grasp.from_pose`) or
+            mappings with ``palm_pose`` (4 × 4, mm, the object file's frame),
+            ``joint_angles_deg`` (``[θ1, θ2]`` per finger) and optionally ``axis_name`` (a
+            ``grasp-sim label`` line is one).
+        samples: perturbed checks per grasp.
+        hand: default: the thesis hand.
+        gravity: ``"down"`` or ``"six"``.
+        **sim_params: ``[sim]`` keys of a scenario.
+
+    Returns:
+        One record per grasp, in order (docs/OUTPUT.md "Label lines"): ``verdict``,
+        ``fidelity``, ``hold_probability``, ``interval``, ``as_planned_probability``, ...; a
+        grasp that cannot be checked (a pose that is not rigid, a NaN, the wrong shape) gets a
+        record with ``error`` and the others are still checked.
+
+    Raises:
+        BadScenarioError, BadHandError, BadInputError: as :func:`check`.
+    """
+    if isinstance(samples, bool) or not isinstance(samples, int) or not 1 <= samples <= 1000:
+        raise BadInputError(f"check_many: samples = {samples!r} is not a whole number from 1 to 1000")
+    o, h = _to_object(obj), _to_hand(hand)
+    lines = [_grasp_line(g, k) for k, g in enumerate(grasps)]
+    sim = dict(sim_params)
+    sim["gravity"] = gravity
+    scenario = _scenario(o, h, {}, sim)
+    try:
+        text = json.dumps(scenario, allow_nan=False, default=_plain)
+    except (TypeError, ValueError) as e:
+        raise BadScenarioError(f"grasp_sim.check_many: {e}") from None
+    out = _native.check_lines_table(text, "grasp_sim.check_many", lines, samples)
+    return [json.loads(line) for line in out]
 
 
 def run_scenario(path: PathLike, *, units: str = "mm", gravity: Optional[str] = None,

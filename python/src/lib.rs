@@ -337,6 +337,51 @@ fn run_table(
     })
 }
 
+/// Checks given grasp lines (`label` / `check --grasps` input: one JSON object each) on the
+/// scenario given as JSON (as [`run_table`]'s), `samples` perturbed checks each; returns one
+/// record per line, in line order (an error record for a line that cannot be checked), as
+/// `grasp-sim check --grasps` writes them.
+#[pyfunction]
+#[pyo3(signature = (scenario_json, label, lines, samples))]
+fn check_lines_table(
+    py: Python<'_>,
+    scenario_json: String,
+    label: PathBuf,
+    lines: Vec<String>,
+    samples: usize,
+) -> PyResult<Vec<String>> {
+    let what = label.display().to_string();
+    detached(py, &what, move || {
+        let table: toml::Table = serde_json::from_str(&scenario_json).map_err(|e| {
+            BadScenarioError::new_err(format!("{}: not a scenario table: {e}", label.display()))
+        })?;
+        let text = toml::to_string(&table).map_err(|e| {
+            BadScenarioError::new_err(format!(
+                "{}: cannot be written as TOML: {e}",
+                label.display()
+            ))
+        })?;
+        let scenario = Scenario::parse(&text, &label).map_err(scenario_err)?;
+        let n = lines.len();
+        let given: Vec<Result<String, String>> = lines.into_iter().map(Ok).collect();
+        let info = |_: usize, wall_ms: f64| grasp_sim::label::LabelInfo {
+            input: label.display().to_string(),
+            input_hash: String::new(),
+            grasps: n,
+            wall_ms,
+        };
+        let out = std::sync::Mutex::new(Vec::new());
+        let emit = |l: grasp_sim::label::Line| {
+            out.lock().unwrap_or_else(|p| p.into_inner()).push(l);
+        };
+        grasp_sim::label::check_lines(&scenario, &given, samples.max(1), &info, &emit)
+            .map_err(pipeline_err)?;
+        let mut records = out.into_inner().unwrap_or_else(|p| p.into_inner());
+        records.sort_by_key(|l| l.order);
+        Ok(records.into_iter().map(|l| l.text).collect())
+    })
+}
+
 /// Runs a scenario file (or a bare mesh with the built-in template, in `units`) exactly as
 /// `grasp-sim --json PATH` does; returns its JSON line. Errors carry the CLI's line.
 #[pyfunction]
@@ -651,6 +696,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh_from_arrays, m)?)?;
     m.add_function(wrap_pyfunction!(run_table, m)?)?;
     m.add_function(wrap_pyfunction!(run_file, m)?)?;
+    m.add_function(wrap_pyfunction!(check_lines_table, m)?)?;
     m.add_class::<Batch>()?;
     Ok(())
 }

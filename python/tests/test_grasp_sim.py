@@ -158,7 +158,7 @@ def test_a_bad_given_grasp_raises(cup, pose, angles, message):
 
 def test_an_axis_the_planner_did_not_search_raises(cup, cup_plan):
     g = cup_plan.grasp
-    with pytest.raises(gs.BadInputError, match='axis "sideways" is not one the planner searched'):
+    with pytest.raises(gs.BadInputError, match='axis "sideways" is not a principal axis'):
         gs.check(cup, gs.Grasp.from_pose(g.palm_pose, g.joint_angles_deg, "sideways"))
 
 

@@ -91,6 +91,107 @@ pub fn run_isolated(item: &Item, key: &Key, worker: &Worker) -> Result<Record, I
         })
 }
 
+/// Runs one object in a worker process that prints several lines (`label-worker`), calling
+/// `on_line` with each complete line of its stdout as it comes, so that the caller can keep
+/// what the worker finished before it failed. Returns `None` when the worker succeeded, or why
+/// it failed in words (a timeout, a crash, memory, a nonzero exit).
+///
+/// # Errors
+/// [`Interrupted`] when the worker was ended by an interrupting signal.
+pub fn run_streaming(
+    item: &Item,
+    key: &Key,
+    worker: &Worker,
+    on_line: &(dyn Fn(&str) + Sync),
+) -> Result<Option<String>, Interrupted> {
+    let input = item.path().display().to_string();
+    let mut child = match worker_command(item, key, worker).spawn() {
+        Ok(c) => c,
+        Err(e) => {
+            return Ok(Some(format!(
+                "cannot start the worker {}: {e}",
+                worker.program.display()
+            )))
+        }
+    };
+    let stdout = child.stdout.take();
+    let stderr = child.stderr.take().map(|mut s| {
+        std::thread::spawn(move || {
+            let mut buf = Vec::new();
+            let _ = s.read_to_end(&mut buf);
+            buf
+        })
+    });
+    let deadline = worker.timeout.map(|t| Instant::now() + t);
+    let timed_out = std::sync::atomic::AtomicBool::new(false);
+    let finished = std::sync::atomic::AtomicBool::new(false);
+    let pid = child.id();
+    std::thread::scope(|scope| {
+        // The watchdog: kill the worker at the deadline.
+        if let Some(deadline) = deadline {
+            let (timed_out, finished) = (&timed_out, &finished);
+            scope.spawn(move || {
+                while !finished.load(std::sync::atomic::Ordering::Relaxed) {
+                    if Instant::now() >= deadline {
+                        timed_out.store(true, std::sync::atomic::Ordering::Relaxed);
+                        kill(pid);
+                        return;
+                    }
+                    std::thread::sleep(Duration::from_millis(50));
+                }
+            });
+        }
+        if let Some(out) = stdout {
+            use std::io::BufRead;
+            for line in std::io::BufReader::new(out).lines() {
+                match line {
+                    Ok(l) if !l.trim().is_empty() => on_line(&l),
+                    Ok(_) => {}
+                    Err(_) => break,
+                }
+            }
+        }
+        finished.store(true, std::sync::atomic::Ordering::Relaxed);
+    });
+    let status = child.wait();
+    let stderr = stderr.and_then(|h| h.join().ok()).unwrap_or_default();
+    let stderr = String::from_utf8_lossy(&stderr).into_owned();
+    if timed_out.load(std::sync::atomic::Ordering::Relaxed) {
+        let t = worker.timeout.unwrap_or_default().as_secs_f64();
+        return Ok(Some(format!(
+            "timed out: still running after {t} s (--object-timeout), stopped"
+        )));
+    }
+    let status = match status {
+        Ok(s) => s,
+        Err(e) => return Ok(Some(format!("lost the worker: {e}"))),
+    };
+    if status.success() {
+        return Ok(None);
+    }
+    let last_err = last_error_line(&stderr);
+    failure(&status, &stderr, &last_err, worker)
+        .map(Some)
+        .map_err(|sig| {
+            Interrupted(format!(
+                "{input}: interrupted ({}); --resume runs it again",
+                signal_name(sig)
+            ))
+        })
+}
+
+/// Sends `SIGKILL` to the process `pid` (a worker past its time).
+#[cfg(unix)]
+fn kill(pid: u32) {
+    // SAFETY: kill(2) on a child's pid; no memory is passed.
+    unsafe {
+        libc::kill(pid as libc::pid_t, libc::SIGKILL);
+    }
+}
+
+#[cfg(not(unix))]
+fn kill(_pid: u32) {}
+
 /// The worker's command line for `item`: the worker's arguments, then `--input-hash HASH
 /// PATH`, with its output piped, its threads and its memory limited.
 fn worker_command(item: &Item, key: &Key, worker: &Worker) -> Command {

@@ -112,6 +112,56 @@ impl Journal {
         ))
     }
 
+    /// Opens `path` to resume a file of JSON lines of any kind (`label`'s): as [`Journal::open`]
+    /// (created when missing, locked, a partial last line cut off) without reading its lines
+    /// as batch records; returns the bytes cut off.
+    ///
+    /// # Errors
+    /// As [`Journal::open`], but for the records.
+    pub fn open_lines(path: &Path) -> Result<(Journal, usize), BatchError> {
+        if path.exists() {
+            crate::files::check_regular(path, crate::files::MAX_RESULTS_BYTES)
+                .map_err(|e| BatchError::io(path, e))?;
+        }
+        let file = OpenOptions::new()
+            .read(true)
+            .append(true)
+            .create(true)
+            .open(path)
+            .map_err(|e| BatchError::io(path, e))?;
+        lock(&file, path)?;
+        let bytes = crate::files::read_regular(path, crate::files::MAX_RESULTS_BYTES)
+            .map_err(|e| BatchError::io(path, e))?;
+        let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        let partial = bytes.len() - complete;
+        if partial > 0 {
+            file.set_len(complete as u64)
+                .map_err(|e| BatchError::io(path, e))?;
+        }
+        Ok((
+            Journal {
+                path: path.to_path_buf(),
+                file: Mutex::new(file),
+            },
+            partial,
+        ))
+    }
+
+    /// Appends one line of text (no newline in it): one write of the line and its newline,
+    /// then a sync to disk.
+    ///
+    /// # Errors
+    /// [`BatchError::Io`] when the write or the sync fails.
+    pub fn append_line(&self, line: &str) -> Result<(), BatchError> {
+        let mut buf = Vec::with_capacity(line.len() + 1);
+        buf.extend_from_slice(line.as_bytes());
+        buf.push(b'\n');
+        let mut file = self.file.lock().unwrap_or_else(|p| p.into_inner());
+        file.write_all(&buf)
+            .and_then(|()| file.sync_data())
+            .map_err(|e| BatchError::io(&self.path, e))
+    }
+
     /// Appends one record: one write of the line and its newline, then a sync to disk.
     ///
     /// # Errors

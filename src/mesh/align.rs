@@ -115,6 +115,18 @@ impl GraspAxis {
         },
     ];
 
+    /// The axis named `name` as [`GraspAxis::name`] writes it (`least`, `middle-`, ...).
+    pub fn from_name(name: &str) -> Option<GraspAxis> {
+        let (m, flipped) = match name.strip_suffix('-') {
+            Some(m) => (m, true),
+            None => (name, false),
+        };
+        let rank = ["least", "middle", "largest"]
+            .iter()
+            .position(|n| *n == m)?;
+        Some(GraspAxis { rank, flipped })
+    }
+
     /// A short name: `least`, `middle` or `largest` (moment), with `-` when flipped.
     pub fn name(&self) -> String {
         let m = ["least", "middle", "largest"][self.rank.min(2)];

@@ -190,48 +190,72 @@ pub struct Computed {
     posed: Option<sim::SimHand>,
     /// The bodies' poses at the end of the first hold and at the end of the closing.
     sim_poses: Option<(Vec<sim::BodyPose>, Vec<sim::BodyPose>)>,
-    /// The axis plan whose aligned object the check is on (`None`: the object's own).
-    checked_axis: Option<usize>,
+    /// The aligned object the check is on.
+    checked_axis: CheckedOn,
 }
 
 impl Computed {
     /// The aligned object the checked grasp (or `override_angles`) is on.
     fn checked_on(&self) -> &mesh::AlignedObject {
-        self.checked_axis
-            .map_or(&self.object.aligned, |i| &self.selection.axes[i].aligned)
+        match &self.checked_axis {
+            CheckedOn::Own => &self.object.aligned,
+            CheckedOn::Plan(i) => &self.selection.axes[*i].aligned,
+            CheckedOn::Given(a) => a.as_ref(),
+        }
     }
 }
 
-/// The axis plan the check is on: the given grasp's axis, else the chosen grasp's; `None`: the
-/// object's own aligned frame.
+/// Where the check is: on an axis plan's aligned object, or on an axis a given grasp names that
+/// the planner did not search (aligned for it, as the planner would align it).
+enum CheckedOn {
+    /// The object's own aligned frame (the thesis axis).
+    Own,
+    /// The aligned object of `selection.axes[i]`.
+    Plan(usize),
+    /// A given grasp's axis the search never reached.
+    Given(Box<mesh::AlignedObject>),
+}
+
+/// Where the check is: the given grasp's axis, else the chosen grasp's; the object's own
+/// aligned frame when neither names one.
+///
+/// # Errors
+/// [`Error::Given`] for an axis name that names no principal axis.
 fn checked_axis(
     options: &RunOptions,
     selection: &select::Selection,
-) -> Result<Option<usize>, Error> {
+    object: &PreparedObject,
+    scenario: &Scenario,
+) -> Result<CheckedOn, Error> {
     let Some(given) = &options.given else {
-        return Ok(selection.chosen().map(|c| c.axis_plan));
+        return Ok(selection
+            .chosen()
+            .map_or(CheckedOn::Own, |c| CheckedOn::Plan(c.axis_plan)));
     };
     let Some(name) = &given.axis_name else {
-        return Ok(None);
+        return Ok(CheckedOn::Own);
     };
-    match selection
+    if let Some(i) = selection
         .axes
         .iter()
         .position(|a| a.aligned.axis.name() == *name)
     {
-        Some(i) => Ok(Some(i)),
-        None => {
-            let mut known: Vec<String> = selection
-                .axes
-                .iter()
-                .map(|a| a.aligned.axis.name())
-                .collect();
-            known.dedup();
-            Err(Error::Given(format!(
-                "axis \"{name}\" is not one the planner searched ({})",
-                known.join(", ")
-            )))
-        }
+        return Ok(CheckedOn::Plan(i));
+    }
+    // A candidate of a run that searched further (more candidates, or an axis this run's
+    // search stopped before) is checked where it was planned: its axis aligned as the planner
+    // aligns it.
+    match mesh::GraspAxis::from_name(name) {
+        Some(axis) => Ok(CheckedOn::Given(Box::new(mesh::align_with_rule(
+            object.mesh(),
+            &object.props,
+            axis,
+            scenario.object.frame,
+        )))),
+        None => Err(Error::Given(format!(
+            "axis \"{name}\" is not a principal axis (least, middle, largest, each with `-` \
+             when flipped)"
+        ))),
     }
 }
 
@@ -271,8 +295,12 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
     let selection = select_grasps(scenario, options, &object, &mut timings);
     let qualities = qualities(scenario, options, &selection);
     let plan = build::plan_report(scenario, &selection, &qualities, timings);
-    let checked_axis = checked_axis(options, &selection)?;
-    let checked_on = checked_axis.map_or(&object.aligned, |i| &selection.axes[i].aligned);
+    let checked_axis = checked_axis(options, &selection, &object, scenario)?;
+    let checked_on = match &checked_axis {
+        CheckedOn::Own => &object.aligned,
+        CheckedOn::Plan(i) => &selection.axes[*i].aligned,
+        CheckedOn::Given(a) => a.as_ref(),
+    };
     let posed = posed(scenario, options, &selection, checked_on)?;
     let (sim, sim_poses, ran) = run_sim(scenario, options, &object, checked_on, &posed);
     // A check that ran here (not in the candidate search: `override_angles`) closed its own

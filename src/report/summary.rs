@@ -501,7 +501,8 @@ fn replay_line(p: &crate::sim::Perturbation) -> String {
 }
 
 /// `+X`, `-Z`, ... for an axis direction; the vector otherwise.
-fn direction_name(g: [f64; 3]) -> String {
+/// A gravity direction in words: `+X`, `-Z`, or its components.
+pub fn direction_name(g: [f64; 3]) -> String {
     for (i, axis) in ["X", "Y", "Z"].iter().enumerate() {
         if g[i].abs() == 1.0 {
             return format!("{}{axis}", if g[i] > 0.0 { "+" } else { "-" });

@@ -20,6 +20,16 @@ pub enum GravityMode {
     Six,
 }
 
+impl GravityMode {
+    /// The name used in TOML and on the command line.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            GravityMode::Down => "down",
+            GravityMode::Six => "six",
+        }
+    }
+}
+
 /// How the physics check runs the hold test (docs/SIM.md, "Protocols").
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "lowercase")]

@@ -12,6 +12,7 @@ mod hand_files;
 mod hostile;
 mod isolation;
 mod issue16;
+mod label;
 mod planner;
 mod quality;
 mod real_meshes;

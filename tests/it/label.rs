@@ -1,0 +1,284 @@
+//! `grasp-sim label` and `grasp-sim check --grasps` (issue 57): the label records equal single
+//! checks of the same grasps, a bad given line gets an error record while the others are
+//! checked, and `--resume` after a kill loses no finished grasp.
+
+use crate::{grasp_sim, root};
+use serde_json::Value;
+use std::path::Path;
+
+/// The lines of a JSON Lines file.
+fn lines(path: &Path) -> Vec<Value> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+/// A line without what differs between runs: its `label` part (input, hash, wall time).
+fn without_label(v: &Value) -> Value {
+    let mut v = v.clone();
+    v.as_object_mut().unwrap().remove("label");
+    v
+}
+
+/// `label` of `inputs` with `args`, into `out`; the exit status and stderr.
+fn label(inputs: &[&Path], args: &[&str], out: &Path) -> (Option<i32>, String) {
+    let o = grasp_sim()
+        .arg("label")
+        .args(inputs)
+        .args(args)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    (
+        o.status.code(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn label_records_equal_single_checks_of_the_same_grasps() {
+    let dir = tempfile::tempdir().unwrap();
+    let cup = root().join("assets/objects/cup.stl");
+    let out = dir.path().join("cup.jsonl");
+    let (code, err) = label(
+        &[&cup],
+        &["--grasps", "5", "--samples", "3", "--in-process"],
+        &out,
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let labelled = lines(&out);
+    assert_eq!(labelled.len(), 5, "{err}");
+    // The first candidate in search order is always labelled; the picks are distinct and in
+    // search order in the file.
+    let indices: Vec<u64> = labelled
+        .iter()
+        .map(|l| l["grasp_index"].as_u64().unwrap())
+        .collect();
+    assert_eq!(indices[0], 0);
+    assert!(indices.windows(2).all(|w| w[0] < w[1]), "{indices:?}");
+    for l in &labelled {
+        let p = l["hold_probability"].as_f64().unwrap();
+        assert!((0.0..=1.0).contains(&p), "{l}");
+        assert_eq!(l["samples"].as_u64(), Some(3), "{l}");
+        assert_eq!(l["joint_angles_deg"].as_array().unwrap().len(), 3);
+        assert_eq!(l["palm_pose"][3], serde_json::json!([0.0, 0.0, 0.0, 1.0]));
+        assert!(l["grade"]["palm"].as_f64().is_some(), "{l}");
+    }
+    // Each line checked alone, as a given grasp, reports exactly what `label` wrote for it.
+    for (k, l) in labelled.iter().enumerate() {
+        let one = dir.path().join(format!("g{k}.jsonl"));
+        std::fs::write(&one, format!("{l}\n")).unwrap();
+        let checked = dir.path().join(format!("c{k}.jsonl"));
+        let o = grasp_sim()
+            .args(["check", "--samples", "3", "--grasps"])
+            .arg(&one)
+            .arg(&cup)
+            .arg("--out")
+            .arg(&checked)
+            .output()
+            .unwrap();
+        assert_eq!(
+            o.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&o.stderr)
+        );
+        let c = lines(&checked);
+        assert_eq!(c.len(), 1);
+        assert_eq!(without_label(&c[0]), without_label(l), "grasp {k}");
+    }
+}
+
+#[test]
+fn label_picks_diverse_grasps_not_the_first_near_copies() {
+    let dir = tempfile::tempdir().unwrap();
+    let cup = root().join("assets/objects/cup.stl");
+    let out = dir.path().join("cup.jsonl");
+    let summary = dir.path().join("summary.jsonl");
+    let o = grasp_sim()
+        .arg("label")
+        .arg(&cup)
+        .args([
+            "--grasps",
+            "8",
+            "--samples",
+            "1",
+            "--in-process",
+            "--summary",
+        ])
+        .arg(&summary)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let s = &lines(&summary)[0];
+    // The cup's first candidates differ only in the approach angle at one elevation: their
+    // palms lie a few millimetres apart; the picks spread over the object.
+    let picked = s["picked_spread"][0].as_f64().unwrap();
+    let first = s["first_spread"][0].as_f64().unwrap();
+    assert!(s["candidates"].as_u64().unwrap() > 100, "{s}");
+    assert!(picked > 3.0 * first, "picked {picked} mm, first {first} mm");
+    let indices: Vec<u64> = lines(&out)
+        .iter()
+        .map(|l| l["grasp_index"].as_u64().unwrap())
+        .collect();
+    assert!(*indices.last().unwrap() > 50, "{indices:?}");
+}
+
+#[test]
+fn a_bad_given_line_gets_an_error_record_and_the_others_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let d40 = root().join("assets/objects/cylinder_d40.stl");
+    let out = dir.path().join("d40.jsonl");
+    let (code, err) = label(
+        &[&d40],
+        &["--grasps", "2", "--samples", "2", "--in-process"],
+        &out,
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let good = lines(&out);
+    let mut scaled = good[0].clone();
+    for i in 0..3 {
+        for j in 0..3 {
+            scaled["palm_pose"][i][j] =
+                Value::from(scaled["palm_pose"][i][j].as_f64().unwrap() * 2.0);
+        }
+    }
+    let mut two_fingers = good[0].clone();
+    two_fingers["joint_angles_deg"]
+        .as_array_mut()
+        .unwrap()
+        .pop();
+    let nan =
+        good[0]
+            .to_string()
+            .replacen(&format!("{}", good[0]["joint_angles_deg"][0][0]), "NaN", 1);
+    let given = dir.path().join("given.jsonl");
+    std::fs::write(
+        &given,
+        format!("{}\n{scaled}\n{two_fingers}\n{nan}\n{}\n", good[0], good[1]),
+    )
+    .unwrap();
+    let checked = dir.path().join("checked.jsonl");
+    let o = grasp_sim()
+        .args(["check", "--samples", "2", "--grasps"])
+        .arg(&given)
+        .arg(&d40)
+        .arg("--out")
+        .arg(&checked)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let c = lines(&checked);
+    assert_eq!(c.len(), 5);
+    assert_eq!(without_label(&c[0]), without_label(&good[0]));
+    assert_eq!(without_label(&c[4]), without_label(&good[1]));
+    for (k, needle) in [
+        (1, "not orthonormal"),
+        (2, "has 2 fingers' angles, the hand has 3"),
+        (3, "NaN or Infinity"),
+    ] {
+        let e = c[k]["error"].as_str().unwrap_or_else(|| panic!("{}", c[k]));
+        assert!(
+            e.contains(&format!("line {}", k + 1)) && e.contains(needle),
+            "{e}"
+        );
+        assert!(c[k].get("verdict").is_none());
+    }
+}
+
+#[test]
+fn an_ungraspable_object_gets_one_line_saying_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let d10 = root().join("scenarios/cylinder_d10.toml");
+    let out = dir.path().join("d10.jsonl");
+    let (code, err) = label(&[&d10], &["--grasps", "4", "--samples", "1"], &out);
+    assert_eq!(code, Some(0), "{err}");
+    let l = lines(&out);
+    assert_eq!(l.len(), 1);
+    assert!(l[0]["ungraspable"].as_str().is_some(), "{}", l[0]);
+    assert_eq!(l[0]["object"], "cylinder_d10");
+}
+
+#[test]
+fn resume_after_a_kill_loses_no_finished_grasp() {
+    let dir = tempfile::tempdir().unwrap();
+    let cup = root().join("assets/objects/cup.stl");
+    let d40 = root().join("assets/objects/cylinder_d40.stl");
+    let args = [
+        "--grasps",
+        "6",
+        "--samples",
+        "2",
+        "--jobs",
+        "1",
+        "--in-process",
+    ];
+    // The whole run, uninterrupted.
+    let whole = dir.path().join("whole.jsonl");
+    let (code, err) = label(&[&cup, &d40], &args, &whole);
+    assert_eq!(code, Some(0), "{err}");
+    let whole = lines(&whole);
+    assert_eq!(whole.len(), 12);
+    // The same run, killed once a few grasps are in the file, then resumed.
+    let out = dir.path().join("run.jsonl");
+    let mut child = grasp_sim()
+        .arg("label")
+        .arg(&cup)
+        .arg(&d40)
+        .args(args)
+        .args(["--resume", "--out"])
+        .arg(&out)
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = std::time::Instant::now();
+    let count = |p: &Path| {
+        std::fs::read_to_string(p)
+            .map(|t| t.matches('\n').count())
+            .unwrap_or(0)
+    };
+    while count(&out) < 3 && t0.elapsed().as_secs() < 120 {
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let before: Vec<Value> = std::fs::read_to_string(&out)
+        .unwrap()
+        .lines()
+        .filter_map(|l| serde_json::from_str(l).ok())
+        .collect();
+    assert!(
+        !before.is_empty() && before.len() < 12,
+        "{} lines",
+        before.len()
+    );
+    let (code, err) = label(&[&cup, &d40], &[&args[..], &["--resume"]].concat(), &out);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(err.contains("resume:"), "{err}");
+    let after = lines(&out);
+    // The finished grasps are kept as written (their wall time too: not labelled again), and
+    // the file ends as the uninterrupted run's.
+    for b in &before {
+        assert!(after.contains(b), "lost {b}");
+    }
+    let strip = |v: &[Value]| v.iter().map(without_label).collect::<Vec<_>>();
+    assert_eq!(strip(&after), strip(&whole));
+}
