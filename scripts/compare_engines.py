@@ -144,10 +144,13 @@ def agreement_summary(rows):
 
 
 def folder_name(name):
-    """A scenario name as grasp-sim makes it a folder name: `/`, `\\` and control characters
-    as `_`, a leading `.` or an empty name prefixed with `_`."""
-    s = "".join("_" if c in "/\\" or ord(c) < 32 or ord(c) == 127 else c for c in name)
-    return "_" + s if not s or s.startswith(".") else s
+    """A scenario name as grasp-sim makes it a folder name (`files::folder_name`): `/`, `\\`
+    and control characters as `_`, an empty name, `.` and `..` prefixed with `_`, at most 200
+    bytes."""
+    s = "".join("_" if c in "/\\" or ord(c) < 32 or 127 <= ord(c) < 160 else c for c in name)
+    s = "_" + s if s in ("", ".", "..") else s
+    b = s.encode()[:200]
+    return b.decode("utf-8", "ignore")
 
 
 def labels(path, scenes, jsonl):

@@ -24,16 +24,15 @@ use std::path::{Path, PathBuf};
 
 /// Problems writing an export.
 ///
-/// Its message names the file; the reason is its `source()`, the I/O error, which `{:#}` (as the
-/// binary prints errors) appends: `{path}: cannot write: {reason}`.
+/// Its message names the file and the reason, the I/O error: `{path}: cannot write: {reason}`
+/// (not the error's `source()`, so that a chain printed whole says the reason once).
 #[derive(Debug, thiserror::Error)]
-#[error("{path}: cannot write")]
+#[error("{path}: cannot write: {}", crate::messages::io_message(.error))]
 pub struct ExportError {
     /// The file or folder.
     pub path: PathBuf,
     /// What the operating system said.
-    #[source]
-    pub source: std::io::Error,
+    pub error: std::io::Error,
 }
 
 /// Everything an export needs about the grasp.
@@ -100,7 +99,7 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     let keys = Keyframes::new(case, &start);
 
     let mut s = String::new();
-    let _ = writeln!(s, "<mujoco model=\"grasp-sim {}\">", input.name);
+    let _ = writeln!(s, "<mujoco model=\"grasp-sim {}\">", xml_attr(input.name));
     mjcf_options(&mut s, case, &meshes);
     let _ = writeln!(s, "  <worldbody>");
     mjcf_hand(&mut s, case, &start);
@@ -124,10 +123,19 @@ pub fn write_mjcf(dir: &Path, input: &ExportInput) -> Result<(), ExportError> {
     Ok(())
 }
 
+/// `text` as the value of an XML attribute in double quotes: a scenario's name may hold `"`,
+/// `<` or `&`.
+fn xml_attr(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('"', "&quot;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
 fn io_error(path: &Path, e: std::io::Error) -> ExportError {
     ExportError {
         path: path.to_path_buf(),
-        source: e,
+        error: e,
     }
 }
 

@@ -152,10 +152,118 @@ pub fn check_replaceable(path: &Path) -> io::Result<()> {
     }
 }
 
-/// Writes `bytes` to `path` through a temporary file beside it (`.NAME.tmp`), synced, and a
-/// rename: `path` is then either its old self or whole. On any error, a full disk included,
-/// the temporary file is removed and `path` is left as it was. Only a regular file or a new
-/// path is replaced ([`check_replaceable`]).
+/// The most bytes one name in a path may have: the common file systems' limit (`NAME_MAX`).
+pub const MAX_NAME_BYTES: usize = 255;
+
+/// The most bytes an output folder's name may have (a scenario's `name`): room under
+/// [`MAX_NAME_BYTES`] for the `-N` a repeated name gets and a temporary file's suffix.
+pub const MAX_FOLDER_NAME_BYTES: usize = 200;
+
+/// What is wrong with `name` as the name of one folder inside an output folder (`--report
+/// DIR`, `--export-mjcf DIR`, `--export-urdf DIR`), or `None` when nothing is: it must be one
+/// name, not empty, not `.` or `..`, without `/` or `\` (an absolute name starts with `/`),
+/// NUL or other control characters, and at most [`MAX_FOLDER_NAME_BYTES`] bytes. Joined onto
+/// the folder given, such a name stays inside it.
+pub fn folder_name_problem(name: &str) -> Option<String> {
+    if name.is_empty() {
+        return Some("is empty".to_string());
+    }
+    if name == "." || name == ".." {
+        return Some(format!("is `{name}`, which names no folder of its own"));
+    }
+    if let Some(c) = name
+        .chars()
+        .find(|&c| c == '/' || c == '\\' || c.is_control())
+    {
+        let what = match c {
+            '/' => "`/`".to_string(),
+            '\\' => "`\\`".to_string(),
+            '\0' => "a NUL byte".to_string(),
+            c => format!("the control character U+{:04X}", u32::from(c)),
+        };
+        return Some(format!("contains {what}"));
+    }
+    if name.len() > MAX_FOLDER_NAME_BYTES {
+        return Some(format!(
+            "has {} bytes, more than the {MAX_FOLDER_NAME_BYTES} a folder name may have here",
+            name.len()
+        ));
+    }
+    None
+}
+
+/// `name` made a folder name ([`folder_name_problem`] finds nothing in it): each `/`, `\`
+/// and control character replaced by `_`, `.` and `..` (and an empty name) prefixed with `_`,
+/// and cut (at a character boundary) to [`MAX_FOLDER_NAME_BYTES`]. What a mesh's file stem
+/// becomes when it names a run; a name that is one already is kept as it is.
+pub fn folder_name(name: &str) -> String {
+    let mut out: String = name
+        .chars()
+        .map(|c| {
+            if c == '/' || c == '\\' || c.is_control() {
+                '_'
+            } else {
+                c
+            }
+        })
+        .collect();
+    if out.is_empty() || out == "." || out == ".." {
+        out.insert(0, '_');
+    }
+    let mut keep = out.len().min(MAX_FOLDER_NAME_BYTES);
+    while !out.is_char_boundary(keep) {
+        keep -= 1;
+    }
+    out.truncate(keep);
+    out
+}
+
+/// A name no other writer of this or another process is using in `dir`: `.NAME.PID.N.tmp`,
+/// `NAME` shortened (at a character boundary) to keep the whole within [`MAX_NAME_BYTES`].
+fn temporary_name(dir: &Path, name: &str, what: &str) -> std::path::PathBuf {
+    static NEXT: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let suffix = format!(".{}.{n}.{what}", std::process::id());
+    let mut keep = MAX_NAME_BYTES
+        .saturating_sub(1 + suffix.len())
+        .min(name.len());
+    while !name.is_char_boundary(keep) {
+        keep -= 1;
+    }
+    dir.join(format!(".{}{suffix}", &name[..keep]))
+}
+
+/// Creates a new file at a name no one else uses in `dir` (see [`temporary_name`]), never
+/// through an existing file or link (`O_EXCL`); returns it with its path.
+///
+/// # Errors
+/// The operating system's error creating it.
+pub fn create_private(
+    dir: &Path,
+    name: &str,
+    what: &str,
+) -> io::Result<(std::fs::File, std::path::PathBuf)> {
+    loop {
+        let path = temporary_name(dir, name, what);
+        match std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&path)
+        {
+            Err(e) if e.kind() == io::ErrorKind::AlreadyExists => continue,
+            Err(e) => return Err(e),
+            Ok(f) => return Ok((f, path)),
+        }
+    }
+}
+
+/// Writes `bytes` to `path` through a temporary file beside it (`.NAME.PID.N.tmp`, made new,
+/// so that two writers never share one and no link is followed), synced, and a rename: `path`
+/// is then either its old self or whole. On any error, a full disk included, the temporary
+/// file is removed and `path` is left as it was. Only a regular file or a new path is replaced
+/// ([`check_replaceable`], checked before the write and again before the rename): never a
+/// symbolic link, a device or a FIFO, and nothing is ever opened at `path` itself, so a FIFO
+/// there cannot block the write. Every output file of grasp-sim is written here.
 ///
 /// Test hook, debug builds only: with `GRASP_SIM_TEST_FAULT=enospc:NAME`, writing a file whose
 /// path contains `NAME` writes half its bytes and then fails as a full disk does (`ENOSPC`),
@@ -174,20 +282,43 @@ pub fn write_replacing(path: &Path, bytes: &[u8]) -> io::Result<()> {
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    let tmp = dir.join(format!(".{name}.tmp"));
-    let written = std::fs::File::create(&tmp).and_then(|mut f| {
-        if full_disk_fault(path) {
-            f.write_all(&bytes[..bytes.len() / 2])?;
-            return Err(io::Error::from_raw_os_error(28));
+    if name.len() > MAX_NAME_BYTES {
+        return Err(io::Error::other(format!(
+            "its name has {} bytes, more than the {MAX_NAME_BYTES} a file system takes",
+            name.len()
+        )));
+    }
+    let (mut f, tmp) = create_private(dir, &name, "tmp").map_err(|e| {
+        if e.kind() == io::ErrorKind::NotFound {
+            io::Error::other(format!("no folder {}", dir.display()))
+        } else {
+            e
         }
-        f.write_all(bytes)?;
-        f.sync_data()
-    });
+    })?;
+    let written = if full_disk_fault(path) {
+        f.write_all(&bytes[..bytes.len() / 2])
+            .and_then(|()| Err(io::Error::from_raw_os_error(28)))
+    } else {
+        f.write_all(bytes).and_then(|()| f.sync_data())
+    };
+    drop(f);
     written
+        .and_then(|()| check_replaceable(path))
         .and_then(|()| std::fs::rename(&tmp, path))
         .inspect_err(|_| {
             let _ = std::fs::remove_file(&tmp);
         })
+}
+
+/// Checks that a file can be made in the folder `dir`: makes one at a name no one else uses
+/// and removes it (two runs checking one folder at once do not see each other's).
+///
+/// # Errors
+/// The operating system's error.
+pub fn check_writable_dir(dir: &Path) -> io::Result<()> {
+    let (f, probe) = create_private(dir, ".grasp-sim-write-test", "probe")?;
+    drop(f);
+    std::fs::remove_file(&probe)
 }
 
 /// Whether the debug-build fault hook of [`write_replacing`] asks this write to fail.
@@ -200,6 +331,96 @@ fn full_disk_fault(path: &Path) -> bool {
     }
     let _ = path;
     false
+}
+
+/// The lock one run holds on an output folder (`--report DIR`, `--export-mjcf DIR`,
+/// `--export-urdf DIR`, `tune --out DIR`) for as long as it writes there: a file
+/// `.grasp-sim.lock` in the folder, locked with `flock` (released if the run dies) and removed
+/// when the run ends. A second run into the same folder is refused at once with the lock's
+/// message, instead of the two runs' files mixing (or one run's check of the folder seeing the
+/// other's files come and go).
+#[derive(Debug)]
+pub struct FolderLock {
+    path: std::path::PathBuf,
+    file: Option<std::fs::File>,
+}
+
+impl FolderLock {
+    /// Locks the folder `dir`, which must exist.
+    ///
+    /// # Errors
+    /// [`io::ErrorKind::WouldBlock`] with a message saying another run holds the folder, or
+    /// the operating system's error making the lock file.
+    pub fn take(dir: &Path) -> io::Result<FolderLock> {
+        let path = dir.join(".grasp-sim.lock");
+        // A run that ends removes the lock file while it holds it; a run that opened the name
+        // just before would then hold a removed file. The lock counts only on the file the name
+        // still is; otherwise the open is tried again.
+        loop {
+            let mut options = std::fs::OpenOptions::new();
+            options.write(true).create(true).truncate(false);
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::OpenOptionsExt;
+                options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+            }
+            let file = options.open(&path)?;
+            if !lock_exclusive(&file)? {
+                return Err(io::Error::new(
+                    io::ErrorKind::WouldBlock,
+                    "in use by another grasp-sim run (locked); one run per output folder",
+                ));
+            }
+            if is_same_file(&file, &path) {
+                return Ok(FolderLock {
+                    path,
+                    file: Some(file),
+                });
+            }
+        }
+    }
+}
+
+impl Drop for FolderLock {
+    fn drop(&mut self) {
+        // Removed while still held, so no other run can lock the name being removed.
+        let _ = std::fs::remove_file(&self.path);
+        drop(self.file.take());
+    }
+}
+
+/// Takes `flock`'s exclusive lock on `file` without waiting: false if another holds it. A
+/// file system without locks (some network mounts) counts as locked by this run.
+#[cfg(unix)]
+fn lock_exclusive(file: &std::fs::File) -> io::Result<bool> {
+    use std::os::fd::AsRawFd;
+    // SAFETY: flock on a file descriptor borrowed for the call; no memory is passed.
+    let r = unsafe { libc::flock(file.as_raw_fd(), libc::LOCK_EX | libc::LOCK_NB) };
+    if r == 0 {
+        return Ok(true);
+    }
+    let e = io::Error::last_os_error();
+    Ok(e.raw_os_error() != Some(libc::EWOULDBLOCK))
+}
+
+#[cfg(not(unix))]
+fn lock_exclusive(_file: &std::fs::File) -> io::Result<bool> {
+    Ok(true)
+}
+
+/// Returns true if and only if `path` is (still) the file `file` has open.
+#[cfg(unix)]
+fn is_same_file(file: &std::fs::File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::symlink_metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn is_same_file(_file: &std::fs::File, _path: &Path) -> bool {
+    true
 }
 
 #[cfg(test)]
@@ -231,6 +452,36 @@ mod tests {
         assert_eq!(e.kind(), io::ErrorKind::InvalidData);
         assert_eq!(size(MAX_MESH_BYTES), "256 MiB");
         assert_eq!(size(MAX_RESULTS_BYTES), "1 GiB");
+    }
+
+    #[test]
+    fn folder_names_stay_inside_their_folder() {
+        for bad in [
+            "",
+            ".",
+            "..",
+            "../../escape",
+            "/abs",
+            "a\\b",
+            "a\0b",
+            "a\nb",
+        ] {
+            assert!(folder_name_problem(bad).is_some(), "{bad:?}");
+            let fixed = folder_name(bad);
+            assert_eq!(folder_name_problem(&fixed), None, "{bad:?} -> {fixed:?}");
+            let joined = Path::new("/out").join(&fixed);
+            assert_eq!(joined.parent(), Some(Path::new("/out")), "{fixed:?}");
+        }
+        assert_eq!(folder_name("../../escape"), ".._.._escape");
+        assert_eq!(folder_name(".."), "_..");
+        assert_eq!(folder_name_problem("a\0b").unwrap(), "contains a NUL byte");
+        for good in ["cup", "cup 2", "textured", ".hidden", "a..b", "é"] {
+            assert_eq!(folder_name_problem(good), None, "{good:?}");
+            assert_eq!(folder_name(good), good);
+        }
+        let long = "é".repeat(150);
+        assert!(folder_name_problem(&long).unwrap().contains("300 bytes"));
+        assert_eq!(folder_name(&long).len(), MAX_FOLDER_NAME_BYTES);
     }
 
     #[test]

@@ -22,6 +22,9 @@ pub use geometry::{bend, palm_rotation, BodyPose, HandBox};
 
 /// The largest length a hand file may give `[mm]`: a hand is hand-sized (issue 32).
 pub const MAX_LENGTH_MM: f64 = 2000.0;
+/// The shortest positive length a hand may have `[mm]`: 10 µm, far under any finger and far
+/// above the f32 physics check's rounding at a hand's size.
+pub const MIN_LENGTH_MM: f64 = 0.01;
 
 /// The hands built into the binary, by name: found wherever grasp-sim runs, without a path.
 pub const BUNDLED: [(&str, &str); 2] = [
@@ -407,6 +410,12 @@ impl Hand {
             if !(v.is_finite() && v > 0.0) {
                 return Err((key, format!("must be a positive length, got {v}")));
             }
+            if v < MIN_LENGTH_MM {
+                return Err((
+                    key,
+                    format!("must be in [{MIN_LENGTH_MM}, {MAX_LENGTH_MM}] mm, got {v}"),
+                ));
+            }
         }
         let non_negative = [
             ("palm.margin_mm", self.palm.margin_mm),
@@ -497,13 +506,15 @@ impl Hand {
             if !(joint_ok(c.follower)
                 && joint_ok(c.leader)
                 && c.multiplier.is_finite()
-                && c.offset_deg.is_finite())
+                && c.multiplier.abs() <= 100.0
+                && c.offset_deg.is_finite()
+                && c.offset_deg.abs() <= 360.0)
             {
                 return Err((
                     "coupling",
                     format!(
-                        "must name [finger 1-{n}, joint 1-2] twice with a finite multiplier \
-                         and offset, got {c:?}"
+                        "must name [finger 1-{n}, joint 1-2] twice with a multiplier in \
+                         [-100, 100] and an offset in [-360, 360]°, got {c:?}"
                     ),
                 ));
             }
@@ -512,8 +523,14 @@ impl Hand {
             if self.finger_list[..i].iter().any(|g| g.name == f.name) {
                 return Err(("finger.name", format!("`{}` appears twice", f.name)));
             }
-            if !f.height_mm.is_finite() {
-                return Err(("finger.height_mm", format!("must be finite for {}", f.name)));
+            if !(f.height_mm.is_finite() && f.height_mm.abs() <= MAX_LENGTH_MM) {
+                return Err((
+                    "finger.height_mm",
+                    format!(
+                        "must be in [-{MAX_LENGTH_MM}, {MAX_LENGTH_MM}] mm for {}, got {}",
+                        f.name, f.height_mm
+                    ),
+                ));
             }
         }
         Ok(())

@@ -294,8 +294,13 @@ pub fn run(file: &std::path::Path, svg: Option<&std::path::Path>) -> anyhow::Res
         },
         std::path::Path::to_path_buf,
     );
-    std::fs::write(&out, figure(&d))
-        .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", out.display()))?;
+    crate::files::write_replacing(&out, figure(&d).as_bytes()).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: cannot write: {}",
+            out.display(),
+            crate::messages::io_message(&e)
+        )
+    })?;
     println!("figure: {}", out.display());
     Ok(0)
 }

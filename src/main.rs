@@ -4,7 +4,9 @@
 mod cli;
 
 use clap::Parser;
-use grasp_sim::pipeline::{check_output_dir, check_output_file, inputs, Progress, RunOptions};
+use grasp_sim::pipeline::{
+    check_output_dir, check_output_file, inputs, lock_output_dir, Progress, RunOptions,
+};
 use grasp_sim::scenario::{GravityMode, Scenario};
 use std::io::IsTerminal;
 use std::process::ExitCode;
@@ -150,6 +152,8 @@ fn run_inputs(cli: cli::Cli) -> anyhow::Result<u8> {
         report: cli.report,
         ..RunOptions::from(grasp_sim::RunFlags::from(cli.flags))
     };
+    // Each output folder locked once for the whole run, though two flags name the same one.
+    let mut locks: Vec<(std::path::PathBuf, grasp_sim::files::FolderLock)> = Vec::new();
     for (flag, dir) in [
         ("--report", &options.report),
         ("--export-mjcf", &options.export_mjcf),
@@ -157,6 +161,11 @@ fn run_inputs(cli: cli::Cli) -> anyhow::Result<u8> {
     ] {
         if let Some(d) = dir {
             anyhow::Context::context(check_output_dir(d), flag)?;
+            let same = std::fs::canonicalize(d).unwrap_or_else(|_| d.clone());
+            if !locks.iter().any(|(p, _)| *p == same) {
+                let lock = anyhow::Context::context(lock_output_dir(d), flag)?;
+                locks.push((same, lock));
+            }
         }
     }
     let command_line = inputs::CommandLine {

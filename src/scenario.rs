@@ -401,10 +401,30 @@ impl Scenario {
                 ));
             }
         }
+        // The name is the output folders' subfolder (`--report DIR/NAME`): one folder name,
+        // checked here; a file stem is made one (`..stl` would name `.`).
+        if let Some(problem) = raw
+            .name
+            .as_deref()
+            .and_then(crate::files::folder_name_problem)
+        {
+            return Err(invalid(
+                "name",
+                format!(
+                    "{problem}: it names the run's folder inside --report, --export-mjcf and \
+                     --export-urdf, so it must be one folder name (not `.` or `..`, no `/`, `\\`, \
+                     NUL or control characters, at most {} bytes)",
+                    crate::files::MAX_FOLDER_NAME_BYTES
+                ),
+            ));
+        }
         let name = raw.name.unwrap_or_else(|| {
-            path.file_stem()
-                .map(|s| s.to_string_lossy().into_owned())
-                .unwrap_or_default()
+            crate::files::folder_name(
+                &path
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+            )
         });
         Ok(Scenario {
             path: path.to_path_buf(),
@@ -425,6 +445,12 @@ impl Scenario {
     }
 }
 
+/// The least Coulomb friction a scenario may give.
+pub const MIN_FRICTION: f64 = 0.01;
+/// The lightest object a scenario may give `[kg]`: a milligram.
+pub const MIN_MASS_KG: f64 = 1e-6;
+/// The least density a scenario may give `[kg/m³]` (silica aerogel is about 1).
+pub const MIN_DENSITY_KG_M3: f64 = 0.1;
 /// The heaviest object a scenario may give `[kg]`.
 pub const MAX_MASS_KG: f64 = 10_000.0;
 /// The densest object a scenario may give `[kg/m³]`.
@@ -456,16 +482,20 @@ fn validate_object(o: &RawObject) -> Result<MassSpec, (&'static str, String)> {
         }
         // The physics check works in f32: past these an object's forces overflow and a check
         // could say `hold` of 1e20 kg.
-        MassSpec::Density(d) if d > MAX_DENSITY_KG_M3 => {
+        MassSpec::Density(d) if !(MIN_DENSITY_KG_M3..=MAX_DENSITY_KG_M3).contains(&d) => {
             return Err((
                 "object.density_kg_m3",
-                format!("must be at most {MAX_DENSITY_KG_M3} (osmium is 22590), got {d}"),
+                format!(
+                    "must be in [{MIN_DENSITY_KG_M3}, {MAX_DENSITY_KG_M3}] kg/m³ (osmium is 22590), got {d}"
+                ),
             ))
         }
-        MassSpec::Mass(m) if m > MAX_MASS_KG => {
+        MassSpec::Mass(m) if !(MIN_MASS_KG..=MAX_MASS_KG).contains(&m) => {
             return Err((
                 "object.mass_kg",
-                format!("must be at most {MAX_MASS_KG} kg (no hand holds more), got {m}"),
+                format!(
+                    "must be in [{MIN_MASS_KG}, {MAX_MASS_KG}] kg (no hand holds more), got {m}"
+                ),
             ))
         }
         _ => {}
@@ -483,12 +513,13 @@ fn validate_object(o: &RawObject) -> Result<MassSpec, (&'static str, String)> {
             ),
         ));
     }
-    // Coulomb friction between a hand and an object: 0 is frictionless; rubber on rubber
-    // rarely exceeds ~1.5, so 2 bounds any plausible value.
-    if !(o.friction.is_finite() && o.friction > 0.0 && o.friction <= 2.0) {
+    // Coulomb friction between a hand and an object: PTFE on steel, the slipperiest pair in
+    // the tables, is about 0.04; rubber on rubber rarely exceeds ~1.5, so [0.01, 2] bounds any
+    // plausible value (5e-324 was taken, and blamed on the planner's vertical deviation).
+    if !(o.friction.is_finite() && (MIN_FRICTION..=2.0).contains(&o.friction)) {
         return Err((
             "object.friction",
-            format!("must be in (0, 2], got {}", o.friction),
+            format!("must be in [{MIN_FRICTION}, 2], got {}", o.friction),
         ));
     }
     Ok(mass)

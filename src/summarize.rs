@@ -82,9 +82,14 @@ impl Summary {
     /// [`BatchError::Io`] when it cannot be read; [`BatchError::NotARecord`] for a complete
     /// line that is not a run report or an error line (naming its line number).
     pub fn read(path: &Path) -> Result<Summary, BatchError> {
-        let bytes = crate::files::read_regular(path, crate::files::MAX_RESULTS_BYTES)
-            .map_err(|e| BatchError::io(path, e))?;
-        Summary::parse(path, &bytes)
+        // Line by line: the memory is the rows', not the file's (a 478 MB file, under the
+        // 1 GiB cap, held whole and parsed into JSON trees, took 2.8 GB; issue 56).
+        let limit = crate::files::MAX_RESULTS_BYTES;
+        crate::files::check_regular(path, limit).map_err(|e| BatchError::io(path, e))?;
+        let file = std::fs::File::open(path).map_err(|e| BatchError::io(path, e))?;
+        let reader =
+            std::io::BufReader::with_capacity(1 << 16, std::io::Read::take(file, limit + 1));
+        Summary::from_reader(path, reader, limit)
     }
 
     /// [`Summary::read`] on the file's bytes (`path` names it in errors).
@@ -92,17 +97,43 @@ impl Summary {
     /// # Errors
     /// As [`Summary::read`].
     pub fn parse(path: &Path, bytes: &[u8]) -> Result<Summary, BatchError> {
-        let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
+        Summary::from_reader(path, bytes, u64::MAX)
+    }
+
+    /// The summary of the lines `reader` gives, one at a time (at most `limit` bytes).
+    fn from_reader(
+        path: &Path,
+        mut reader: impl std::io::BufRead,
+        limit: u64,
+    ) -> Result<Summary, BatchError> {
         let mut s = Summary::default();
-        if complete < bytes.len() {
-            s.warnings.push(format!(
-                "skipped a partial last line ({} bytes, no newline: a run interrupted while writing; `batch --resume` continues it)",
-                bytes.len() - complete
-            ));
-        }
-        let mut views = Vec::new();
         let mut seen: BTreeMap<String, usize> = BTreeMap::new();
-        for (i, line) in bytes[..complete].split(|&b| b == b'\n').enumerate() {
+        let mut line: Vec<u8> = Vec::new();
+        let mut total = 0u64;
+        for i in 0.. {
+            line.clear();
+            let n = reader
+                .read_until(b'\n', &mut line)
+                .map_err(|e| BatchError::io(path, e))?;
+            total += n as u64;
+            if total > limit {
+                return Err(BatchError::io(
+                    path,
+                    std::io::Error::other(format!(
+                        "more than the {limit} bytes a results file may have here"
+                    )),
+                ));
+            }
+            if n == 0 {
+                break;
+            }
+            if line.last() != Some(&b'\n') {
+                s.warnings.push(format!(
+                    "skipped a partial last line ({n} bytes, no newline: a run interrupted while writing; `batch --resume` continues it)"
+                ));
+                break;
+            }
+            let line = &line[..line.len() - 1];
             if line.iter().all(u8::is_ascii_whitespace) {
                 continue;
             }
@@ -112,12 +143,19 @@ impl Summary {
                 why,
             };
             let text = std::str::from_utf8(line).map_err(|_| bad("not UTF-8".to_string()))?;
-            let v: serde_json::Value =
-                serde_json::from_str(text).map_err(|e| bad(format!("not JSON ({e})")))?;
-            if !v.is_object() {
-                return Err(bad("not a JSON object".to_string()));
-            }
-            let v = RecordView::of(&v);
+            // The view straight from the text (no JSON tree of the whole line); where that
+            // fails, the tree says why.
+            let v = match serde_json::from_str::<RecordView>(text) {
+                Ok(v) if text.trim_start().starts_with('{') => v,
+                _ => {
+                    let v: serde_json::Value =
+                        serde_json::from_str(text).map_err(|e| bad(format!("not JSON ({e})")))?;
+                    if !v.is_object() {
+                        return Err(bad("not a JSON object".to_string()));
+                    }
+                    RecordView::of(&v)
+                }
+            };
             let row = row_of(&v).map_err(bad)?;
             *seen.entry(row.input.clone()).or_insert(0) += 1;
             for d in &v.sim.directions {
@@ -130,10 +168,9 @@ impl Summary {
                     None => {}
                 }
             }
+            s.counts.add(&v);
             s.rows.push(row);
-            views.push(v);
         }
-        s.counts = Counts::of_views(&views);
         let twice: Vec<String> = seen
             .iter()
             .filter(|(_, &n)| n > 1)

@@ -196,6 +196,14 @@ class Object:
             vertices, faces = vertices.vertices, vertices.faces
         if faces is None:
             raise BadInputError("Object.from_arrays: faces missing (or give a trimesh.Trimesh)")
+        # Bounded before anything is copied: 10^8 vertices took the interpreter down.
+        for what, arr, most in (("vertices", vertices, MAX_ARRAY_VERTICES), ("faces", faces, MAX_ARRAY_FACES)):
+            n = int(np.shape(arr)[0]) if np.ndim(arr) >= 1 else 0
+            if n > most:
+                raise BadInputError(
+                    f"<arrays>: {n} {what}, more than the {most} a mesh may have "
+                    "(the faces of a 256 MiB binary STL)"
+                )
         v = np.ascontiguousarray(np.asarray(vertices, dtype=np.float64))
         f = np.asarray(faces)
         if f.size and not np.issubdtype(f.dtype, np.integer):
@@ -500,7 +508,51 @@ def _plain(value: Any) -> Any:
     raise TypeError(f"{type(value).__name__} is not a scenario value (a number, string, bool or list)")
 
 
+#: The most grasps ``candidates=`` may collect, and the most ``samples=`` (the CLI's caps).
+MAX_CANDIDATES = 1000
+MAX_SAMPLES = 1000
+#: The most vertices and faces :meth:`Object.from_arrays` takes: the faces of the largest mesh
+#: file read (a binary STL of 256 MiB), and three vertices each.
+MAX_ARRAY_FACES = ((256 << 20) - 84) // 50
+MAX_ARRAY_VERTICES = 3 * MAX_ARRAY_FACES
+
+
+def _count(label: str, key: str, value: Any, high: int) -> int:
+    """``value`` as a whole number in 1..=``high``, else a BadScenarioError naming ``key``
+    (``candidates=-1`` raised a bare OverflowError from the native call)."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise BadScenarioError(f"{label}: `{key}` must be a whole number in 1..={high}, got {value!r}")
+    if not 1 <= int(value) <= high:
+        raise BadScenarioError(f"{label}: `{key}` must be in 1..={high}, got {int(value)}")
+    return int(value)
+
+
+def _finite(label: str, table: Mapping[str, Any], section: str) -> None:
+    """Every number of ``table`` (a ``[planner]``, ``[sim]`` or ``[object]`` table, lists
+    included) finite, else a BadScenarioError naming the key (json.dumps said only "Out of
+    range float values are not JSON compliant")."""
+
+    def bad(v: Any) -> bool:
+        if isinstance(v, (list, tuple)):
+            return any(bad(x) for x in v)
+        if isinstance(v, np.ndarray):
+            return v.dtype.kind in "fc" and not bool(np.all(np.isfinite(v)))
+        if isinstance(v, (float, np.floating)):
+            return not np.isfinite(v)
+        return False
+
+    for key, v in table.items():
+        if bad(v):
+            raise BadScenarioError(f"{label}: `{section}.{key}` must be a finite number, got {v!r}")
+
+
 def _run(label: str, scenario: Dict[str, Any], **flags: Any) -> Dict[str, Any]:
+    for section in ("object", "planner", "sim"):
+        _finite(label, scenario.get(section, {}), section)
+    if "candidates" in flags:
+        flags["candidates"] = _count(label, "candidates", flags["candidates"], MAX_CANDIDATES)
+    if flags.get("max_checked") is not None:
+        flags["max_checked"] = _count(label, "max_checked", flags["max_checked"], 100)
     try:
         text = json.dumps(scenario, allow_nan=False, default=_plain)
     except (TypeError, ValueError) as e:
@@ -581,7 +633,7 @@ def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
     sim = dict(sim_params)
     sim["gravity"] = gravity
     if samples != 1:
-        sim["samples"] = samples
+        sim["samples"] = _count("grasp_sim.check", "samples", samples, MAX_SAMPLES)
     flags: Dict[str, Any] = {"payload": payload, "quality": quality}
     if given is not None:
         flags["given"] = given._given()
@@ -675,6 +727,7 @@ def run_scenario(path: PathLike, *, units: str = "mm", gravity: Optional[str] = 
     Raises:
         GraspSimError (a subclass): the line the CLI prints after ``grasp-sim: error:``.
     """
+    candidates = _count("grasp_sim.run_scenario", "candidates", candidates, MAX_CANDIDATES)
     line = _native.run_file(os.fspath(path), units, gravity, no_sim, payload, quality, candidates)
     report: Dict[str, Any] = json.loads(line)
     return report

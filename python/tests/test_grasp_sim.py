@@ -379,3 +379,19 @@ def test_another_thread_runs_while_a_check_runs(cup, cup_plan):
     # at its usual rate (millions a second) for the check's duration.
     assert seconds > 0.05, f"the check took {seconds:.3f} s: too short to tell"
     assert during > 10_000 * seconds, f"{during} ticks in {seconds:.3f} s"
+
+
+def test_bad_keyword_values_raise_naming_the_key(cup):
+    # Issue 56: candidates=-1 raised a bare OverflowError, inf and NaN a JSON message that
+    # named no key, and 10^8 vertices took the interpreter down.
+    with pytest.raises(gs.BadScenarioError, match=r"`candidates` must be in 1..=1000, got -1"):
+        gs.plan(cup, candidates=-1)
+    with pytest.raises(gs.BadScenarioError, match=r"`planner.sf_c` must be a finite number, got nan"):
+        gs.plan(cup, sf_c=float("nan"))
+    with pytest.raises(gs.BadScenarioError, match=r"`sim.duration_s` must be a finite number, got inf"):
+        gs.check(cup, duration_s=float("inf"))
+    with pytest.raises(gs.BadScenarioError, match=r"`samples`"):
+        gs.check(cup, samples=0)
+    big = np.broadcast_to(np.zeros(3), (10**8, 3))  # no memory of its own
+    with pytest.raises(gs.BadInputError, match=r"100000000 vertices, more than the"):
+        gs.Object.from_arrays(big, np.zeros((1, 3), dtype=np.int64))

@@ -80,12 +80,21 @@ impl Journal {
             crate::files::check_regular(path, crate::files::MAX_RESULTS_BYTES)
                 .map_err(|e| BatchError::io(path, e))?;
         }
-        let file = OpenOptions::new()
-            .read(true)
-            .append(true)
-            .create(true)
-            .open(path)
-            .map_err(|e| BatchError::io(path, e))?;
+        let mut options = OpenOptions::new();
+        options.read(true).append(true).create(true);
+        // A link or a FIFO put there since the check above: never followed, never waited on.
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::OpenOptionsExt;
+            options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+        }
+        let file = options.open(path).map_err(|e| BatchError::io(path, e))?;
+        if !file.metadata().is_ok_and(|m| m.is_file()) {
+            return Err(BatchError::io(
+                path,
+                std::io::Error::other("not a regular file: outputs replace regular files only"),
+            ));
+        }
         lock(&file, path)?;
         let bytes = crate::files::read_regular(path, crate::files::MAX_RESULTS_BYTES)
             .map_err(|e| BatchError::io(path, e))?;
@@ -215,17 +224,26 @@ impl RunLock {
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         let path = dir.join(format!(".{name}.lock"));
-        let file = OpenOptions::new()
-            .write(true)
-            .create(true)
-            .truncate(false)
-            .open(&path)
-            .map_err(|e| BatchError::io(&path, e))?;
-        lock(&file, out)?;
-        Ok(RunLock {
-            path,
-            file: Some(file),
-        })
+        // A run that ends removes its lock file while it holds it: a run that opened the name
+        // just before may then lock the removed file. It takes the lock only on the file the
+        // name still is, and tries again otherwise.
+        loop {
+            let mut options = OpenOptions::new();
+            options.write(true).create(true).truncate(false);
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::OpenOptionsExt;
+                options.custom_flags(libc::O_NOFOLLOW | libc::O_NONBLOCK);
+            }
+            let file = options.open(&path).map_err(|e| BatchError::io(&path, e))?;
+            lock(&file, out)?;
+            if same_file(&file, &path) {
+                return Ok(RunLock {
+                    path,
+                    file: Some(file),
+                });
+            }
+        }
     }
 }
 
@@ -258,6 +276,21 @@ fn lock(file: &File, path: &Path) -> Result<(), BatchError> {
 #[cfg(not(unix))]
 fn lock(_file: &File, _path: &Path) -> Result<(), BatchError> {
     Ok(())
+}
+
+/// Returns true if and only if `path` is (still) the file `file` has open.
+#[cfg(unix)]
+fn same_file(file: &File, path: &Path) -> bool {
+    use std::os::unix::fs::MetadataExt;
+    match (file.metadata(), std::fs::symlink_metadata(path)) {
+        (Ok(a), Ok(b)) => a.dev() == b.dev() && a.ino() == b.ino(),
+        _ => false,
+    }
+}
+
+#[cfg(not(unix))]
+fn same_file(_file: &File, _path: &Path) -> bool {
+    true
 }
 
 #[cfg(test)]

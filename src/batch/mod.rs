@@ -355,29 +355,35 @@ impl Counts {
     pub fn of_views<'a>(lines: impl IntoIterator<Item = &'a RecordView>) -> Counts {
         let mut c = Counts::default();
         for v in lines {
-            c.objects += 1;
-            if v.error.is_some() {
-                c.errors += 1;
-                continue;
-            }
-            if v.is_feasible() {
-                c.feasible += 1;
-            } else {
-                c.ungraspable += 1;
-            }
-            match v.sim.ran() {
-                Some(Verdict::Hold) => c.hold += 1,
-                Some(Verdict::Slip) => c.slip += 1,
-                Some(Verdict::Drop) => c.drop += 1,
-                None => {}
-            }
-            match v.expect.met {
-                Some(true) => c.met += 1,
-                Some(false) => c.not_met += 1,
-                None => c.unjudged += 1,
-            }
+            c.add(v);
         }
         c
+    }
+
+    /// Counts the outcome of one more line.
+    pub fn add(&mut self, v: &RecordView) {
+        let c = self;
+        c.objects += 1;
+        if v.error.is_some() {
+            c.errors += 1;
+            return;
+        }
+        if v.is_feasible() {
+            c.feasible += 1;
+        } else {
+            c.ungraspable += 1;
+        }
+        match v.sim.ran() {
+            Some(Verdict::Hold) => c.hold += 1,
+            Some(Verdict::Slip) => c.slip += 1,
+            Some(Verdict::Drop) => c.drop += 1,
+            None => {}
+        }
+        match v.expect.met {
+            Some(true) => c.met += 1,
+            Some(false) => c.not_met += 1,
+            None => c.unjudged += 1,
+        }
     }
 
     /// Counts the outcomes of `records`.

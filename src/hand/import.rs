@@ -242,10 +242,34 @@ fn shape_points(shape: &GeomShape) -> Vec<Point3<f64>> {
     out
 }
 
+/// The most links a hand's URDF or MJCF may have: a hand is tens of links (the bundled BH8 has
+/// 11); thousands behind fixed joints (issue 56) are no hand.
+pub const MAX_HAND_LINKS: usize = 2000;
+
 impl Tree {
-    /// The joint whose child is `link`, if any.
-    fn parent_joint(&self, link: usize) -> Option<usize> {
-        self.joints.iter().position(|j| j.child == link)
+    /// For each link, the joint whose child it is (the first, as the file lists them): a
+    /// table built once per walk, so that the walks are linear in the tree's size (each was a
+    /// scan of every joint per link, and the paths to every link cubic in their number:
+    /// thousands of fixed links, issue 56).
+    fn parents(&self) -> Vec<Option<usize>> {
+        let mut out = vec![None; self.links.len()];
+        for (k, j) in self.joints.iter().enumerate() {
+            if let Some(slot) = out.get_mut(j.child) {
+                slot.get_or_insert(k);
+            }
+        }
+        out
+    }
+
+    /// For each link, the joints whose parent it is, in file order.
+    fn children(&self) -> Vec<Vec<usize>> {
+        let mut out = vec![Vec::new(); self.links.len()];
+        for (k, j) in self.joints.iter().enumerate() {
+            if let Some(list) = out.get_mut(j.parent) {
+                list.push(k);
+            }
+        }
+        out
     }
 
     /// The joint named `name`.
@@ -255,13 +279,14 @@ impl Tree {
 
     /// The links reached from `link` through fixed joints only, `link` first.
     fn rigid_subtree(&self, link: usize) -> Vec<usize> {
+        let children = self.children();
         let mut out = vec![link];
         let mut k = 0;
         while k < out.len() {
             let at = out[k];
-            for j in &self.joints {
-                if j.parent == at && j.kind == JointKind::Fixed {
-                    out.push(j.child);
+            for &j in children.get(at).map(Vec::as_slice).unwrap_or_default() {
+                if self.joints[j].kind == JointKind::Fixed {
+                    out.push(self.joints[j].child);
                 }
             }
             k += 1;
@@ -283,8 +308,9 @@ impl Tree {
     /// # Errors
     /// None (every link has a parent: a loop) or several roots.
     fn root(&self) -> Result<usize, HandError> {
+        let parents = self.parents();
         let roots: Vec<usize> = (0..self.links.len())
-            .filter(|&l| self.parent_joint(l).is_none())
+            .filter(|&l| parents[l].is_none())
             .collect();
         match roots.as_slice() {
             [r] => Ok(*r),
@@ -305,11 +331,13 @@ impl Tree {
 
     /// The chain of links from the root to `link` (root first), or a loop error.
     fn path_to(&self, link: usize) -> Result<Vec<usize>, HandError> {
+        let parents = self.parents();
         let mut out = vec![link];
+        let mut on_path = std::collections::HashSet::from([link]);
         let mut at = link;
-        while let Some(j) = self.parent_joint(at) {
+        while let Some(j) = parents.get(at).copied().flatten() {
             at = self.joints[j].parent;
-            if out.contains(&at) {
+            if !on_path.insert(at) {
                 return Err(err(
                     &self.file,
                     format!(
@@ -330,11 +358,13 @@ impl Tree {
 fn poses_below(tree: &Tree, base: usize, q: &BTreeMap<usize, f64>) -> Vec<Option<Isometry3<f64>>> {
     let mut pose = vec![None; tree.links.len()];
     pose[base] = Some(Isometry3::identity());
+    let children = tree.children();
     let mut stack = vec![base];
     while let Some(at) = stack.pop() {
         let Some(p) = pose[at] else { continue };
-        for (k, j) in tree.joints.iter().enumerate() {
-            if j.parent != at || pose[j.child].is_some() {
+        for &k in &children[at] {
+            let j = &tree.joints[k];
+            if pose[j.child].is_some() {
                 continue;
             }
             let value = q.get(&k).copied().unwrap_or(0.0);
@@ -736,8 +766,27 @@ pub fn derive(
             format!("line {line}: {what} closes a loop: expected a tree of links (open chains)"),
         ));
     }
+    if tree.links.len() > MAX_HAND_LINKS {
+        return Err(err(
+            &tree.file,
+            format!(
+                "{} links, more than the {MAX_HAND_LINKS} a hand may have",
+                tree.links.len()
+            ),
+        ));
+    }
+    let parents = tree.parents();
     for l in 0..tree.links.len() {
-        tree.path_to(l)?;
+        // The loop check of `path_to`, on the table built once.
+        let mut on_path = std::collections::HashSet::from([l]);
+        let mut at = l;
+        while let Some(j) = parents[at] {
+            at = tree.joints[j].parent;
+            if !on_path.insert(at) {
+                tree.path_to(l)?;
+                break;
+            }
+        }
     }
     let (palm, starts) = find_palm(tree, mapping)?;
     let q = held_values(tree, mapping)?;

@@ -84,6 +84,16 @@ fn limit(path: &Path, l: roxmltree::Node) -> Result<Option<(f64, f64)>, HandErro
     let get = |a: &str| numbers(path, l, a, 1).map_err(|e| from_mesh(path, e));
     let lo = get("lower")?.map_or(0.0, |v| v[0]);
     let hi = get("upper")?.map_or(0.0, |v| v[0]);
+    // Reversed limits are a mistake to name, not a joint without limits (issue 56).
+    if lo > hi {
+        return Err(err(
+            path,
+            format!(
+                "line {}: <limit> lower=\"{lo}\" is above upper=\"{hi}\" (radians): the limits are reversed; swap them",
+                line_of(l)
+            ),
+        ));
+    }
     Ok((lo < hi).then_some((lo, hi)))
 }
 

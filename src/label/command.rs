@@ -243,6 +243,13 @@ impl Held {
 pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
     let template = request.worker.template()?;
     check_outputs(request)?;
+    // The output folders locked for this run: a second run into one is refused (issue 56).
+    let export = request.worker.export.as_ref().map(|e| e.dir.clone());
+    let _folders = [&request.npz, &export]
+        .into_iter()
+        .flatten()
+        .map(|d| crate::pipeline::lock_output_dir(d))
+        .collect::<anyhow::Result<Vec<_>>>()?;
     let mut items = batch::expand(&request.inputs)?;
     if let Some(shard) = request.shard {
         items = shard.of(&items);
@@ -759,7 +766,7 @@ fn write_npz(
             .scenario(item, template)
             .map_or(3, |s| s.hand.finger_list.len());
         let bytes = super::npz::npz(&lines, fingers)?;
-        let file = dir.join(format!("{}.npz", super::object::file_stem_of(&name)));
+        let file = dir.join(format!("{}.npz", crate::files::folder_name(&name)));
         journal::write_atomically(&file, &bytes)?;
     }
     Ok(())

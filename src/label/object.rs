@@ -586,7 +586,10 @@ fn pose_picks(
             let pose = line.pose_in(&plan.aligned);
             let shape = object.shape(&plan.aligned, &pose, hand);
             if let Some(e) = export.filter(|e| e.takes(&scenario.name, i)) {
-                let folder = e.dir.join(file_stem_of(&scenario.name)).join(i.to_string());
+                let folder = e
+                    .dir
+                    .join(crate::files::folder_name(&scenario.name))
+                    .join(i.to_string());
                 crate::export::write_mjcf(
                     &folder,
                     &crate::export::ExportInput {
@@ -680,26 +683,4 @@ pub fn check_lines(
     summary.holding = held;
     summary.wall_ms = t0.elapsed().as_secs_f64() * 1000.0;
     Ok(summary)
-}
-
-/// `name` as a file stem inside a folder: `/`, `\\`, control characters and a leading `.`
-/// replaced by `_`, at most 200 bytes.
-pub(crate) fn file_stem_of(name: &str) -> String {
-    let mut s: String = name
-        .chars()
-        .map(|c| {
-            if c == '/' || c == '\\' || c.is_control() {
-                '_'
-            } else {
-                c
-            }
-        })
-        .collect();
-    if s.is_empty() || s.starts_with('.') {
-        s.insert(0, '_');
-    }
-    while s.len() > 200 {
-        s.pop();
-    }
-    s
 }

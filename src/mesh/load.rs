@@ -344,6 +344,9 @@ fn check_obj_lines(text: &str, path: &Path) -> Result<(), MeshError> {
                 if corners.len() < 3 {
                     return Err(err(n, "a face needs at least three vertices".to_string()));
                 }
+                if corners.len() > MAX_POLYGON_VERTICES {
+                    return Err(err(n, polygon_too_large(corners.len())));
+                }
                 for c in corners {
                     let v = c.split('/').next().unwrap_or("");
                     let k: i64 = v
@@ -370,6 +373,34 @@ fn check_obj_lines(text: &str, path: &Path) -> Result<(), MeshError> {
         }
     }
     Ok(())
+}
+
+/// The sum of the absolute volumes of the tetrahedra of `mesh`'s triangles about its bounding
+/// box's centre `[mm³]`: the scale of the rounding in its signed volume.
+fn volume_terms(mesh: &Mesh) -> f64 {
+    let (lo, hi) = mesh.bounds();
+    let c = nalgebra::center(&lo, &hi);
+    (0..mesh.triangles.len())
+        .map(|t| {
+            let [a, b, d] = mesh.corners(t).map(|p| p - c);
+            a.dot(&b.cross(&d)).abs() / 6.0
+        })
+        .sum()
+}
+
+/// The most vertices one polygon of an OBJ or PLY face may have. A polygon is fanned into
+/// triangles from its first vertex, so a cap of n vertices becomes n − 2 slivers meeting at one
+/// point; a 100,000-vertex cap (issue 56) took the physics check's collider past 4 GB. 1024
+/// is far above any polygon a modeller writes (a cylinder's cap of 256 segments is common).
+pub const MAX_POLYGON_VERTICES: usize = 1024;
+
+/// The message for a face of `n` vertices, past [`MAX_POLYGON_VERTICES`].
+fn polygon_too_large(n: usize) -> String {
+    format!(
+        "a face of {n} vertices, more than the {MAX_POLYGON_VERTICES} a polygon may have \
+         (it is fanned into {} sliver triangles); triangulate it first",
+        n - 2
+    )
 }
 
 /// Triangles as a file has them, and whether it was binary.
@@ -586,6 +617,13 @@ fn ply_triangles(
                 "face {} has {} vertices; a face needs at least three",
                 f + 1,
                 idx.len()
+            )));
+        }
+        if idx.len() > MAX_POLYGON_VERTICES {
+            return Err(err(format!(
+                "face {}: {}",
+                f + 1,
+                polygon_too_large(idx.len())
             )));
         }
         if let Some(&bad) = idx
@@ -841,7 +879,12 @@ fn stl_binary(
     read_triangles(&patched, path, true)
 }
 
-/// The triangles of an ASCII STL; a grammar error names the first line that breaks it.
+/// The triangles of an ASCII STL, every `solid ... endsolid` block of it (CAD tools write an
+/// assembly as several; stl_io read the first only, half an object without a word); a grammar
+/// error names the first line that breaks it. The grammar: `solid [name]`, then per facet
+/// `facet normal x y z`, `outer loop`, three `vertex x y z`, `endloop`, `endfacet`, then
+/// `endsolid [name]`, and after it another solid or nothing but blank lines; `x y z` finite
+/// numbers (so `nan`, `inf` and `1e999` break it). Words are separated by any white space.
 fn stl_ascii(bytes: &[u8], path: &Path) -> Result<Vec<[[f32; 3]; 3]>, MeshError> {
     let p = || path.to_path_buf();
     let len = bytes.len() as u64;
@@ -854,92 +897,118 @@ fn stl_ascii(bytes: &[u8], path: &Path) -> Result<Vec<[[f32; 3]; 3]>, MeshError>
             len
         ),
     })?;
-    let original_text = text;
-    // stl_io wants "solid <name>"; a bare "solid" first line is valid STL too.
-    let trimmed = text.trim_start();
-    let first_line = trimmed.lines().next().unwrap_or("");
-    let text = if first_line.trim() == "solid" {
-        format!("solid unnamed{}", &trimmed[first_line.len()..])
-    } else {
-        trimmed.to_string()
-    };
-    read_triangles(text.as_bytes(), path, false).map_err(|e| match e {
-        // stl_io names no line: find the first line that breaks the grammar and name it.
-        MeshError::Ascii { path, detail } => MeshError::Ascii {
-            detail: match first_bad_ascii_line(original_text) {
-                // stl_io's own words add nothing to a non-finite number but its Rust
-                // names ("expected finite f32, got NaN which is Nan").
-                Some((n, line, want)) if detail.contains("expected finite f32") => {
-                    format!("line {n} ({line}): {want}, with finite numbers")
-                }
-                Some((n, line, want)) => format!("line {n} ({line}): {want} ({detail})"),
-                None => detail,
-            },
-            path,
-        },
-        e => e,
-    })
+    parse_ascii_stl(text).map_err(|detail| MeshError::Ascii { path: p(), detail })
 }
 
-/// The first line of an ASCII STL that breaks its grammar (`solid`, then per facet `facet
-/// normal x y z`, `outer loop`, three `vertex x y z`, `endloop`, `endfacet`, then `endsolid`;
-/// `x y z` finite numbers, so `nan`, `inf` and `1e999` break it too):
-/// its 1-based number, the line quoted (or "end of file"), and what was expected there. `None`
-/// when every line fits (the parser's complaint is then about something else).
-fn first_bad_ascii_line(text: &str) -> Option<(usize, String, String)> {
-    const STEPS: [(&str, usize); 7] = [
-        ("facet normal", 3),
-        ("outer loop", 0),
-        ("vertex", 3),
-        ("vertex", 3),
-        ("vertex", 3),
-        ("endloop", 0),
-        ("endfacet", 0),
-    ];
-    let mut lines = text
-        .lines()
-        .enumerate()
-        .map(|(i, l)| (i + 1, l))
-        .filter(|(_, l)| !l.trim().is_empty());
-    let quote = |l: &str| format!("`{}`", l.trim());
-    let mut last = match lines.next() {
-        Some((n, l)) if l.split_whitespace().next() == Some("solid") => n,
-        Some((n, l)) => return Some((n, quote(l), "expected `solid`".to_string())),
-        None => return None,
-    };
-    let mut step = 0;
-    for (n, l) in lines {
-        last = n;
-        let words: Vec<&str> = l.split_whitespace().collect();
-        if step == 0 && words.first() == Some(&"endsolid") {
-            return None;
+/// The facet lines of an ASCII STL: keyword words and how many numbers follow them.
+const FACET_LINES: [(&str, usize); 7] = [
+    ("facet normal", 3),
+    ("outer loop", 0),
+    ("vertex", 3),
+    ("vertex", 3),
+    ("vertex", 3),
+    ("endloop", 0),
+    ("endfacet", 0),
+];
+
+/// [`stl_ascii`]'s parser: the triangles of every solid, or the error's detail, `line N
+/// (`the line`): expected ...` (or `line N (end of file)`).
+fn parse_ascii_stl(text: &str) -> Result<Vec<[[f32; 3]; 3]>, String> {
+    let quote = |l: &str| {
+        let l = l.trim();
+        let short: String = l.chars().take(80).collect();
+        if short.len() < l.len() {
+            format!("`{short}...`")
+        } else {
+            format!("`{short}`")
         }
-        let (keyword, numbers) = STEPS[step];
-        let kw: Vec<&str> = keyword.split(' ').collect();
+    };
+    let mut out = Vec::new();
+    // Where in the grammar: None between solids, Some(step) inside one (step 0: a facet or
+    // `endsolid`).
+    let mut state: Option<usize> = None;
+    let mut solids = 0usize;
+    let mut corners = [[0f32; 3]; 3];
+    let mut last = 0usize;
+    for (i, line) in text.lines().enumerate() {
+        let n = i + 1;
+        let mut words = line.split_whitespace();
+        let Some(first) = words.next() else {
+            continue;
+        };
+        last = n;
+        let step = match state {
+            None => {
+                if first != "solid" {
+                    let want = if solids == 0 {
+                        "expected `solid`"
+                    } else {
+                        "expected `solid` or the end of the file after `endsolid`"
+                    };
+                    return Err(format!("line {n} ({}): {want}", quote(line)));
+                }
+                solids += 1;
+                state = Some(0);
+                continue;
+            }
+            Some(step) => step,
+        };
+        if step == 0 && first == "endsolid" {
+            state = None;
+            continue;
+        }
+        let (keyword, count) = FACET_LINES[step];
         let want = || {
-            let nums = [" x y z", ""][usize::from(numbers == 0)];
+            let nums = if count == 3 { " x y z" } else { "" };
             if step == 0 {
                 format!("expected `{keyword}{nums}` or `endsolid`")
             } else {
                 format!("expected `{keyword}{nums}`")
             }
         };
-        let fits = words.len() == kw.len() + numbers
-            && words[..kw.len()] == kw[..]
-            && words[kw.len()..]
-                .iter()
-                .all(|w| w.parse::<f32>().is_ok_and(f32::is_finite));
-        if !fits {
-            return Some((n, quote(l), want()));
+        let kw: Vec<&str> = keyword.split(' ').collect();
+        let mut all = std::iter::once(first).chain(words);
+        if !kw.iter().all(|k| all.next() == Some(*k)) {
+            return Err(format!("line {n} ({}): {}", quote(line), want()));
         }
-        step = (step + 1) % STEPS.len();
+        let numbers: Vec<&str> = all.collect();
+        if numbers.len() != count {
+            return Err(format!("line {n} ({}): {}", quote(line), want()));
+        }
+        let mut v = [0f32; 3];
+        for (k, w) in numbers.iter().enumerate() {
+            match w.parse::<f32>() {
+                Ok(x) if x.is_finite() => v[k] = x,
+                Ok(_) => {
+                    return Err(format!(
+                        "line {n} ({}): {}, with finite numbers",
+                        quote(line),
+                        want()
+                    ))
+                }
+                Err(e) => return Err(format!("line {n} ({}): {} ({e})", quote(line), want())),
+            }
+        }
+        if (2..=4).contains(&step) {
+            corners[step - 2] = v;
+        }
+        if step == FACET_LINES.len() - 1 {
+            out.push(corners);
+        }
+        state = Some((step + 1) % FACET_LINES.len());
     }
-    let want = if step == 0 {
-        "expected `endsolid`".to_string()
-    } else {
-        format!("expected `{}`", STEPS[step].0)
-    };
-    Some((last + 1, "end of file".to_string(), want))
+    match state {
+        None if solids > 0 => Ok(out),
+        None => Err(format!("line {} (end of file): expected `solid`", last + 1)),
+        Some(step) => {
+            let want = if step == 0 {
+                "expected `endsolid`".to_string()
+            } else {
+                format!("expected `{}`", FACET_LINES[step].0)
+            };
+            Err(format!("line {} (end of file): {want}", last + 1))
+        }
+    }
 }
 
 fn read_triangles(
@@ -1093,9 +1162,15 @@ pub(super) fn build(
         super::mass_properties(&mesh).volume_mm3
     };
     let mut was_inverted = false;
-    // A closed surface of any real size encloses a volume well above rounding noise.
+    // A closed surface of any real size encloses a volume well above rounding noise. The
+    // noise was taken from the bounding box alone (1e-9 of its diagonal cubed), which called a
+    // closed 10 km rod of 20 mm and a 0.001 × 1000 mm needle surfaces enclosing nothing
+    // (issue 56): a volume is kept as well when it stands above the rounding of its own
+    // terms, the triangles' tetrahedra about the box's centre (each good to the f32
+    // coordinates, some 1e-7 of itself), so that each reaches the check of what is wrong with
+    // it (too large for the planner's steps, too thin for the hand).
     let noise = 1e-9 * diag2.powf(1.5);
-    if volume.abs() <= noise {
+    if volume.abs() <= noise && volume.abs() <= 1e-5 * volume_terms(&mesh) {
         return Err(MeshError::NoVolume {
             path: p(),
             volume_mm3: volume,
@@ -1176,5 +1251,59 @@ fn fmt_mm(mm: f64) -> String {
         format!("{} m", fmt_size(mm / 1000.0))
     } else {
         format!("{} mm", fmt_size(mm))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `solid name`, one facet per triangle, `endsolid name`.
+    fn solid(name: &str, tris: &[[[f32; 3]; 3]]) -> String {
+        let mut s = format!("solid {name}\n");
+        for t in tris {
+            s += "  facet normal 0 0 0\n    outer loop\n";
+            for v in t {
+                s += &format!("      vertex {} {} {}\n", v[0], v[1], v[2]);
+            }
+            s += "    endloop\n  endfacet\n";
+        }
+        s + &format!("endsolid {name}\n")
+    }
+
+    /// Issue 56: an ASCII STL of two solids (an assembly) was read up to its first
+    /// `endsolid`; every solid is read, and what follows an `endsolid` must be another.
+    #[test]
+    fn every_solid_of_an_ascii_stl_is_read() {
+        let a = [[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]];
+        let b = [
+            [[0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [0.0, 1.0, 5.0]],
+            [[0.0, 0.0, 6.0], [1.0, 0.0, 6.0], [0.0, 1.5, 6.0]],
+        ];
+        let text = format!("{}\n{}", solid("a", &a), solid("b", &b));
+        let tris = parse_ascii_stl(&text).unwrap();
+        assert_eq!(tris.len(), 3);
+        assert_eq!(tris[0], a[0]);
+        assert_eq!(tris[2], b[1]);
+        // A bare `solid` and `endsolid`, tabs and CRLF line ends read too.
+        let crlf = "solid\r\n\tfacet normal 0 0 1\r\nouter loop\r\nvertex 0 0 0\r\nvertex 1 0 0\r\nvertex 0 1 0\r\nendloop\r\nendfacet\r\nendsolid\r\n";
+        assert_eq!(parse_ascii_stl(crlf).unwrap().len(), 1);
+        // Anything else after an `endsolid` is refused with its line.
+        let junk = format!("{}garbage here\n", solid("a", &a));
+        assert_eq!(
+            parse_ascii_stl(&junk).unwrap_err(),
+            "line 10 (`garbage here`): expected `solid` or the end of the file after `endsolid`"
+        );
+        // A second solid cut short names where.
+        let cut = format!("{}solid b\n  facet normal 0 0 1\n", solid("a", &a));
+        assert_eq!(
+            parse_ascii_stl(&cut).unwrap_err(),
+            "line 12 (end of file): expected `outer loop`"
+        );
+        assert_eq!(
+            parse_ascii_stl("solid a\nfacet normal 0 0 1\nouter loop\nvertex 0 0 inf\n")
+                .unwrap_err(),
+            "line 4 (`vertex 0 0 inf`): expected `vertex x y z`, with finite numbers"
+        );
     }
 }

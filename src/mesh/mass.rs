@@ -33,12 +33,14 @@ pub fn mass_properties(mesh: &Mesh) -> MassProperties {
 /// for a surface whose integral about the file's origin depends on the frame): the union's
 /// where several shells overlap, else `exact`.
 pub fn mass_properties_from(mesh: &Mesh, exact: MassProperties) -> MassProperties {
-    if mesh.shell_count() < 2 || exact.volume_mm3 <= 0.0 {
+    if exact.volume_mm3 <= 0.0 || !mesh.shells_may_overlap() {
         return exact;
     }
-    // Several shells: the surface integral adds their volumes, counting any overlap twice. Where
-    // the union (integrated over slices) is smaller by more than the integration's own error,
-    // the shells overlap and the union is the object.
+    // Shells whose bounds meet: the surface integral adds their volumes, counting any overlap
+    // twice. Where the union (integrated over slices) is smaller by more than the integration's
+    // own error, the shells overlap and the union is the object. Shells apart (an assembly's
+    // parts, issue 56) keep the exact sum: the slices' error at each shell's ends would pass
+    // for an overlap.
     let union = union_mass_properties(mesh, UNION_SLICES);
     if union.volume_mm3 < exact.volume_mm3 * (1.0 - OVERLAP_TOLERANCE) {
         union

@@ -452,6 +452,11 @@ impl Mesh {
 
     /// The number of shells: sets of triangles connected through shared vertices.
     pub fn shell_count(&self) -> usize {
+        self.shell_bounds().len()
+    }
+
+    /// The axis-aligned bounds (low and high corner) of each shell, in no set order.
+    pub fn shell_bounds(&self) -> Vec<(Point3<f64>, Point3<f64>)> {
         let mut parent: Vec<u32> = (0..self.vertices.len() as u32).collect();
         fn find(parent: &mut [u32], mut i: u32) -> u32 {
             while parent[i as usize] != i {
@@ -468,15 +473,42 @@ impl Mesh {
                 }
             }
         }
-        let mut used = vec![false; self.vertices.len()];
+        let mut shell = vec![u32::MAX; self.vertices.len()];
+        let mut bounds: Vec<(Point3<f64>, Point3<f64>)> = Vec::new();
         for t in &self.triangles {
             for &v in t {
-                used[v as usize] = true;
+                let root = find(&mut parent, v) as usize;
+                if shell[root] == u32::MAX {
+                    shell[root] = bounds.len() as u32;
+                    let p = self.vertices[v as usize];
+                    bounds.push((p, p));
+                }
+                let (lo, hi) = &mut bounds[shell[root] as usize];
+                let p = &self.vertices[v as usize];
+                *lo = lo.inf(p);
+                *hi = hi.sup(p);
             }
         }
-        (0..self.vertices.len() as u32)
-            .filter(|&v| used[v as usize] && find(&mut parent, v) == v)
-            .count()
+        bounds
+    }
+
+    /// Returns true if and only if the bounds of two shells meet, so their solids may overlap
+    /// (shells apart, as the parts of an assembly, cannot). Sorted by their low x and swept,
+    /// so the work is proportional to the shells and the pairs whose x ranges meet.
+    pub fn shells_may_overlap(&self) -> bool {
+        let mut b = self.shell_bounds();
+        b.sort_by(|p, q| p.0.x.total_cmp(&q.0.x));
+        for (i, (lo, hi)) in b.iter().enumerate() {
+            for (lo2, hi2) in &b[i + 1..] {
+                if lo2.x > hi.x {
+                    break;
+                }
+                if lo2.y <= hi.y && lo.y <= hi2.y && lo2.z <= hi.z && lo.z <= hi2.z {
+                    return true;
+                }
+            }
+        }
+        false
     }
 
     /// Closes every hole whose boundary loop spans at most `max_extent_mm` (the largest distance

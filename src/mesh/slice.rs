@@ -1125,10 +1125,12 @@ impl Slice {
         } else {
             self
         };
-        s.bridged_exact(gap_mm)
+        s.bridged_exact(gap_mm, tol_mm)
     }
 
-    fn bridged_exact(self, gap_mm: f64) -> Slice {
+    /// [`Slice::bridged`], where the pieces are many, the dents of their grown union within
+    /// `tol_mm` filled before it is shrunk back ([`close_gaps`]).
+    fn bridged_exact(self, gap_mm: f64, tol_mm: f64) -> Slice {
         let plane = self.plane;
         let outermost = self.outermost;
         let mut contours = self.contours;
@@ -1151,9 +1153,9 @@ impl Slice {
         if pieces_touch(&contours) {
             // Pieces that touch to round-off (two shells meeting face to face) are one piece,
             // as the union makes them where their edges coincide: merged, not bridged.
-            return finish(plane, close_gaps(contours, TOUCH_MM));
+            return finish(plane, close_gaps(contours, TOUCH_MM, 0.0));
         }
-        finish(plane, close_gaps(contours, 0.5 * gap_mm))
+        finish(plane, close_gaps(contours, 0.5 * gap_mm, tol_mm))
     }
 }
 
@@ -1340,15 +1342,34 @@ fn outward_offset(q: Point2<f64>, a: Point2<f64>, b: Point2<f64>) -> f64 {
 }
 
 /// Morphological closing of the closed contours by a polygon of inradius `r` (i_overlay's outline
-/// offset, grown then shrunk); open contours are kept as they are.
-fn close_gaps(contours: Vec<Contour>, r: f64) -> Vec<Contour> {
+/// offset, grown then shrunk), where the contours are many the dents of the grown union within
+/// `dent_mm` filled before the shrink ([`super::polygon_limits::close_rings`]: a bound on the
+/// shrink's work); open contours are kept as they are.
+fn close_gaps(contours: Vec<Contour>, r: f64, dent_mm: f64) -> Vec<Contour> {
     // Bevel joins: the structuring element is then a polygon rather than a disc (convex corners
     // come back exactly, a bridged gap's edge is straight to within r (1 - cos(turn / 2))), and
     // the offset makes no arc points, which on a slice of many pieces costs several times more
     // than the rest of the planner.
     map_closed(contours, |rings| {
-        super::polygon_limits::close_rings(rings, r)
+        super::polygon_limits::close_rings(rings, r, |grown| fill_ring_dents(grown, dent_mm))
     })
+}
+
+/// Each ring with its dents within `tol_mm` filled ([`Contour::simplified`]: points are only
+/// dropped where that moves the outline outward, into the empty side); `tol_mm <= 0` keeps
+/// the rings as they are.
+fn fill_ring_dents(rings: Vec<Vec<[f64; 2]>>, tol_mm: f64) -> Vec<Vec<[f64; 2]>> {
+    if tol_mm.is_nan() || tol_mm <= 0.0 {
+        return rings;
+    }
+    rings
+        .into_iter()
+        .map(|ring| {
+            let points = ring.iter().map(|&[x, y]| Point2::new(x, y)).collect();
+            let c = Contour::from_polyline(points, true).simplified(tol_mm);
+            c.points.iter().map(|p| [p.x, p.y]).collect()
+        })
+        .collect()
 }
 
 #[cfg(test)]

@@ -139,10 +139,11 @@ pub fn scenario_for(item: &Item, template: &Scenario) -> Result<Scenario, Error>
         Item::Mesh(p) => {
             let mut s = template.clone();
             s.object.mesh = p.clone();
-            s.name = p
-                .file_stem()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default();
+            s.name = crate::files::folder_name(
+                &p.file_stem()
+                    .map(|n| n.to_string_lossy().into_owned())
+                    .unwrap_or_default(),
+            );
             Ok(s)
         }
     }

@@ -133,7 +133,7 @@ fn run_bounded(
 ) -> Result<(crate::report::RunReport, Option<String>), Failure> {
     let (send, receive) = std::sync::mpsc::channel();
     let worker = std::thread::Builder::new()
-        .name(format!("input {}", scenario.name))
+        .name(format!("input {}", scenario.name.replace('\0', "\\0")))
         .stack_size(256 << 20)
         .spawn(move || {
             let r = run(&scenario, &options).map(|r| (r, options.folder));

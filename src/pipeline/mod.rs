@@ -30,6 +30,17 @@ pub enum Error {
     /// A grasp given to check ([`RunOptions::given`]) that cannot be posed.
     #[error("given grasp: {0}")]
     Given(String),
+    /// An output folder's name (a scenario's `name`) that would not stay inside the folder
+    /// given (`../x`, an absolute path, NUL): nothing is written.
+    #[error("{dir}: the run's name {name:?} {problem}: not a folder name inside it, nothing written", dir = .dir.display())]
+    OutputName {
+        /// The output folder given.
+        dir: std::path::PathBuf,
+        /// The name.
+        name: String,
+        /// What is wrong with it ([`crate::files::folder_name_problem`]).
+        problem: String,
+    },
 }
 
 /// A grasp given from outside the planner, to check as it is: a learned model's, another
@@ -361,13 +372,42 @@ fn posed(
             GraspSource::Given,
             None,
         )),
-        None => sim_pose(
-            scenario,
-            checked_on,
-            &selection.axes[0].graded,
-            selection.chosen().map(|c| (&c.grasp, c.check.clone())),
-        ),
+        None => {
+            let graded = &selection.axes[0].graded;
+            check_override_index(scenario, graded)?;
+            sim_pose(
+                scenario,
+                checked_on,
+                graded,
+                selection.chosen().map(|c| (&c.grasp, c.check.clone())),
+            )
+        }
     })
+}
+
+/// `[sim] override_index` against the indexed elevations the planner found: 1 to their count
+/// (it was clamped into that range before issue 56, while 0 and −1 were refused).
+///
+/// # Errors
+/// [`scenario::ScenarioError::Invalid`] naming the key and the valid range.
+fn check_override_index(scenario: &Scenario, graded: &plan::GradedDomain) -> Result<(), Error> {
+    let input = &scenario.sim.input;
+    let (Some(_), Some(index)) = (&input.override_angles, input.override_index) else {
+        return Ok(());
+    };
+    let n = graded.domain.elevations.len();
+    if (1..=n).contains(&index) {
+        return Ok(());
+    }
+    Err(Error::Scenario(scenario::ScenarioError::Invalid {
+        path: scenario.path.clone(),
+        key: "sim.override_index".to_string(),
+        problem: if n == 0 {
+            format!("is {index}, but the object has no indexed elevation to place the palm on")
+        } else {
+            format!("must be in 1..={n} (the object's indexed elevations), got {index}")
+        },
+    }))
 }
 
 /// Writes the URDF and MJCF exports and the `--report` folder that `options` ask for, from
@@ -380,6 +420,19 @@ pub fn write_outputs(
     scenario: &Scenario,
     options: &RunOptions,
 ) -> Result<(), Error> {
+    // Every output folder is the folder given joined with one folder name: checked here, for
+    // any scenario (a library caller's too), before anything is written.
+    let folder = options.folder_for(scenario);
+    if let Some(problem) = crate::files::folder_name_problem(folder) {
+        let given = [&options.export_urdf, &options.export_mjcf, &options.report];
+        if let Some(dir) = given.into_iter().flatten().next() {
+            return Err(Error::OutputName {
+                dir: dir.clone(),
+                name: folder.to_string(),
+                problem,
+            });
+        }
+    }
     if let Some(dir) = &options.export_urdf {
         export::write_urdf(
             &dir.join(options.folder_for(scenario)),
@@ -640,10 +693,33 @@ pub fn check_output_dir(dir: &std::path::Path) -> anyhow::Result<()> {
     }
     std::fs::create_dir_all(dir)
         .with_context(|| format!("{}: cannot create folder", dir.display()))?;
-    let probe = dir.join(".grasp-sim-write-test");
-    std::fs::write(&probe, b"")
-        .and_then(|()| std::fs::remove_file(&probe))
-        .with_context(|| format!("{}: cannot write in this folder", dir.display()))
+    crate::files::check_writable_dir(dir).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: cannot write in this folder: {}",
+            dir.display(),
+            crate::messages::io_message(&e)
+        )
+    })
+}
+
+/// [`check_output_dir`], then the folder locked for this run ([`crate::files::FolderLock`]):
+/// a second run into the same folder is refused with the lock's message while this one runs.
+///
+/// # Errors
+/// [`check_output_dir`]'s, or another run holding the folder, or the lock file not made.
+pub fn lock_output_dir(dir: &std::path::Path) -> anyhow::Result<crate::files::FolderLock> {
+    check_output_dir(dir)?;
+    crate::files::FolderLock::take(dir).map_err(|e| {
+        if e.kind() == std::io::ErrorKind::WouldBlock {
+            anyhow::anyhow!("{}: {e}", dir.display())
+        } else {
+            anyhow::anyhow!(
+                "{}: cannot lock the folder: {}",
+                dir.display(),
+                crate::messages::io_message(&e)
+            )
+        }
+    })
 }
 
 /// Checks that `file` can be written later: its folder exists and takes a file.
@@ -651,7 +727,6 @@ pub fn check_output_dir(dir: &std::path::Path) -> anyhow::Result<()> {
 /// # Errors
 /// No such folder, a folder where the file should be, or a folder that cannot be written in.
 pub fn check_output_file(file: &std::path::Path) -> anyhow::Result<()> {
-    use anyhow::Context;
     let dir = file
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
@@ -673,8 +748,12 @@ pub fn check_output_file(file: &std::path::Path) -> anyhow::Result<()> {
     if let Err(e) = crate::files::check_replaceable(file) {
         anyhow::bail!("{}: {e}", file.display());
     }
-    let probe = dir.join(".grasp-sim-write-test");
-    std::fs::write(&probe, b"")
-        .and_then(|()| std::fs::remove_file(&probe))
-        .with_context(|| format!("{}: cannot write in {}", file.display(), dir.display()))
+    crate::files::check_writable_dir(dir).map_err(|e| {
+        anyhow::anyhow!(
+            "{}: cannot write in {}: {}",
+            file.display(),
+            dir.display(),
+            crate::messages::io_message(&e)
+        )
+    })
 }

@@ -79,6 +79,10 @@ impl Default for PlannerParams {
     }
 }
 
+/// The most curvature segments accepted (thesis default 3): each counts segments of a slice
+/// before and after a touch point.
+pub const MAX_CURVATURE_SEGMENTS: usize = 1000;
+
 /// The finest HeightStep accepted `[mm]` (thesis default 2.5): 1e-6 mm ran out of memory.
 pub const MIN_HEIGHT_STEP_MM: f64 = 0.1;
 /// The finest AngularStep accepted `[deg]` (thesis default 10): 1e-6° ran out of memory.
@@ -119,20 +123,27 @@ impl PlannerParams {
         if !(0.0..=1.0).contains(&p.sf_c) {
             return Err(("planner.sf_c", format!("must be in [0, 1], got {}", p.sf_c)));
         }
+        // The friction is checked before (`object.friction`, in [0.01, 2]): a cone too narrow
+        // for the deviation is the deviation's to fit, and the message says both.
         let friction_cone_deg = friction.atan().to_degrees();
         if !(p.vertical_deviation_deg >= 0.0 && p.vertical_deviation_deg < friction_cone_deg) {
             return Err((
                 "planner.vertical_deviation_deg",
                 format!(
-                    "must be in [0, {friction_cone_deg:.1}) (below the friction cone of mu = {}), got {}",
-                    friction, p.vertical_deviation_deg
+                    "must be in [0, {friction_cone_deg:.1}) (below the friction cone of object.friction = {}), got {}; lower it or raise object.friction above {:.3}",
+                    friction,
+                    p.vertical_deviation_deg,
+                    p.vertical_deviation_deg.to_radians().tan()
                 ),
             ));
         }
-        if p.curvature_segments == 0 {
+        if !(1..=MAX_CURVATURE_SEGMENTS).contains(&p.curvature_segments) {
             return Err((
                 "planner.curvature_segments",
-                "must be at least 1".to_string(),
+                format!(
+                    "must be in 1..={MAX_CURVATURE_SEGMENTS}, got {}",
+                    p.curvature_segments
+                ),
             ));
         }
         for (key, v) in keyed!("planner", p; sf_centred, sf_opposed, sf_spread, sf_margin,) {
@@ -144,14 +155,18 @@ impl PlannerParams {
                 ));
             }
         }
-        for (key, v) in keyed!("planner", p;
+        // Each number's physical range, stated (issue 56).
+        for ((key, v), (hi, unit)) in keyed!("planner", p;
             magnify_factor,
             joint_deviation_theta1_deg,
             joint_deviation_theta2_deg,
             pitch_range_deg,
-        ) {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err((key, format!("must be zero or positive, got {v}")));
+        )
+        .into_iter()
+        .zip([(1000.0, ""), (180.0, "°"), (180.0, "°"), (90.0, "°")])
+        {
+            if !(v.is_finite() && (0.0..=hi).contains(&v)) {
+                return Err((key, format!("must be in [0, {hi}]{unit}, got {v}")));
             }
         }
         Ok(())

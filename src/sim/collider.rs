@@ -7,7 +7,7 @@
 use super::convert;
 use crate::mesh::Mesh;
 use nalgebra::Vector3;
-use rapier3d::parry::transformation::vhacd::VHACDParameters;
+use rapier3d::parry::transformation::vhacd::{VHACDParameters, VHACD};
 use rapier3d::prelude::*;
 
 /// How the object's collider was made.
@@ -294,15 +294,19 @@ impl ObjectShape {
             let hull_mm3 = own.map_or(parry_mm3, |m| m.volume_mm3);
             if hull_mm3 <= volume_mm3 * 1.02 {
                 let misweighed = (parry_mm3 - hull_mm3).abs() > MISWEIGHED_FRACTION * hull_mm3;
-                let rebuilt = (misweighed || bent_shape_m(&hull) > MERGED_FACE_TOLERANCE_M)
-                    .then(|| coarsened_hull(vertices, triangles))
-                    .flatten();
+                let usable = usable_shape(&hull);
+                let rebuilt =
+                    (misweighed || !usable || bent_shape_m(&hull) > MERGED_FACE_TOLERANCE_M)
+                        .then(|| coarsened_hull(vertices, triangles, usable))
+                        .flatten();
                 // A polyhedron that misweighs the hull and cannot be rebuilt keeps its contact
                 // geometry, and the body takes the hull's own mass distribution.
                 let mesh_mass = (misweighed && rebuilt.is_none()).then_some(own).flatten();
                 let (shape, coarsened_from) = match rebuilt {
                     Some((coarse, from)) => (coarse, Some(from)),
-                    None => (hull, None),
+                    None if usable => (hull, None),
+                    // No hull the scene can use: the decomposition, its parts checked.
+                    None => return Self::decomposition(mesh, &points, is_revolution),
                 };
                 return ObjectShape {
                     shape,
@@ -311,6 +315,26 @@ impl ObjectShape {
                     is_revolution,
                     coarsened_from,
                     mesh_mass,
+                    hull_off_mm: None,
+                    hull_planes: Some(hull_planes(vertices, triangles).into()),
+                };
+            }
+        } else if let Some((vertices, triangles)) = &hull_mesh {
+            // parry made no polyhedron of the hull at all (a cylinder of 4000 segments, whose
+            // caps' fans it cannot join): of a convex mesh, the hull rebuilt from its planes.
+            let convex =
+                hull_mass(vertices, triangles).is_some_and(|m| m.volume_mm3 <= volume_mm3 * 1.02);
+            if let Some((shape, from)) = convex
+                .then(|| coarsened_hull(vertices, triangles, false))
+                .flatten()
+            {
+                return ObjectShape {
+                    shape,
+                    kind: ColliderKind::ConvexHull,
+                    parts: 1,
+                    is_revolution,
+                    coarsened_from: Some(from),
+                    mesh_mass: None,
                     hull_off_mm: None,
                     hull_planes: Some(hull_planes(vertices, triangles).into()),
                 };
@@ -325,7 +349,24 @@ impl ObjectShape {
             resolution: 64,
             ..VHACDParameters::default()
         };
-        let shape = SharedShape::convex_decomposition_with_params(points, &mesh.triangles, &params);
+        // parry's `SharedShape::convex_decomposition_with_params`, without its panic on a
+        // decomposition none of whose parts it makes a polyhedron of (a cylinder of 4000
+        // segments), and with each part checked.
+        let decomposition = VHACD::decompose(&params, points, &mesh.triangles, true);
+        let parts: Vec<(Pose, SharedShape)> = decomposition
+            .compute_exact_convex_hulls(points, &mesh.triangles)
+            .into_iter()
+            .filter_map(|(v, t)| SharedShape::convex_mesh(v, &t).map(|c| (Pose::IDENTITY, c)))
+            .collect();
+        let shape = (!parts.is_empty())
+            .then(|| usable_parts(&SharedShape::compound(parts)))
+            .flatten()
+            .or_else(|| {
+                // No part: the hull of the whole mesh rebuilt from its planes, else its box.
+                let (v, t) = rapier3d::parry::transformation::try_convex_hull(points).ok()?;
+                coarsened_hull(&v, &t, false).map(|(h, _)| h)
+            })
+            .unwrap_or_else(|| bounding_box(points));
         let parts = shape.as_compound().map_or(1, |c| c.shapes().len());
         ObjectShape {
             shape,
@@ -499,6 +540,67 @@ fn bent_face_m(poly: &rapier3d::parry::shape::ConvexPolyhedron) -> f32 {
         .fold(0.0f32, f32::max)
 }
 
+/// Returns true if and only if the physics scene can use `poly`: at least four points and four
+/// faces, each face with at least three vertices. parry's polyhedron of a hull merges
+/// neighbouring triangles whose normals differ by less than about 1.5° ([`bent_face_m`]); on a
+/// surface tessellated finer than that everywhere (a UV sphere of 300 × 150 segments, 60 mm)
+/// every edge is merged away and no face is left, and the contact queries on it index an
+/// empty face list.
+fn usable_polyhedron(poly: &rapier3d::parry::shape::ConvexPolyhedron) -> bool {
+    poly.points().len() >= 4
+        && poly.faces().len() >= 4
+        && poly.faces().iter().all(|f| f.num_vertices_or_edges >= 3)
+}
+
+/// [`usable_polyhedron`] of a convex polyhedron, or of every part of a compound with parts;
+/// true for any other shape.
+fn usable_shape(shape: &SharedShape) -> bool {
+    if let Some(poly) = shape.as_convex_polyhedron() {
+        return usable_polyhedron(poly);
+    }
+    shape
+        .as_compound()
+        .is_none_or(|c| !c.shapes().is_empty() && c.shapes().iter().all(|(_, p)| usable_shape(p)))
+}
+
+/// A convex decomposition with each part the scene cannot use ([`usable_polyhedron`]) rebuilt
+/// from its face planes ([`coarsened_hull`]), or left out where that fails; `None` when no part
+/// is left. The decomposition itself when every part is usable.
+fn usable_parts(shape: &SharedShape) -> Option<SharedShape> {
+    if usable_shape(shape) {
+        return Some(shape.clone());
+    }
+    let compound = shape.as_compound()?;
+    let parts: Vec<(Pose, SharedShape)> = compound
+        .shapes()
+        .iter()
+        .filter_map(|(pose, part)| {
+            if usable_shape(part) {
+                return Some((*pose, part.clone()));
+            }
+            let points = part.as_convex_polyhedron()?.points();
+            let (v, t) = rapier3d::parry::transformation::try_convex_hull(points).ok()?;
+            coarsened_hull(&v, &t, false).map(|(h, _)| (*pose, h))
+        })
+        .collect();
+    (!parts.is_empty()).then(|| SharedShape::compound(parts))
+}
+
+/// The box bounding `points` `[m]`: the collider of last resort, where neither the hull nor any
+/// part of the decomposition is a polyhedron the scene can use (none is known; the collider's
+/// report then says `1 parts` of a decomposition).
+fn bounding_box(points: &[Vector]) -> SharedShape {
+    let first = points.first().copied().unwrap_or(Vector::ZERO);
+    let (lo, hi) = points
+        .iter()
+        .fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let half = ((hi - lo) * 0.5).max(Vector::splat(1e-6));
+    SharedShape::compound(vec![(
+        Pose::from_translation((lo + hi) * 0.5),
+        SharedShape::cuboid(half.x, half.y, half.z),
+    )])
+}
+
 /// [`bent_face_m`] of a shape that is a convex polyhedron (0 for any other).
 fn bent_shape_m(shape: &SharedShape) -> f32 {
     shape.as_convex_polyhedron().map_or(0.0, bent_face_m)
@@ -526,7 +628,16 @@ const MAX_OUTER_STANDOFF_M: f64 = 5e-5;
 /// two of its faces meet at 2° or more, so parry keeps them apart. Returns it with the full
 /// hull's vertex count, or `None` where the full hull needs no rebuilding (every thesis object)
 /// or the rebuilt one would stand off by more than [`MAX_OUTER_STANDOFF_M`].
-fn coarsened_hull(vertices: &[Vector], triangles: &[[u32; 3]]) -> Option<(SharedShape, usize)> {
+///
+/// `strict`: the rebuilt hull must hold every vertex to [`SUPPORT_TOLERANCE_M`]; otherwise
+/// (for a hull parry kept no usable polyhedron of, [`usable_polyhedron`]) to
+/// [`MERGED_FACE_TOLERANCE_M`], the contact error the scene allows anyway: a UV sphere of
+/// 300 × 150 segments leaves a vertex 0.14 µm outside the rebuilt hull.
+fn coarsened_hull(
+    vertices: &[Vector],
+    triangles: &[[u32; 3]],
+    strict: bool,
+) -> Option<(SharedShape, usize)> {
     let v64: Vec<Vector3<f64>> = vertices
         .iter()
         .map(|v| Vector3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z)))
@@ -549,10 +660,15 @@ fn coarsened_hull(vertices: &[Vector], triangles: &[[u32; 3]]) -> Option<(Shared
     let corners = plane_corners(&kept, &true_planes, &centre)?;
     let rebuilt = SharedShape::convex_hull(&corners)?;
     let poly = rebuilt.as_convex_polyhedron()?;
-    if poly.points().len() < 4 || bent_face_m(poly) > MERGED_FACE_TOLERANCE_M {
+    if !usable_polyhedron(poly) || bent_face_m(poly) > MERGED_FACE_TOLERANCE_M {
         return None;
     }
-    holds_all(poly, &v64).then_some((rebuilt, vertices.len()))
+    let tolerance = if strict {
+        SUPPORT_TOLERANCE_M
+    } else {
+        f64::from(MERGED_FACE_TOLERANCE_M)
+    };
+    holds_all(poly, &v64, tolerance).then_some((rebuilt, vertices.len()))
 }
 
 /// The face planes of the hull `(area, unit normal, offset from the centre)` that
@@ -569,18 +685,148 @@ fn kept_planes(
     planes.sort_by(|a, b| b.0.total_cmp(&a.0).then(a.2.total_cmp(&b.2)));
     let cos_min = MIN_FACE_ANGLE_RAD.cos();
     let mut kept: Vec<(Vector3<f64>, f64)> = Vec::new();
+    // The kept normals by cell of side NORMAL_CELL: two unit normals less than 2° apart are
+    // less than 0.035 apart, so in the same or a neighbouring cell.
+    let mut near: std::collections::HashMap<[i64; 3], Vec<usize>, foldhash::fast::FixedState> =
+        Default::default();
+    let vertices = Clusters::of_points(v64);
     // A sliver triangle of nearly collinear points (a side's rings, one above the other) has a
     // normal of rounding noise: its plane is kept only if the whole hull is on its inner side.
     let supporting = |n: &Vector3<f64>, d: f64| {
-        v64.iter()
-            .all(|v| n.dot(&(v - centre)) <= d + SUPPORT_TOLERANCE_M)
+        vertices.all(n, *centre, d + SUPPORT_TOLERANCE_M, |i| {
+            n.dot(&(v64[i] - centre)) <= d + SUPPORT_TOLERANCE_M
+        })
     };
     for (_, n, d) in planes {
-        if kept.iter().all(|(m, _)| m.dot(&n) < cos_min) && supporting(&n, d) {
+        let cell = normal_cell(&n);
+        let apart = neighbours(cell).all(|c| {
+            near.get(&c)
+                .is_none_or(|ks| ks.iter().all(|&k| kept[k].0.dot(&n) < cos_min))
+        });
+        if apart && supporting(&n, d) {
+            near.entry(cell).or_default().push(kept.len());
             kept.push((n, d));
         }
     }
     kept
+}
+
+/// The side of the cells [`kept_planes`] and [`plane_corners`] group unit normals in: more
+/// than the 0.035 between two normals 2° apart.
+const NORMAL_CELL: f64 = 0.05;
+
+/// The cell of side [`NORMAL_CELL`] that holds the unit normal `n`.
+fn normal_cell(n: &Vector3<f64>) -> [i64; 3] {
+    [n.x, n.y, n.z].map(|c| (c / NORMAL_CELL).floor() as i64)
+}
+
+/// `cell` and its 26 neighbours.
+fn neighbours(cell: [i64; 3]) -> impl Iterator<Item = [i64; 3]> {
+    (0..27).map(move |k| {
+        [
+            cell[0] + k % 3 - 1,
+            cell[1] + (k / 3) % 3 - 1,
+            cell[2] + k / 9 - 1,
+        ]
+    })
+}
+
+/// Vectors grouped in cells for bounding a linear function over each group at once (the
+/// convex hull rebuild's tests of every vertex against a plane, and of every plane against a
+/// corner, were each a product of two counts: 75 s for a 600 × 300 sphere): a group's members
+/// `v` lie within `radius` of its `centre`, so `n·v ≤ n·centre + |n|·radius` (Cauchy–Schwarz),
+/// and each carries a value (a plane's offset) of which the group keeps the least. A test of
+/// every member then looks only at the groups whose bound does not settle it, so its answer is
+/// the test's over every member, exactly.
+struct Clusters {
+    groups: Vec<Cluster>,
+}
+
+/// One group of [`Clusters`].
+struct Cluster {
+    centre: Vector3<f64>,
+    radius: f64,
+    least: f64,
+    members: Vec<usize>,
+}
+
+impl Clusters {
+    /// `items` (vector, value) grouped in cubes of side `cell`, in index order within a group.
+    fn new(items: &[(Vector3<f64>, f64)], cell: f64) -> Clusters {
+        let mut cells: std::collections::BTreeMap<[i64; 3], Vec<usize>> = Default::default();
+        for (i, (v, _)) in items.iter().enumerate() {
+            let key = [v.x, v.y, v.z].map(|c| {
+                let k = (c / cell).floor();
+                if k.is_finite() {
+                    k as i64
+                } else {
+                    0
+                }
+            });
+            cells.entry(key).or_default().push(i);
+        }
+        let groups = cells
+            .into_values()
+            .map(|members| {
+                let centre = members.iter().map(|&i| items[i].0).sum::<Vector3<f64>>()
+                    / members.len() as f64;
+                let radius = members
+                    .iter()
+                    .map(|&i| (items[i].0 - centre).norm())
+                    .fold(0.0, f64::max);
+                let least = members
+                    .iter()
+                    .map(|&i| items[i].1)
+                    .fold(f64::INFINITY, f64::min);
+                Cluster {
+                    centre,
+                    radius,
+                    least,
+                    members,
+                }
+            })
+            .collect();
+        Clusters { groups }
+    }
+
+    /// Points grouped in cells of about 16 points of a surface.
+    fn of_points(points: &[Vector3<f64>]) -> Clusters {
+        let items: Vec<(Vector3<f64>, f64)> = points.iter().map(|p| (*p, 0.0)).collect();
+        let (lo, hi) = points.iter().fold(
+            (
+                Vector3::repeat(f64::INFINITY),
+                Vector3::repeat(f64::NEG_INFINITY),
+            ),
+            |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+        );
+        let extent = (hi - lo).max();
+        let across = (points.len() as f64 / 96.0).sqrt().clamp(1.0, 64.0);
+        let cell = if extent.is_finite() && extent > 0.0 {
+            extent / across
+        } else {
+            1.0
+        };
+        Clusters::new(&items, cell)
+    }
+
+    /// Whether `test` holds of every member whose group's bound on `n·(v − origin)` exceeds
+    /// `limit` (with a margin for rounding): of every member, when `test` is `n·(v − origin) ≤
+    /// limit` or implied by it.
+    fn all(
+        &self,
+        n: &Vector3<f64>,
+        origin: Vector3<f64>,
+        limit: f64,
+        mut test: impl FnMut(usize) -> bool,
+    ) -> bool {
+        let norm = n.norm();
+        self.groups.iter().all(|g| {
+            let at = n.dot(&(g.centre - origin));
+            let bound = at + norm * g.radius;
+            let margin = 1e-12 * (1.0 + at.abs() + norm * g.radius);
+            bound + margin <= limit || g.members.iter().all(|&i| test(i))
+        })
+    }
 }
 
 /// The corners of the intersection of the `kept` half-spaces (about `centre`) `[m]`, found
@@ -607,12 +853,28 @@ fn plane_corners(
         .enumerate()
         .map(|(k, p)| (p.to_array().map(f32::to_bits), k))
         .collect();
-    // How far a point (relative to the centre) stands outside the true hull `[m]`.
-    let standoff = |x: &Vector3<f64>| {
-        true_planes
+    // Whether a point (relative to the centre) stands outside the true hull by at most
+    // MAX_OUTER_STANDOFF_M: n·x − d ≤ MAX for every plane, so n·x ≤ d + MAX, bounded by each
+    // group of normals with its least offset.
+    let planes = Clusters::new(
+        &true_planes
             .iter()
-            .map(|(_, n, d)| n.dot(x) - d)
-            .fold(0.0f64, f64::max)
+            .map(|(_, n, d)| (*n, *d))
+            .collect::<Vec<_>>(),
+        NORMAL_CELL,
+    );
+    let close = |x: &Vector3<f64>| {
+        let norm = x.norm();
+        planes.groups.iter().all(|g| {
+            let at = g.centre.dot(x);
+            let bound = at + g.radius * norm - g.least;
+            let margin = 1e-12 * (1.0 + at.abs() + g.radius * norm + g.least.abs());
+            bound + margin <= MAX_OUTER_STANDOFF_M
+                || g.members.iter().all(|&i| {
+                    let (_, n, d) = true_planes[i];
+                    n.dot(x) - d <= MAX_OUTER_STANDOFF_M
+                })
+        })
     };
     let mut corners: Vec<Vector> = Vec::new();
     for t in &dual_triangles {
@@ -631,7 +893,7 @@ fn plane_corners(
         let Some(x) = m.lu().solve(&Vector3::new(p1.1, p2.1, p3.1)) else {
             continue;
         };
-        if x.iter().all(|c| c.is_finite()) && standoff(&x) <= MAX_OUTER_STANDOFF_M {
+        if x.iter().all(|c| c.is_finite()) && close(&x) {
             let p = x + centre;
             corners.push(Vector::new(p.x as f32, p.y as f32, p.z as f32));
         }
@@ -641,9 +903,14 @@ fn plane_corners(
 
 /// Returns true if and only if `poly` holds every point of `v64` `[m]` (no corner lost to the
 /// skips of [`plane_corners`]): every point inside every face plane parry made, to
-/// [`SUPPORT_TOLERANCE_M`].
-fn holds_all(poly: &rapier3d::parry::shape::ConvexPolyhedron, v64: &[Vector3<f64>]) -> bool {
+/// `tolerance` `[m]`.
+fn holds_all(
+    poly: &rapier3d::parry::shape::ConvexPolyhedron,
+    v64: &[Vector3<f64>],
+    tolerance: f64,
+) -> bool {
     let ids = poly.vertices_adj_to_face();
+    let points = Clusters::of_points(v64);
     poly.faces().iter().all(|f| {
         let a = poly.points()[ids[f.first_vertex_or_edge as usize] as usize];
         let a = Vector3::new(f64::from(a.x), f64::from(a.y), f64::from(a.z));
@@ -652,7 +919,7 @@ fn holds_all(poly: &rapier3d::parry::shape::ConvexPolyhedron, v64: &[Vector3<f64
             f64::from(f.normal.y),
             f64::from(f.normal.z),
         );
-        v64.iter().all(|x| n.dot(&(x - a)) <= SUPPORT_TOLERANCE_M)
+        points.all(&n, a, tolerance, |i| n.dot(&(v64[i] - a)) <= tolerance)
     })
 }
 
@@ -675,6 +942,22 @@ pub fn collider_inertia(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 56: parry merged every hull face of a UV sphere of 300 × 150 segments (89,400
+    /// triangles, 60 mm) away, and the scene's support scan indexed an empty face list (a
+    /// panic in the physics check). Its collider is now a polyhedron with faces, or another
+    /// usable shape, and a point's depth is found on it.
+    #[test]
+    fn a_finely_divided_sphere_gets_a_collider_with_faces() {
+        let mesh = crate::mesh::primitives::uv_sphere(30.0, 300);
+        assert_eq!(mesh.triangles.len(), 89_400);
+        let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
+        let shape = ObjectShape::from_mesh(&mesh, volume);
+        assert!(usable_shape(&shape.shape), "{:?}", shape.kind);
+        let inside = nalgebra::Point3::new(29.0, 0.0, 0.0);
+        let depth = shape.depth_mm(&[inside]);
+        assert!((depth - 1.0).abs() < 0.06, "depth {depth} mm, expected 1");
+    }
 
     #[test]
     fn a_hull_that_bridges_a_planned_contact_gives_way_to_the_decomposition() {

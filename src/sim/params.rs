@@ -652,29 +652,141 @@ impl SimParams {
         self.robust.validate()
     }
 
-    /// The values that must be finite and positive.
+    /// Every number's physical range (issue 56: a contact stiffness of 1e300 Hz overflowed the
+    /// f32 solver, and an object that never moved was judged `drop`): each value must be
+    /// finite and within its range, which the message states. The lower bounds are exclusive
+    /// (0: the value must be positive) or inclusive where zero means "none".
     fn validate_positive(&self) -> Result<(), Invalid> {
         let s = self;
-        for (key, v) in sim_keyed!(s;
-            hold.duration_s,
-            solver.timestep_s,
-            fingers.torque_limit_nm,
-            fingers.joint1_lock_torque_nm,
-            hold.hold_translation_mm,
-            hold.hold_rotation_deg,
-            closing.close_duration_s,
-            fingers.motor_stiffness_nm_per_rad,
-            fingers.finger_density_kg_m3,
-            solver.contact_stiffness_hz,
-            closing.open_margin_deg,
-            early.rest_window_s,
-            early.rest_safety,
-            early.rest_margin,
-            hold.max_penetration_mm,
-            hold.max_closing_shift_mm,
-        ) {
-            if !(v.is_finite() && v > 0.0) {
-                return Err((key, format!("must be positive, got {v}")));
+        // (key, value, low, low included, high, unit)
+        let ranges: [(&'static str, f64, f64, bool, f64, &str); 16] = [
+            (
+                "sim.duration_s",
+                s.hold.duration_s,
+                0.0,
+                false,
+                3600.0,
+                " s",
+            ),
+            (
+                "sim.timestep_s",
+                s.solver.timestep_s,
+                0.0,
+                false,
+                0.05,
+                " s",
+            ),
+            (
+                "sim.torque_limit_nm",
+                s.fingers.torque_limit_nm,
+                0.0,
+                false,
+                1000.0,
+                " N·m",
+            ),
+            (
+                "sim.joint1_lock_torque_nm",
+                s.fingers.joint1_lock_torque_nm,
+                0.0,
+                false,
+                10_000.0,
+                " N·m",
+            ),
+            (
+                "sim.hold_translation_mm",
+                s.hold.hold_translation_mm,
+                0.0,
+                false,
+                1000.0,
+                " mm",
+            ),
+            (
+                "sim.hold_rotation_deg",
+                s.hold.hold_rotation_deg,
+                0.0,
+                false,
+                180.0,
+                "°",
+            ),
+            (
+                "sim.close_duration_s",
+                s.closing.close_duration_s,
+                0.0,
+                false,
+                600.0,
+                " s",
+            ),
+            (
+                "sim.motor_stiffness_nm_per_rad",
+                s.fingers.motor_stiffness_nm_per_rad,
+                0.0,
+                false,
+                1e6,
+                " N·m/rad",
+            ),
+            (
+                "sim.finger_density_kg_m3",
+                s.fingers.finger_density_kg_m3,
+                0.0,
+                false,
+                100_000.0,
+                " kg/m³",
+            ),
+            (
+                "sim.contact_stiffness_hz",
+                s.solver.contact_stiffness_hz,
+                1.0,
+                true,
+                1e6,
+                " Hz",
+            ),
+            (
+                "sim.open_margin_deg",
+                s.closing.open_margin_deg,
+                0.0,
+                false,
+                90.0,
+                "°",
+            ),
+            (
+                "sim.rest_window_s",
+                s.early.rest_window_s,
+                0.0,
+                false,
+                10.0,
+                " s",
+            ),
+            (
+                "sim.rest_safety",
+                s.early.rest_safety,
+                0.0,
+                false,
+                100.0,
+                "",
+            ),
+            ("sim.rest_margin", s.early.rest_margin, 0.0, false, 1.0, ""),
+            (
+                "sim.max_penetration_mm",
+                s.hold.max_penetration_mm,
+                0.0,
+                false,
+                1000.0,
+                " mm",
+            ),
+            (
+                "sim.max_closing_shift_mm",
+                s.hold.max_closing_shift_mm,
+                0.0,
+                false,
+                1000.0,
+                " mm",
+            ),
+        ];
+        for (key, v, lo, closed, hi, unit) in ranges {
+            let above = if closed { v >= lo } else { v > lo };
+            if !(v.is_finite() && above && v <= hi) {
+                let open = if closed { '[' } else { '(' };
+                return Err((key, format!("must be in {open}{lo}, {hi}]{unit}, got {v}")));
             }
         }
         Ok(())
@@ -701,10 +813,10 @@ impl SimParams {
     /// hold.
     fn validate_bounds(&self) -> Result<(), Invalid> {
         let damping = self.fingers.motor_damping_nms_per_rad;
-        if !(damping.is_finite() && damping >= 0.0) {
+        if !(damping.is_finite() && (0.0..=10_000.0).contains(&damping)) {
             return Err((
                 "sim.motor_damping_nms_per_rad",
-                format!("must be zero or positive, got {damping}"),
+                format!("must be in [0, 10000] N·m·s/rad, got {damping}"),
             ));
         }
         let share = self.hold.min_on_plan_fraction;
@@ -719,15 +831,6 @@ impl SimParams {
                 "sim.closing_decides",
                 "needs protocol = \"fast\" (the full protocol holds every direction to its end)"
                     .to_string(),
-            ));
-        }
-        if self.early.rest_margin > 1.0 {
-            return Err((
-                "sim.rest_margin",
-                format!(
-                    "must be at most 1 (a fraction of the thresholds), got {}",
-                    self.early.rest_margin
-                ),
             ));
         }
         let timestep_s = self.solver.timestep_s;
@@ -786,6 +889,14 @@ impl InputParams {
                     "angles must be in (0, 180] degrees".to_string(),
                 ));
             }
+        }
+        if self.override_index == Some(0) {
+            return Err((
+                "sim.override_index",
+                "must be at least 1 (indexed elevations count from 1; at most the object's \
+                 count, checked once it is planned), got 0"
+                    .to_string(),
+            ));
         }
         if self.override_index.is_some() && self.override_angles.is_none() {
             return Err((
@@ -852,8 +963,8 @@ impl FingerParams {
     /// The squeeze overshoots: zero or positive.
     fn validate_squeeze(&self) -> Result<(), Invalid> {
         for (key, v) in keyed!("sim", self; squeeze_deg, squeeze2_deg) {
-            if !v.is_finite() || v < 0.0 {
-                return Err((key, format!("must be zero or positive, got {v}")));
+            if !(v.is_finite() && (0.0..=90.0).contains(&v)) {
+                return Err((key, format!("must be in [0, 90]°, got {v}")));
             }
         }
         Ok(())
@@ -960,8 +1071,32 @@ mod tests {
             p.validate(3),
             Err((
                 "sim.timestep_s",
-                "must be at most 0.05 s and a tenth of duration_s, got 0.5".to_string()
+                "must be in (0, 0.05] s, got 0.5".to_string()
             ))
+        );
+        p.solver.timestep_s = 0.04;
+        p.hold.duration_s = 0.2;
+        assert_eq!(
+            p.validate(3),
+            Err((
+                "sim.timestep_s",
+                "must be at most 0.05 s and a tenth of duration_s, got 0.04".to_string()
+            ))
+        );
+        // Every number has a physical range, stated (issue 56).
+        let mut p = SimParams::default();
+        p.solver.contact_stiffness_hz = 1e300;
+        let (key, problem) = p.validate(3).unwrap_err();
+        assert_eq!(key, "sim.contact_stiffness_hz");
+        assert!(
+            problem.starts_with("must be in [1, 1000000] Hz, got 1000"),
+            "{problem}"
+        );
+        assert_eq!(
+            check(
+                "override_angles = [[90.0, 90.0], [90.0, 90.0], [90.0, 90.0]]\noverride_index = 0"
+            ),
+            Err("sim.override_index")
         );
     }
 }

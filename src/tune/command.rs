@@ -3,7 +3,7 @@
 
 use super::{Sweep, TuneResult};
 use crate::batch::{self, plural};
-use crate::pipeline::{check_output_dir, Progress};
+use crate::pipeline::{lock_output_dir, Progress};
 use crate::scenario::Scenario;
 use anyhow::Context;
 use std::path::{Path, PathBuf};
@@ -32,6 +32,16 @@ pub struct Request {
 /// # Errors
 /// A bad template or input list, an output that cannot be written, or every setting invalid.
 pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
+    // One parameter swept twice would make a grid whose two columns set the same value, the
+    // second overwriting the first at every setting.
+    for (k, sweep) in request.sweeps.iter().enumerate() {
+        if request.sweeps[..k].iter().any(|s| s.name == sweep.name) {
+            anyhow::bail!(
+                "--param: `{}` is given twice; sweep each parameter once (NAME=START:END:STEP)",
+                sweep.name
+            );
+        }
+    }
     let settings = super::grid_size(&request.sweeps);
     if settings > super::MAX_SETTINGS {
         let sizes: Vec<String> = request
@@ -50,7 +60,8 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
         None => batch::default_template(),
     };
     let items = batch::expand(&request.inputs)?;
-    check_output_dir(&request.out).context("--out")?;
+    // Held to the end of the sweep: a second tune into the same folder is refused.
+    let _lock = lock_output_dir(&request.out).context("--out")?;
     let jobs = request
         .jobs
         .unwrap_or_else(batch::command::default_jobs)

@@ -91,7 +91,7 @@ pub fn write_report(
 fn export_error(path: &Path, e: std::io::Error) -> ExportError {
     ExportError {
         path: path.to_path_buf(),
-        source: e,
+        error: e,
     }
 }
 

@@ -7,6 +7,7 @@ mod engines;
 mod export;
 mod formats;
 mod frames;
+mod fuzz_drive;
 mod geometry;
 mod hand_files;
 mod hostile;
