@@ -273,6 +273,21 @@ fn mesh_from_arrays<'py>(
 /// object's file frame, `[θ1, θ2]` per finger `[deg]`, and the axis name gravity refers to.
 type Given = ([f64; 3], [f64; 4], Vec<[f64; 2]>, Option<String>);
 
+/// A scenario given as JSON (a table per section, as its TOML would have it): converted to
+/// TOML and parsed by `Scenario::parse` with `label` as its path.
+fn scenario_of_json(scenario_json: &str, label: &std::path::Path) -> PyResult<Scenario> {
+    let table: toml::Table = serde_json::from_str(scenario_json).map_err(|e| {
+        BadScenarioError::new_err(format!("{}: not a scenario table: {e}", label.display()))
+    })?;
+    let text = toml::to_string(&table).map_err(|e| {
+        BadScenarioError::new_err(format!(
+            "{}: cannot be written as TOML: {e}",
+            label.display()
+        ))
+    })?;
+    Scenario::parse(&text, label).map_err(scenario_err)
+}
+
 /// Run flags as the command line's.
 fn options(
     no_sim: bool,
@@ -313,16 +328,7 @@ fn run_table(
 ) -> PyResult<String> {
     let what = label.display().to_string();
     detached(py, &what, move || {
-        let table: toml::Table = serde_json::from_str(&scenario_json).map_err(|e| {
-            BadScenarioError::new_err(format!("{}: not a scenario table: {e}", label.display()))
-        })?;
-        let text = toml::to_string(&table).map_err(|e| {
-            BadScenarioError::new_err(format!(
-                "{}: cannot be written as TOML: {e}",
-                label.display()
-            ))
-        })?;
-        let scenario = Scenario::parse(&text, &label).map_err(scenario_err)?;
+        let scenario = scenario_of_json(&scenario_json, &label)?;
         let mut o = options(no_sim, payload, quality, candidates, max_checked);
         o.given = given.map(|(position_mm, quaternion_wxyz, theta_deg, axis_name)| {
             grasp_sim::GivenGrasp {
@@ -352,16 +358,7 @@ fn check_lines_table(
 ) -> PyResult<Vec<String>> {
     let what = label.display().to_string();
     detached(py, &what, move || {
-        let table: toml::Table = serde_json::from_str(&scenario_json).map_err(|e| {
-            BadScenarioError::new_err(format!("{}: not a scenario table: {e}", label.display()))
-        })?;
-        let text = toml::to_string(&table).map_err(|e| {
-            BadScenarioError::new_err(format!(
-                "{}: cannot be written as TOML: {e}",
-                label.display()
-            ))
-        })?;
-        let scenario = Scenario::parse(&text, &label).map_err(scenario_err)?;
+        let scenario = scenario_of_json(&scenario_json, &label)?;
         let n = lines.len();
         let given: Vec<Result<String, String>> = lines.into_iter().map(Ok).collect();
         let info = |_: usize, wall_ms: f64| grasp_sim::label::LabelInfo {

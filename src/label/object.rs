@@ -417,19 +417,6 @@ fn feature_of(g: &Grasp, aligned: &AlignedObject, hand: &crate::hand::Hand) -> F
     }
 }
 
-/// Loads `scenario`'s object and checks the planner's work bound, as a run does.
-fn prepare(scenario: &Scenario, timings: &mut StageTimings) -> Result<PreparedObject, Error> {
-    let object = PreparedObject::load(&scenario.object, timings)?;
-    let p = &scenario.planner;
-    mesh::check_planner_work(
-        object.mesh(),
-        &scenario.object.mesh,
-        p.height_step_mm,
-        p.angular_step_deg,
-    )?;
-    Ok(object)
-}
-
 /// Plans `object`'s candidates as a run does, without checking any: every feasible grasp in
 /// search order, up to `candidates`.
 fn plan_candidates(
@@ -478,7 +465,7 @@ pub fn label_object(
     let t0 = Instant::now();
     let scenario = with_samples(scenario, params.samples);
     let mut timings = StageTimings::default();
-    let object = prepare(&scenario, &mut timings)?;
+    let object = crate::pipeline::prepare(&scenario, &mut timings)?;
     let selection = plan_candidates(&scenario, &object, params.candidates, &mut timings);
     let hand = &scenario.hand;
     let features: Vec<Feature> = selection
@@ -625,7 +612,7 @@ pub fn check_lines(
     let t0 = Instant::now();
     let scenario = with_samples(scenario, samples);
     let mut timings = StageTimings::default();
-    let object = prepare(&scenario, &mut timings)?;
+    let object = crate::pipeline::prepare(&scenario, &mut timings)?;
     let hand = &scenario.hand;
     let fingers = hand.finger_list.len();
     let parsed: Vec<Result<GraspLine, String>> = lines

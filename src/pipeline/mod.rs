@@ -269,13 +269,14 @@ pub fn run(scenario: &Scenario, options: &RunOptions) -> Result<RunReport, Error
     Ok(computed.report)
 }
 
-/// Prepares the object, plans, checks the chosen grasp and judges `[expect]`. Writes nothing.
+/// Loads `scenario`'s object and checks the planner's work bound before any planning;
+/// `timings` receives `load` and `align`.
 ///
 /// # Errors
-/// [`Error`] for a bad mesh file.
-pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Error> {
-    let mut timings = StageTimings::default();
-    let object = PreparedObject::load(&scenario.object, &mut timings)?;
+/// [`Error`] for a bad mesh file, or an object too large for the planner (with a hint when
+/// its unit looks wrong).
+pub fn prepare(scenario: &Scenario, timings: &mut StageTimings) -> Result<PreparedObject, Error> {
+    let object = PreparedObject::load(&scenario.object, timings)?;
     let p = &scenario.planner;
     mesh::check_planner_work(
         object.mesh(),
@@ -292,6 +293,16 @@ pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Er
         }
         e
     })?;
+    Ok(object)
+}
+
+/// Prepares the object, plans, checks the chosen grasp and judges `[expect]`. Writes nothing.
+///
+/// # Errors
+/// [`Error`] for a bad mesh file.
+pub fn compute(scenario: &Scenario, options: &RunOptions) -> Result<Computed, Error> {
+    let mut timings = StageTimings::default();
+    let object = prepare(scenario, &mut timings)?;
     let selection = select_grasps(scenario, options, &object, &mut timings);
     let qualities = qualities(scenario, options, &selection);
     let plan = build::plan_report(scenario, &selection, &qualities, timings);
