@@ -45,5 +45,6 @@ pub mod slice;
 pub mod summarize;
 pub mod tune;
 pub mod visual;
+mod xml_lines;
 
 pub use pipeline::{run, Error, GivenGrasp, RunFlags, RunOptions, DEFAULT_MAX_CHECKED};

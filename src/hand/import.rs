@@ -194,6 +194,18 @@ pub(crate) fn read_xml_text(path: &Path, kind: &str) -> Result<String, HandError
     Ok(text)
 }
 
+/// Refuses a hand of more than [`MAX_HAND_LINKS`] links: checked by the readers before any
+/// link is read, as the file's elements are counted, and again on the tree.
+pub(crate) fn check_link_count(path: &Path, links: usize) -> Result<(), HandError> {
+    if links > MAX_HAND_LINKS {
+        return Err(err(
+            path,
+            format!("{links} links, more than the {MAX_HAND_LINKS} a hand may have"),
+        ));
+    }
+    Ok(())
+}
+
 pub(crate) fn err(path: &Path, message: impl Into<String>) -> HandError {
     HandError::Parse {
         path: path.to_path_buf(),
@@ -766,15 +778,7 @@ pub fn derive(
             format!("line {line}: {what} closes a loop: expected a tree of links (open chains)"),
         ));
     }
-    if tree.links.len() > MAX_HAND_LINKS {
-        return Err(err(
-            &tree.file,
-            format!(
-                "{} links, more than the {MAX_HAND_LINKS} a hand may have",
-                tree.links.len()
-            ),
-        ));
-    }
+    check_link_count(&tree.file, tree.links.len())?;
     let parents = tree.parents();
     for l in 0..tree.links.len() {
         // The loop check of `path_to`, on the table built once.

@@ -17,9 +17,7 @@ use std::path::{Path, PathBuf};
 
 const MM_PER_M: f64 = 1000.0;
 
-fn line_of(node: roxmltree::Node) -> u32 {
-    node.document().text_pos_at(node.range().start).row
-}
+use crate::xml_lines::line_of;
 
 /// What the compiler settings and assets say.
 struct Context<'a> {
@@ -373,6 +371,7 @@ pub fn read(path: &Path) -> Result<Tree, HandError> {
     let text = super::import::read_xml_text(path, "an MJCF")?;
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| err(path, format!("not well-formed XML: {e}")))?;
+    let _lines = crate::xml_lines::Lines::enter(&text);
     let root = doc.root_element();
     if !root.has_tag_name("mujoco") {
         return Err(err(
@@ -400,6 +399,12 @@ pub fn read(path: &Path) -> Result<Tree, HandError> {
             "no <worldbody>: expected the hand's bodies in one",
         ));
     };
+    // The world and its bodies, counted before any is read.
+    let bodies = world
+        .descendants()
+        .filter(|c| c.has_tag_name("body"))
+        .count();
+    super::import::check_link_count(path, 1 + bodies)?;
     let mut tree = Tree {
         file: path.to_path_buf(),
         name: root.attribute("model").unwrap_or("hand").to_string(),

@@ -25,9 +25,7 @@ fn from_mesh(path: &Path, e: MeshError) -> HandError {
     }
 }
 
-fn line_of(node: roxmltree::Node) -> u32 {
-    node.document().text_pos_at(node.range().start).row
-}
+use crate::xml_lines::line_of;
 
 /// A pose in metres as one in millimetres.
 fn to_mm(p: Isometry3<f64>) -> Isometry3<f64> {
@@ -198,6 +196,7 @@ pub fn read(path: &Path) -> Result<Tree, HandError> {
     let text = super::import::read_xml_text(path, "a URDF")?;
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| err(path, format!("not well-formed XML: {e}")))?;
+    let _lines = crate::xml_lines::Lines::enter(&text);
     let robot = doc.root_element();
     if !robot.has_tag_name("robot") {
         return Err(err(
@@ -208,6 +207,8 @@ pub fn read(path: &Path) -> Result<Tree, HandError> {
             ),
         ));
     }
+    let count = robot.children().filter(|c| c.has_tag_name("link")).count();
+    super::import::check_link_count(path, count)?;
     let mut links = Vec::new();
     for l in robot.children().filter(|c| c.has_tag_name("link")) {
         links.push(Link {

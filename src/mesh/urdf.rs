@@ -56,7 +56,7 @@ pub(crate) fn numbers(
     let Some(text) = node.attribute(attr) else {
         return Ok(None);
     };
-    let line = node.document().text_pos_at(node.range().start).row;
+    let line = crate::xml_lines::line_of(node);
     let bad = || {
         urdf_err(
             path,
@@ -141,7 +141,7 @@ fn geometry(path: &Path, element: roxmltree::Node) -> Result<Result<Placed, Stri
     else {
         return Ok(Err("no <geometry>".to_string()));
     };
-    let line = g.document().text_pos_at(g.range().start).row;
+    let line = crate::xml_lines::line_of(g);
     // A shape's attributes, each of `n` lengths, all given and positive.
     let lengths = |attrs: &[(&str, usize)], want: &str| -> Result<Vec<f64>, MeshError> {
         let mut v = Vec::new();
@@ -295,6 +295,7 @@ fn read(path: &Path) -> Result<Read, MeshError> {
     }
     let doc = roxmltree::Document::parse(&text)
         .map_err(|e| urdf_err(path, format!("not well-formed XML: {e}")))?;
+    let _lines = crate::xml_lines::Lines::enter(&text);
     let robot = doc.root_element();
     if !robot.has_tag_name("robot") {
         return Err(urdf_err(
@@ -314,13 +315,13 @@ fn read(path: &Path) -> Result<Read, MeshError> {
     }
     let names: std::collections::HashSet<&str> =
         links.iter().filter_map(|l| l.attribute("name")).collect();
-    let parent = joint_parents(path, &doc, robot, &names)?;
+    let parent = joint_parents(path, robot, &names)?;
     let mut placed = Vec::new();
     let mut notes = Vec::new();
     let mut mass_kg = None;
     for link in links {
         let name = link.attribute("name").unwrap_or("");
-        if let Some(v) = link_mass(path, &doc, link, name)? {
+        if let Some(v) = link_mass(path, link, name)? {
             mass_kg = Some(mass_kg.unwrap_or(0.0) + v);
         }
         let link_pose = pose_in_root(path, &parent, name)?;
@@ -354,7 +355,6 @@ fn read(path: &Path) -> Result<Read, MeshError> {
 /// file, or a child that already has a parent (a link has one parent in a tree).
 fn joint_parents<'a>(
     path: &Path,
-    doc: &roxmltree::Document,
     robot: roxmltree::Node<'a, '_>,
     links: &std::collections::HashSet<&str>,
 ) -> Result<HashMap<&'a str, (&'a str, Isometry3<f64>)>, MeshError> {
@@ -366,13 +366,13 @@ fn joint_parents<'a>(
                 .and_then(|c| c.attribute("link"))
         };
         let (Some(p), Some(c)) = (link_of("parent"), link_of("child")) else {
-            let line = doc.text_pos_at(j.range().start).row;
+            let line = crate::xml_lines::line_of(j);
             return Err(urdf_err(
                 path,
                 format!("line {line}: <joint> without a parent or child link"),
             ));
         };
-        let line = doc.text_pos_at(j.range().start).row;
+        let line = crate::xml_lines::line_of(j);
         if let Some(missing) = [p, c].into_iter().find(|l| !links.contains(l)) {
             return Err(urdf_err(
                 path,
@@ -421,12 +421,7 @@ fn pose_in_root(
 ///
 /// # Errors
 /// [`MeshError::Urdf`] for a malformed or negative mass.
-fn link_mass(
-    path: &Path,
-    doc: &roxmltree::Document,
-    link: roxmltree::Node,
-    name: &str,
-) -> Result<Option<f64>, MeshError> {
+fn link_mass(path: &Path, link: roxmltree::Node, name: &str) -> Result<Option<f64>, MeshError> {
     let Some(m) = link
         .children()
         .find(|c| c.has_tag_name("inertial"))
@@ -436,7 +431,7 @@ fn link_mass(
     };
     let v = numbers(path, m, "value", 1)?.map_or(0.0, |v| v[0]);
     if v < 0.0 {
-        let line = doc.text_pos_at(m.range().start).row;
+        let line = crate::xml_lines::line_of(m);
         return Err(urdf_err(
             path,
             format!("line {line}: link `{name}` has a negative mass ({v} kg)"),

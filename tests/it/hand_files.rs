@@ -489,3 +489,64 @@ fn link_meshes_are_the_colliders_of_their_bodies() {
     let finals = |v: &serde_json::Value| v["sim"]["closing"]["fingers"].to_string();
     assert_ne!(finals(&vm), finals(&vb));
 }
+
+/// A hand file of many elements, each on a line of its own: the readers name the right line
+/// deep in it, and a hand of more links than any hand has is refused as its elements are
+/// counted, before any is read (80,000 fixed links, 8.8 MB, were read for minutes before:
+/// every line named was counted from the start of the file).
+#[test]
+fn lines_deep_in_a_large_hand_file_are_named_and_a_huge_one_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let src = std::fs::read_to_string(asset("assets/hands/bh8.urdf")).unwrap();
+    let at = src.find("<robot").unwrap();
+    let at = at + src[at..].find('>').unwrap() + 1;
+    let chain = |n: usize| -> String {
+        (0..n)
+            .map(|k| {
+                let child = if k + 1 < n {
+                    format!("c{}", k + 1)
+                } else {
+                    "palm".to_string()
+                };
+                format!(
+                    "\n<link name=\"c{k}\"/>\n<joint name=\"cj{k}\" type=\"fixed\"><parent \
+                     link=\"c{k}\"/><child link=\"{child}\"/></joint>"
+                )
+            })
+            .collect()
+    };
+    // 1500 links above the palm, then a second parent for finger 1's phalanx 2 on a known line.
+    let text = format!(
+        "{}{}{}",
+        &src[..at],
+        chain(1500),
+        src[at..].replacen(
+            "</robot>",
+            "<joint name=\"back\" type=\"fixed\"><parent link=\"c0\"/><child \
+             link=\"c1\"/></joint>\n</robot>",
+            1
+        )
+    );
+    let line = 1 + text[..text.find("<joint name=\"back\"").unwrap()]
+        .matches('\n')
+        .count();
+    assert!(line > 3000, "{line}");
+    let out = refused(dir.path(), "deep.urdf", &text, "urdf");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("deep.urdf") && err.contains(&format!("line {line}")),
+        "line {line} not named: {err}"
+    );
+    let huge = format!("{}{}{}", &src[..at], chain(80_000), &src[at..]);
+    assert!(huge.len() > 8_000_000);
+    let out = refused(dir.path(), "huge.urdf", &huge, "urdf");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    let links = 80_000 + src.matches("<link ").count();
+    assert!(
+        err.contains("huge.urdf") && err.contains(&format!("{links} links, more than the 2000")),
+        "{err}"
+    );
+}
