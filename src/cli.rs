@@ -158,6 +158,13 @@ pub struct Cli {
           default_value_t = grasp_sim::pipeline::inputs::DEFAULT_TIME_LIMIT_S)]
     pub time_limit: f64,
 
+    /// Keep each object's convex decomposition (V-HACD, 0.1-0.4 s an object and axis) in DIR,
+    /// made if missing, under the digest of its mesh: a later run that meets the same object
+    /// reads it instead of making it again, the same collider bit for bit. For every command;
+    /// also from the environment's GRASP_SIM_COLLIDER_CACHE.
+    #[arg(long, value_name = "DIR", global = true)]
+    pub collider_cache: Option<PathBuf>,
+
     #[command(subcommand)]
     pub command: Option<Command>,
 }

@@ -42,6 +42,9 @@ fn main() -> ExitCode {
 /// Runs the command the flags name; returns the exit status.
 fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
     use cli::Command;
+    if let Some(dir) = &cli.collider_cache {
+        use_collider_cache(dir)?;
+    }
     match cli.command {
         Some(Command::GenAssets { out, hard: true }) => {
             grasp_sim::assets::write_hard_assets(&out).map(|()| 0)
@@ -85,6 +88,20 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
         Some(c @ (Command::LabelWorker { .. } | Command::Check { .. })) => label_command(c),
         None => run_inputs(cli),
     }
+}
+
+/// Names `dir` (made if missing) as the collider cache of this process and of the workers it
+/// starts, through the environment they inherit; before any thread starts.
+fn use_collider_cache(dir: &std::path::Path) -> anyhow::Result<()> {
+    use anyhow::Context;
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!("--collider-cache {}: is not a folder", dir.display());
+    }
+    std::fs::create_dir_all(dir)
+        .and_then(|()| grasp_sim::files::check_writable_dir(dir))
+        .with_context(|| format!("--collider-cache {}: cannot write there", dir.display()))?;
+    std::env::set_var(grasp_sim::sim::collider_cache::ENV, dir);
+    Ok(())
 }
 
 /// `label-worker` and `check --grasps`.

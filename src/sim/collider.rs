@@ -254,6 +254,16 @@ fn shape_key(mesh: &Mesh, volume_mm3: Option<f64>) -> [u8; 32] {
     h.finalize().into()
 }
 
+/// The disk cache's key of the convex decomposition of `mesh`: the digest of the mesh and of
+/// what makes the decomposition ([`super::collider_cache::MAKER`]).
+fn decomposition_key(mesh: &Mesh) -> [u8; 32] {
+    use sha2::{Digest, Sha256};
+    let mut h = Sha256::new();
+    h.update(shape_key(mesh, None));
+    h.update(super::collider_cache::MAKER.as_bytes());
+    h.finalize().into()
+}
+
 impl ObjectShape {
     /// [`ObjectShape::from_mesh`], with convex decompositions (0.1–0.4 s each) and rebuilt hulls
     /// (tens of milliseconds) kept for the rest of the process: the same mesh gives the same
@@ -352,9 +362,15 @@ impl ObjectShape {
         // parry's `SharedShape::convex_decomposition_with_params`, without its panic on a
         // decomposition none of whose parts it makes a polyhedron of (a cylinder of 4000
         // segments), and with each part checked.
-        let decomposition = VHACD::decompose(&params, points, &mesh.triangles, true);
-        let parts: Vec<(Pose, SharedShape)> = decomposition
-            .compute_exact_convex_hulls(points, &mesh.triangles)
+        // The parts come from the disk cache where one is named (`--collider-cache`): the
+        // same parts, bit for bit, as V-HACD makes.
+        let key = decomposition_key(mesh);
+        let hulls =
+            super::collider_cache::load_or_make(super::collider_cache::folder(), &key, || {
+                VHACD::decompose(&params, points, &mesh.triangles, true)
+                    .compute_exact_convex_hulls(points, &mesh.triangles)
+            });
+        let parts: Vec<(Pose, SharedShape)> = hulls
             .into_iter()
             .filter_map(|(v, t)| SharedShape::convex_mesh(v, &t).map(|c| (Pose::IDENTITY, c)))
             .collect();

@@ -37,6 +37,7 @@
 
 pub mod closing;
 pub mod collider;
+pub mod collider_cache;
 pub mod contacts;
 pub mod convert;
 pub mod dispatcher;

@@ -840,3 +840,87 @@ fn a_given_grasp_is_checked_as_given() {
         "given grasp: a coordinate or angle is not a finite number"
     );
 }
+
+/// `--collider-cache DIR` (issue 57): the Meta-World hammer's convex decomposition is made once,
+/// kept in DIR under its mesh's digest and read back by later runs, also by `batch`'s workers;
+/// a damaged file is made again. Every run's JSON is the uncached run's, timings aside.
+#[test]
+fn a_collider_cache_gives_the_same_check_and_is_read_back() {
+    fn timeless(mut v: serde_json::Value) -> serde_json::Value {
+        fn strip(v: &mut serde_json::Value) {
+            match v {
+                serde_json::Value::Object(m) => {
+                    m.remove("wall_ms");
+                    m.remove("timings_ms");
+                    m.values_mut().for_each(strip);
+                }
+                serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+                _ => {}
+            }
+        }
+        strip(&mut v);
+        v
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let cache = dir.path().join("colliders");
+    let scenario = "assets/real/scenarios/mw_hammer.toml";
+    let run = |cache: Option<&std::path::Path>| {
+        let mut cmd = crate::grasp_sim();
+        cmd.arg("--json");
+        if let Some(c) = cache {
+            cmd.arg("--collider-cache").arg(c);
+        }
+        let out = crate::succeed(cmd.arg(scenario));
+        timeless(serde_json::from_slice(&out.stdout).unwrap())
+    };
+    let files = |d: &std::path::Path| -> Vec<std::path::PathBuf> {
+        let mut v: Vec<_> = std::fs::read_dir(d)
+            .map(|r| r.map(|e| e.unwrap().path()).collect())
+            .unwrap_or_default();
+        v.sort();
+        v
+    };
+    let plain = run(None);
+    assert!(
+        plain["sim"]["collider"]
+            .as_str()
+            .unwrap()
+            .starts_with("convex_decomposition"),
+        "{}",
+        plain["sim"]["collider"]
+    );
+    assert_eq!(run(Some(&cache)), plain, "the run that makes the cache");
+    let kept = files(&cache);
+    assert_eq!(kept.len(), 1, "{kept:?}");
+    assert!(kept[0].to_string_lossy().ends_with(".vhacd"));
+    let bytes = std::fs::read(&kept[0]).unwrap();
+    assert_eq!(run(Some(&cache)), plain, "the run that reads it");
+    // Damaged: truncated, it is made again, and whole again after.
+    std::fs::write(&kept[0], &bytes[..bytes.len() / 2]).unwrap();
+    assert_eq!(run(Some(&cache)), plain, "the run after the damage");
+    assert_eq!(std::fs::read(&kept[0]).unwrap(), bytes);
+    // `batch` passes the folder to its workers.
+    let second = dir.path().join("batch-colliders");
+    let out = crate::succeed(
+        crate::grasp_sim()
+            .args(["batch", "--jobs", "1", "--collider-cache"])
+            .arg(&second)
+            .arg(scenario),
+    );
+    let line: serde_json::Value =
+        serde_json::from_str(String::from_utf8_lossy(&out.stdout).lines().next().unwrap()).unwrap();
+    assert_eq!(line["sim"]["verdict"], plain["sim"]["verdict"]);
+    assert_eq!(files(&second).len(), 1);
+    assert_eq!(std::fs::read(&files(&second)[0]).unwrap(), bytes);
+    // A cache that cannot be a folder is refused with one line.
+    let out = crate::grasp_sim()
+        .arg("--collider-cache")
+        .arg(&kept[0])
+        .arg(scenario)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(err.contains("--collider-cache"), "{err}");
+}
