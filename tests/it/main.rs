@@ -12,7 +12,6 @@ mod geometry;
 mod hand_files;
 mod hostile;
 mod isolation;
-mod issue16;
 mod label;
 mod order;
 mod planner;
