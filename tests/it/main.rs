@@ -14,6 +14,7 @@ mod hostile;
 mod isolation;
 mod label;
 mod order;
+mod output_keys;
 mod planner;
 mod quality;
 mod real_meshes;
