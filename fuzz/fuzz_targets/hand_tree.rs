@@ -1,10 +1,10 @@
-//! Issue 56's `hand_tree` class from fuzz bytes (see `issue56.rs`, shared with the stable driver
-//! `tests/it/fuzz_drive.rs`).
+//! Issue 56's `hand_tree` class from fuzz bytes (see `input_classes.rs`, shared with the stable
+//! driver `tests/it/fuzz_drive.rs`).
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-#[path = "issue56.rs"]
-mod issue56;
+#[path = "input_classes.rs"]
+mod input_classes;
 
 fuzz_target!(|data: &[u8]| {
     // The first byte picks the seed hand: the BH8's URDF or its MJCF.
@@ -15,6 +15,6 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let file = std::env::temp_dir().join(format!("grasp-sim-fuzz-{}.{ext}", std::process::id()));
-    issue56::hand_tree(rest, &seed, &file);
+    input_classes::hand_tree(rest, &seed, &file);
     let _ = std::fs::remove_file(&file);
 });

@@ -1,9 +1,9 @@
-//! Issue 56's `obj_polygons` class from fuzz bytes (see `issue56.rs`, shared with the stable driver
-//! `tests/it/fuzz_drive.rs`).
+//! Issue 56's `obj_polygons` class from fuzz bytes (see `input_classes.rs`, shared with the stable
+//! driver `tests/it/fuzz_drive.rs`).
 #![no_main]
 use libfuzzer_sys::fuzz_target;
 
-#[path = "issue56.rs"]
-mod issue56;
+#[path = "input_classes.rs"]
+mod input_classes;
 
-fuzz_target!(|data: &[u8]| issue56::obj_polygons(data));
+fuzz_target!(|data: &[u8]| input_classes::obj_polygons(data));

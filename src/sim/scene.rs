@@ -453,7 +453,7 @@ pub fn build(case: &Case) -> Scene {
     // The palm never moves during the check: a fixed body. (A kinematic body here made rapier
     // refresh the palm's contacts irregularly: the object, pressed against the palm, sank into it
     // for about five steps and was thrown back in one, a 0.16 mm sawtooth that ratcheted it along
-    // the fingers by 0.03 mm per period, docs/SIM.md.)
+    // the fingers by 0.03 mm per period: docs/studies/2026-11-22-mujoco-two-faults.md.)
     let palm = world
         .bodies
         .insert(RigidBodyBuilder::fixed().pose(convert::pose(&start.origin_mm, &r_palm)));

@@ -1,5 +1,6 @@
-//! OBJ and PLY loading (issue 13, item 1): a known solid in each format against analytic values,
-//! and bad inputs that must give one line naming the file, never a panic.
+//! Mesh files: OBJ and PLY loading (issue 13, item 1), a known solid in each format against
+//! analytic values; bad inputs (an ASCII STL's named by its line) that must give one line naming
+//! the file, never a panic; a seam written off by rounding welded.
 
 use grasp_sim::mesh::{align, load_mesh, parse_mesh, LengthUnit, MeshFormat};
 use std::path::{Path, PathBuf};
@@ -276,4 +277,101 @@ fn binary_ply_with_a_nan_coordinate_is_refused() {
         .unwrap_err()
         .to_string();
     assert!(e.starts_with("nan.ply: ") && e.contains("NaN"), "{e}");
+}
+
+#[test]
+fn a_malformed_ascii_stl_names_its_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 x\nendloop\nendfacet\nendsolid\n",
+            "line 6 (`vertex 0 1 x`): expected `vertex x y z`",
+        ),
+        (
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n",
+            "line 6 (end of file): expected `vertex`",
+        ),
+        (
+            "\nsolid t\n  facet normal 0 0 1\n  outer lop\n",
+            "line 4 (`outer lop`): expected `outer loop`",
+        ),
+        (
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex nan 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid\n",
+            "line 4 (`vertex nan 0 0`): expected `vertex x y z`, with finite numbers",
+        ),
+    ];
+    for (k, (text, needle)) in cases.iter().enumerate() {
+        let p = dir.path().join(format!("m{k}.stl"));
+        std::fs::write(&p, text).unwrap();
+        let out = crate::grasp_sim().arg(&p).output().unwrap();
+        assert_eq!(out.status.code(), Some(2));
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(needle), "{err}");
+        assert_eq!(err.lines().count(), 1, "{err}");
+    }
+}
+
+/// A closed box as ASCII STL in metres, one corner written as 1e-18 in some of its triangles
+/// and as 0 in the others.
+fn box_with_a_noisy_seam() -> String {
+    let (a, b, c) = (0.04f64, 0.05f64, 0.11f64);
+    let v = |i: usize, noisy: bool| -> [f64; 3] {
+        let p = [
+            if i & 1 == 1 { a } else { 0.0 },
+            if i & 2 == 2 { b } else { 0.0 },
+            if i & 4 == 4 { c } else { 0.0 },
+        ];
+        if i == 0 && noisy {
+            [1e-18, 1e-18, 0.0]
+        } else {
+            p
+        }
+    };
+    // Outward-wound quads of the box (corners by bit: x = 1, y = 2, z = 4).
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let mut s = String::from("solid box\n");
+    for (k, q) in quads.iter().enumerate() {
+        for tri in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
+            s.push_str("facet normal 0 0 0\nouter loop\n");
+            for i in tri {
+                let p = v(i, k == 2);
+                s.push_str(&format!("vertex {:e} {:e} {:e}\n", p[0], p[1], p[2]));
+            }
+            s.push_str("endloop\nendfacet\n");
+        }
+    }
+    s.push_str("endsolid box\n");
+    s
+}
+
+#[test]
+fn a_seam_off_by_rounding_is_welded() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("box.stl");
+    std::fs::write(&p, box_with_a_noisy_seam()).unwrap();
+    let out = crate::succeed(
+        crate::grasp_sim()
+            .args(["--json", "--no-sim", "--units", "m"])
+            .arg(&p),
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["object"]["boundary_edges"], 0, "{}", v["object"]);
+    assert_eq!(v["object"]["triangles"], 12);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!err.contains("boundary"), "{err}");
+    // Distinct vertices a file can tell apart stay apart: the thesis objects keep their counts.
+    let loaded = grasp_sim::mesh::load_mesh(
+        &crate::root().join("assets/objects/cup.stl"),
+        grasp_sim::mesh::LengthUnit::Mm,
+    )
+    .unwrap();
+    assert_eq!(loaded.topology.boundary_edges, 0);
+    assert_eq!(loaded.mesh.triangles.len(), 576);
 }

@@ -1,12 +1,12 @@
-//! A stable-toolchain driver for issue 56's fuzz targets (`fuzz/fuzz_targets/issue56.rs`): each
-//! target's function fed `FUZZ_RUNS` inputs (10⁶ by default), mutated from seeds and from
+//! A stable-toolchain driver for issue 56's fuzz targets (`fuzz/fuzz_targets/input_classes.rs`):
+//! each target's function fed `FUZZ_RUNS` inputs (10⁶ by default), mutated from seeds and from
 //! earlier inputs by a fixed-seed generator (byte flips, insertions, deletions, splices), without
 //! coverage feedback. Ignored in the suite (minutes each):
 //!
 //!     cargo test --test it fuzz_drive -- --ignored --nocapture
 
-#[path = "../../fuzz/fuzz_targets/issue56.rs"]
-mod issue56;
+#[path = "../../fuzz/fuzz_targets/input_classes.rs"]
+mod input_classes;
 
 /// xorshift64*: a fixed-seed generator, so a run can be repeated.
 struct Rng(u64);
@@ -103,7 +103,7 @@ fn obj_polygons() {
         vec![4, 1, 2, 3, 9, 17, 25, 3, 8, 16, 24],
         vec![0, 0xd0, 0x07, 1, 2, 3],
     ];
-    drive("obj_polygons", &seeds, 512, issue56::obj_polygons);
+    drive("obj_polygons", &seeds, 512, input_classes::obj_polygons);
 }
 
 #[test]
@@ -111,7 +111,7 @@ fn obj_polygons() {
 fn stl_solids() {
     let cube: Vec<u8> = (0..200u8).map(|i| 128 + (i % 3) * 40).collect();
     let seeds = vec![vec![1, 0, 1, 12], [vec![3, 0, 3, 12], cube].concat()];
-    drive("stl_solids", &seeds, 512, issue56::stl_solids);
+    drive("stl_solids", &seeds, 512, input_classes::stl_solids);
 }
 
 #[test]
@@ -131,7 +131,7 @@ fn scenario_name() {
     .map(|s| s.as_bytes().to_vec())
     .collect();
     drive("scenario_name", &seeds, 300, |d| {
-        issue56::scenario_name(d, &scenarios)
+        input_classes::scenario_name(d, &scenarios)
     });
 }
 
@@ -142,7 +142,7 @@ fn hand_tree(ext: &str, seed: &str) {
     let file = dir.path().join(format!("hand.{ext}"));
     let seeds = vec![vec![1, 0, 0], vec![3, 5, 2, 7, 9, 3, 1], vec![2, 8, 7, 0]];
     drive(&format!("hand_tree ({ext})"), &seeds, 64, |d| {
-        issue56::hand_tree(d, &text, &file)
+        input_classes::hand_tree(d, &text, &file)
     });
 }
 

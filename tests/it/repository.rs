@@ -1,7 +1,7 @@
 //! The repository speaks for itself (issue 59): no file says how the project was made, every
 //! relative link and anchor of the Markdown files resolves, every study opens as
-//! docs/studies/README.md says and is indexed there, and the README's headline figures are the
-//! ones the generated tables hold.
+//! docs/studies/README.md says and is indexed there, the reference docs and the README stay
+//! short, and the README's headline figures are the ones the generated tables hold.
 //!
 //! The files are those git tracks (`git ls-files`), or, without git, every file under the root
 //! but `target/`, `.git/`, `out/`, `tune/` and the paths `.gitignore` names. The patterns are
@@ -365,6 +365,33 @@ fn every_relative_link_and_anchor_in_the_markdown_resolves() {
         }
     }
     assert!(broken.is_empty(), "broken links:\n{}", broken.join("\n"));
+}
+
+/// A reference doc says what is, briefly, and links to the studies for the measurements and
+/// the histories (issue 59): at most 400 lines each, the README at most 200.
+#[test]
+fn reference_docs_and_the_readme_stay_short() {
+    let root = crate::root();
+    let mut long = Vec::new();
+    for path in files() {
+        let limit = if path == Path::new("README.md") {
+            200
+        } else if path.parent() == Some(Path::new("docs"))
+            && path.extension().is_some_and(|e| e == "md")
+        {
+            400
+        } else {
+            continue;
+        };
+        let lines = std::fs::read_to_string(root.join(&path))
+            .unwrap()
+            .lines()
+            .count();
+        if lines > limit {
+            long.push(format!("{}: {lines} lines, over {limit}", path.display()));
+        }
+    }
+    assert!(long.is_empty(), "too long:\n{}", long.join("\n"));
 }
 
 #[test]

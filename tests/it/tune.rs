@@ -129,3 +129,78 @@ fn a_scenario_with_fixed_joint_angles_is_checked_with_them() {
     assert_eq!(r.counters.plans, 0);
     assert_eq!(r.counters.sim_runs, 1);
 }
+
+#[test]
+fn tune_says_why_a_setting_is_invalid_and_does_not_rank_it() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path().display().to_string();
+    // 3 mm does not divide the 25 mm finger gap; 2.5 mm does.
+    let run = crate::grasp_sim()
+        .args([
+            "tune",
+            "scenarios/cylinder_d10.toml",
+            "--param",
+            "height_step_mm=2.5:3:0.5",
+            "--out",
+            &dir,
+        ])
+        .output()
+        .unwrap();
+    crate::assert_success(&run);
+    let table = String::from_utf8_lossy(&run.stdout);
+    let row = table
+        .lines()
+        .find(|l| l.trim_start().starts_with('3'))
+        .unwrap();
+    assert!(
+        row.contains("invalid, not ranked") && row.contains("must divide the finger gap of 25 mm"),
+        "{table}"
+    );
+    assert!(!row.contains("best"), "{table}");
+    let csv = std::fs::read_to_string(out.path().join("tune.csv")).unwrap();
+    let line = csv.lines().find(|l| l.starts_with("3,")).unwrap();
+    assert!(line.starts_with("3,,,,,,1,\""), "{csv}");
+    let header = csv.lines().next().unwrap();
+    assert_eq!(header.split(',').count(), 8, "{csv}");
+    assert!(!table.contains("-0.00"), "{table}");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.path().join("tune.json")).unwrap())
+            .unwrap();
+    assert!(json["settings"][1]["invalid"]
+        .as_str()
+        .unwrap()
+        .contains("height_step_mm"));
+    assert!(json["settings"][0].get("invalid").is_none());
+    // Every setting invalid: nothing to rank is bad input.
+    let run = crate::grasp_sim()
+        .args([
+            "tune",
+            "scenarios/cylinder_d10.toml",
+            "--param",
+            "height_step_mm=3:3:1",
+            "--out",
+            &dir,
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(run.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(err.contains("every setting is invalid"), "{err}");
+}
+
+#[test]
+fn an_invalid_setting_is_ranked_below_none_of_the_valid_ones() {
+    // The D10 cylinder is ungraspable at every setting: all valid settings score 0, as the
+    // invalid one would; the best must still be a valid one, even when the invalid one is first.
+    let items = expand(&[crate::root().join("scenarios/cylinder_d10.toml")]).unwrap();
+    let r = tune(
+        &items,
+        &default_template(),
+        &[parse_sweep("height_step_mm=2:2.5:0.5").unwrap()],
+        1,
+        1,
+    )
+    .unwrap();
+    assert!(r.settings[0].invalid.is_some(), "{:?}", r.settings[0]);
+    assert_eq!(r.best, 1);
+}

@@ -1,4 +1,5 @@
-//! `--report DIR`: thesis-style SVG figures, planned and simulated glTF scenes, report.html.
+//! `--report DIR`: thesis-style SVG figures, planned and simulated glTF scenes, report.html, and
+//! an ungraspable object's rejections.
 
 fn report(scenario: &str) -> tempfile::TempDir {
     let dir = tempfile::tempdir().unwrap();
@@ -165,4 +166,107 @@ fn the_report_shows_the_grasp_in_three_views() {
         .unwrap();
         assert_eq!(a, b, "{view}");
     }
+}
+
+#[test]
+fn the_report_page_explains_in_tables_words_links_and_figures() {
+    let out = tempfile::tempdir().unwrap();
+    let dir = out.path();
+    let run = crate::succeed(
+        crate::grasp_sim()
+            .args([
+                "scenarios/cup.toml",
+                "scenarios/cylinder_d10.toml",
+                "--report",
+            ])
+            .arg(dir),
+    );
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        err.contains(&format!(
+            "report written to {}",
+            dir.join("cup").join("report.html").display()
+        )),
+        "{err}"
+    );
+    let cup = std::fs::read_to_string(dir.join("cup/report.html")).unwrap();
+    // The Grasp Parameter Set is a table, the scenes are linked.
+    assert!(cup.contains("<table class=\"gps\">"), "{cup}");
+    assert!(cup.contains("<td>finger_1</td><td>98.2</td><td>116.8</td>"));
+    assert!(cup.contains("<a href=\"grasp_planned.glb\">"));
+    assert!(cup.contains("<a href=\"grasp_simulated.glb\">"));
+    assert!(dir.join("cup/grasp_simulated.glb").exists());
+    // Legends sit above the frame, and data is clipped to the frame.
+    let svg = std::fs::read_to_string(dir.join("cup/finger_1.svg")).unwrap();
+    assert!(svg.contains("<clipPath id=\"frame-") && svg.contains("clip-path=\"url(#frame-"));
+    let legend_y: Vec<f64> = svg
+        .lines()
+        .filter(|l| l.contains("class=\"legend\""))
+        .map(|l| {
+            let y = l.split(" y=\"").nth(2).unwrap();
+            y[..y.find('"').unwrap()].parse().unwrap()
+        })
+        .collect();
+    assert!(
+        !legend_y.is_empty() && legend_y.iter().all(|y| *y < 62.0),
+        "{legend_y:?}"
+    );
+    // The widest legend entry ends inside the figure.
+    let planes = std::fs::read_to_string(dir.join("cup/finger_planes.svg")).unwrap();
+    let width: f64 = {
+        let w = planes.split("width=\"").nth(1).unwrap();
+        w[..w.find('"').unwrap()].parse().unwrap()
+    };
+    let line = planes
+        .lines()
+        .find(|l| l.contains("top, centre and bottom plane"))
+        .unwrap();
+    let x: f64 = {
+        let x = line.split("<text class=\"legend\" x=\"").nth(1).unwrap();
+        x[..x.find('"').unwrap()].parse().unwrap()
+    };
+    assert!(x + 6.2 * 43.0 < width, "legend at {x} in {width}");
+    // An ungraspable object: the not-run check in words, and a figure of what decided it.
+    let d10 = std::fs::read_to_string(dir.join("cylinder_d10/report.html")).unwrap();
+    assert!(d10.contains("Physics check: not run (no feasible grasp to check)"));
+    assert!(!d10.contains("not_run"), "raw token on the page");
+    assert!(d10.contains("id=\"rejections\""));
+    let why = std::fs::read_to_string(dir.join("cylinder_d10/rejections.svg")).unwrap();
+    assert!(why.contains("too thin"), "{why}");
+    // A re-run into the same folder without the physics check removes the stale scene.
+    crate::succeed(
+        crate::grasp_sim()
+            .args(["scenarios/cup.toml", "--no-sim", "--report"])
+            .arg(dir),
+    );
+    assert!(!dir.join("cup/grasp_simulated.glb").exists());
+    let cup = std::fs::read_to_string(dir.join("cup/report.html")).unwrap();
+    assert!(!cup.contains("grasp_simulated.glb"));
+    assert!(cup.contains("Physics check: not run (--no-sim)"));
+}
+
+#[test]
+fn an_ungraspable_object_shows_the_constraints_that_rejected_it() {
+    // The cup without palm pitch under the thesis's rules alone (the extended rules pinch it
+    // across its rim: tests/it/tune.rs).
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join("cup_no_pitch.toml");
+    std::fs::write(
+        &scenario,
+        format!(
+            "[object]\nmesh = \"{}\"\n[planner]\npitch_range_deg = 0.0\nangular_step_deg = 30.0\nextended_rules = false\n",
+            crate::root().join("assets/objects/cup.stl").display()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    crate::succeed(
+        crate::grasp_sim()
+            .arg(&scenario)
+            .args(["--no-sim", "--report"])
+            .arg(&out),
+    );
+    let why = std::fs::read_to_string(out.join("cup_no_pitch/rejections.svg")).unwrap();
+    assert!(why.contains("palm pitch out of range ("), "{why}");
+    assert!(why.contains("class=\"rejection\""), "{why}");
 }
