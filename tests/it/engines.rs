@@ -107,7 +107,7 @@ fn slurm_merge_refuses_an_unfinished_array_and_tasks_check_their_environment() {
 
 /// Returns true if and only if `python3 -c "import ray"` works; without it, says why the Ray
 /// test is skipped, or fails when `GRASP_SIM_REQUIRE_RAY` is set (CI sets it).
-fn have_ray() -> bool {
+pub(crate) fn have_ray() -> bool {
     let ok = Command::new("python3")
         .args(["-c", "import ray"])
         .output()

@@ -349,3 +349,50 @@ fn slurm_array_tasks_label_as_one_run_does() {
         strip(lines(&plain))
     );
 }
+
+/// `scripts/ray_batch.py --command label`: three Ray tasks over two objects and their merge
+/// give the plain run's lines (skipped without Ray, required in CI).
+#[test]
+fn ray_tasks_label_as_one_run_does() {
+    if !crate::engines::have_ray() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = ["assets/objects/cup.stl", "assets/objects/cylinder_d40.stl"];
+    let flags = ["--grasps", "2", "--samples", "1"];
+    let plain = dir.path().join("plain.jsonl");
+    let o = grasp_sim()
+        .arg("label")
+        .args(flags)
+        .args(inputs)
+        .arg("--out")
+        .arg(&plain)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let results = dir.path().join("results.jsonl");
+    let out = std::process::Command::new("python3")
+        .current_dir(root())
+        .args(["scripts/ray_batch.py", "--num-cpus", "2", "--shards", "3"])
+        .args(["--command", "label", "--binary"])
+        .arg(env!("CARGO_BIN_EXE_grasp-sim"))
+        .arg("--out")
+        .arg(&results)
+        .args(inputs)
+        .arg("--")
+        .args(flags)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.contains("2 CPUs, 3 shards"), "{err}");
+    let strip = |v: Vec<Value>| v.iter().map(without_label).collect::<Vec<_>>();
+    let labelled = strip(lines(&results));
+    assert_eq!(labelled.len(), 4, "two grasps of each object");
+    assert_eq!(labelled, strip(lines(&plain)));
+}
