@@ -24,7 +24,7 @@ use super::palm::{PalmPlacement, PENETRATION_TOL_MM};
 use super::{Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice_indexed_bridged, Slice, SliceIndex};
+use crate::slice::{Slice, SliceIndex, SliceOptions};
 use nalgebra::{Point2, Rotation2, Vector2};
 use std::f64::consts::PI;
 
@@ -115,7 +115,10 @@ pub fn place_finger(
     let mirror = f.side.sign();
     let slice = |dz: f64| {
         let plane = palm.finger_plane(f.height_mm + dz);
-        slice_indexed_bridged(mesh, index, &plane, 2.0 * o, hand.relief_mm())
+        let options = SliceOptions::indexed(index)
+            .within(hand.relief_mm())
+            .bridged(2.0 * o);
+        crate::slice::slice(mesh, &plane, options)
     };
     // Each plane is built once (its segments copied, the palm's outline checked: a
     // `PalmPenetration`, which no rule set relaxes) and its ALS placed on it.
@@ -731,6 +734,7 @@ mod tests {
                 u: nalgebra::Vector3::x(),
                 v: nalgebra::Vector3::y(),
             },
+            crate::slice::SliceOptions::default(),
         );
         assert_eq!(
             place_als(&s, &hand, 1.0),
