@@ -49,6 +49,14 @@ pub struct Row {
     pub hold_lower_bound: Option<f64>,
 }
 
+impl Row {
+    /// The verdict `verdict` names; `None` for an error, a check not run or a string that names
+    /// no verdict (the row keeps the string as the line gave it).
+    pub fn ran(&self) -> Option<Verdict> {
+        Verdict::named(&self.verdict)
+    }
+}
+
 /// Per gravity direction: how many grasps were checked under it and their verdicts.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct DirectionCount {
@@ -259,7 +267,7 @@ impl Summary {
         let p: Vec<f64> = sampled.iter().filter_map(|r| r.hold_probability).collect();
         let mean = p.iter().sum::<f64>() / p.len() as f64;
         let count = |f: &dyn Fn(f64) -> bool| p.iter().filter(|x| f(**x)).count();
-        let held = sampled.iter().filter(|r| r.verdict == "hold");
+        let held = sampled.iter().filter(|r| r.ran() == Some(Verdict::Hold));
         let weak = held
             .clone()
             .filter(|r| r.hold_lower_bound.is_some_and(|lo| lo < 0.9))
