@@ -26,7 +26,7 @@ use grasp_sim::quality;
 use grasp_sim::report::StageTimings;
 use grasp_sim::scenario::{GravityMode, PlannerParams, Protocol, SimParams};
 use grasp_sim::sim::{check, check_with_payload, Case, ObjectShape, SimHand};
-use grasp_sim::slice::{slice, Plane};
+use grasp_sim::slice::{slice, Plane, SliceOptions};
 use std::hint::black_box;
 use std::path::Path;
 
@@ -44,10 +44,16 @@ fn bench_slice(c: &mut Criterion) {
         let sphere = objects::uv_sphere(50.0, n);
         let tris = sphere.triangles.len();
         g.bench_with_input(BenchmarkId::new("horizontal", tris), &sphere, |b, m| {
-            b.iter(|| slice(black_box(m), &Plane::horizontal(10.0)))
+            b.iter(|| {
+                slice(
+                    black_box(m),
+                    &Plane::horizontal(10.0),
+                    SliceOptions::default(),
+                )
+            })
         });
         g.bench_with_input(BenchmarkId::new("vertical", tris), &sphere, |b, m| {
-            b.iter(|| slice(black_box(m), &Plane::vertical(0.3)))
+            b.iter(|| slice(black_box(m), &Plane::vertical(0.3), SliceOptions::default()))
         });
     }
     g.finish();

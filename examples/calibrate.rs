@@ -16,7 +16,7 @@
 
 use grasp_sim::hand::Hand;
 use grasp_sim::plan::finger::place_als;
-use grasp_sim::slice::{slice, Plane};
+use grasp_sim::slice::{slice, Plane, SliceOptions};
 use nalgebra::{Point3, Vector3};
 use std::path::Path;
 
@@ -38,6 +38,7 @@ fn object_slice(mesh: &grasp_sim::mesh::Mesh, z: f64, x_front: f64) -> grasp_sim
             u: Vector3::x(),
             v: Vector3::y(),
         },
+        SliceOptions::default(),
     )
 }
 

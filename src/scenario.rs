@@ -363,61 +363,9 @@ impl Scenario {
         raw.sim
             .validate(hand.finger_list.len())
             .map_err(|(key, problem)| invalid(key, problem))?;
-        for (key, p) in raw.expect.as_ref().map_or(vec![], |e| {
-            vec![
-                ("expect.min_hold_probability", e.min_hold_probability),
-                (
-                    "expect.min_as_planned_probability",
-                    e.min_as_planned_probability,
-                ),
-            ]
-        }) {
-            if let Some(p) = p {
-                if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
-                    return Err(invalid(key, format!("must be in [0, 1], got {p}")));
-                }
-            }
-        }
-        if let Some(e) = raw.expect.as_ref().filter(|e| e.as_planned) {
-            if e.outcome != Outcome::Hold {
-                return Err(invalid(
-                    "expect.as_planned",
-                    format!(
-                        "asks for a hold as planned, but outcome is \"{}\": set outcome = \"hold\"",
-                        e.outcome.as_str()
-                    ),
-                ));
-            }
-        }
-        if let Some(t) = raw.expect.as_ref().and_then(|e| e.theta_deg.as_ref()) {
-            if t.len() != hand.finger_list.len() {
-                return Err(invalid(
-                    "expect.theta_deg",
-                    format!(
-                        "has {} fingers, the hand has {}",
-                        t.len(),
-                        hand.finger_list.len()
-                    ),
-                ));
-            }
-        }
-        // The name is the output folders' subfolder (`--report DIR/NAME`): one folder name,
-        // checked here; a file stem is made one (`..stl` would name `.`).
-        if let Some(problem) = raw
-            .name
-            .as_deref()
-            .and_then(crate::files::folder_name_problem)
-        {
-            return Err(invalid(
-                "name",
-                format!(
-                    "{problem}: it names the run's folder inside --report, --export-mjcf and \
-                     --export-urdf, so it must be one folder name (not `.` or `..`, no `/`, `\\`, \
-                     NUL or control characters, at most {} bytes)",
-                    crate::files::MAX_FOLDER_NAME_BYTES
-                ),
-            ));
-        }
+        validate_expect(raw.expect.as_ref(), hand.finger_list.len())
+            .map_err(|(key, problem)| invalid(key, problem))?;
+        validate_name(raw.name.as_deref()).map_err(|(key, problem)| invalid(key, problem))?;
         let name = raw.name.unwrap_or_else(|| {
             crate::files::folder_name(
                 &path
@@ -523,6 +471,65 @@ fn validate_object(o: &RawObject) -> Result<MassSpec, (&'static str, String)> {
         ));
     }
     Ok(mass)
+}
+
+/// The `[expect]` table against a hand of `fingers` fingers: the probabilities in [0, 1], an
+/// as-planned hold asked only with outcome `hold`, one `theta_deg` entry per finger. The key
+/// and the problem of the first that is wrong.
+fn validate_expect(expect: Option<&Expect>, fingers: usize) -> Result<(), (&'static str, String)> {
+    for (key, p) in expect.map_or(vec![], |e| {
+        vec![
+            ("expect.min_hold_probability", e.min_hold_probability),
+            (
+                "expect.min_as_planned_probability",
+                e.min_as_planned_probability,
+            ),
+        ]
+    }) {
+        if let Some(p) = p {
+            if !(p.is_finite() && (0.0..=1.0).contains(&p)) {
+                return Err((key, format!("must be in [0, 1], got {p}")));
+            }
+        }
+    }
+    if let Some(e) = expect.filter(|e| e.as_planned) {
+        if e.outcome != Outcome::Hold {
+            return Err((
+                "expect.as_planned",
+                format!(
+                    "asks for a hold as planned, but outcome is \"{}\": set outcome = \"hold\"",
+                    e.outcome.as_str()
+                ),
+            ));
+        }
+    }
+    if let Some(t) = expect.and_then(|e| e.theta_deg.as_ref()) {
+        if t.len() != fingers {
+            return Err((
+                "expect.theta_deg",
+                format!("has {} fingers, the hand has {}", t.len(), fingers),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The scenario's `name`, when given: the output folders' subfolder (`--report DIR/NAME`), so
+/// one folder name, checked here (a file stem, the name otherwise, is made one: `..stl` would
+/// name `.`).
+fn validate_name(name: Option<&str>) -> Result<(), (&'static str, String)> {
+    if let Some(problem) = name.and_then(crate::files::folder_name_problem) {
+        return Err((
+            "name",
+            format!(
+                "{problem}: it names the run's folder inside --report, --export-mjcf and \
+                 --export-urdf, so it must be one folder name (not `.` or `..`, no `/`, `\\`, \
+                 NUL or control characters, at most {} bytes)",
+                crate::files::MAX_FOLDER_NAME_BYTES
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Loads the scenario's hand (a bundled one by name unless a file of that name is beside the

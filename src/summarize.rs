@@ -49,6 +49,14 @@ pub struct Row {
     pub hold_lower_bound: Option<f64>,
 }
 
+impl Row {
+    /// The verdict `verdict` names; `None` for an error, a check not run or a string that names
+    /// no verdict (the row keeps the string as the line gave it).
+    pub fn ran(&self) -> Option<Verdict> {
+        Verdict::named(&self.verdict)
+    }
+}
+
 /// Per gravity direction: how many grasps were checked under it and their verdicts.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct DirectionCount {
@@ -142,32 +150,10 @@ impl Summary {
                 line: i + 1,
                 why,
             };
-            let text = std::str::from_utf8(line).map_err(|_| bad("not UTF-8".to_string()))?;
-            // The view straight from the text (no JSON tree of the whole line); where that
-            // fails, the tree says why.
-            let v = match serde_json::from_str::<RecordView>(text) {
-                Ok(v) if text.trim_start().starts_with('{') => v,
-                _ => {
-                    let v: serde_json::Value =
-                        serde_json::from_str(text).map_err(|e| bad(format!("not JSON ({e})")))?;
-                    if !v.is_object() {
-                        return Err(bad("not a JSON object".to_string()));
-                    }
-                    RecordView::of(&v)
-                }
-            };
+            let v = view_of(line).map_err(bad)?;
             let row = row_of(&v).map_err(bad)?;
             *seen.entry(row.input.clone()).or_insert(0) += 1;
-            for d in &v.sim.directions {
-                let c = s.directions.entry(direction_label(&d.gravity)).or_default();
-                c.checked += 1;
-                match d.ran() {
-                    Some(Verdict::Hold) => c.hold += 1,
-                    Some(Verdict::Slip) => c.slip += 1,
-                    Some(Verdict::Drop) => c.drop += 1,
-                    None => {}
-                }
-            }
+            s.count_directions(&v);
             s.counts.add(&v);
             s.rows.push(row);
         }
@@ -183,6 +169,23 @@ impl Summary {
             ));
         }
         Ok(s)
+    }
+
+    /// Counts each gravity direction of the line `v` and its verdict.
+    fn count_directions(&mut self, v: &RecordView) {
+        for d in &v.sim.directions {
+            let c = self
+                .directions
+                .entry(direction_label(&d.gravity))
+                .or_default();
+            c.checked += 1;
+            match d.ran() {
+                Some(Verdict::Hold) => c.hold += 1,
+                Some(Verdict::Slip) => c.slip += 1,
+                Some(Verdict::Drop) => c.drop += 1,
+                None => {}
+            }
+        }
     }
 
     /// The report as text: `name` heads it; the `slowest` slowest objects are listed.
@@ -259,7 +262,7 @@ impl Summary {
         let p: Vec<f64> = sampled.iter().filter_map(|r| r.hold_probability).collect();
         let mean = p.iter().sum::<f64>() / p.len() as f64;
         let count = |f: &dyn Fn(f64) -> bool| p.iter().filter(|x| f(**x)).count();
-        let held = sampled.iter().filter(|r| r.verdict == "hold");
+        let held = sampled.iter().filter(|r| r.ran() == Some(Verdict::Hold));
         let weak = held
             .clone()
             .filter(|r| r.hold_lower_bound.is_some_and(|lo| lo < 0.9))
@@ -377,6 +380,24 @@ fn direction_label(v: &[f64]) -> String {
         }
     }
     format!("({:.3}, {:.3}, {:.3})", v[0], v[1], v[2])
+}
+
+/// The view of one complete line (without its newline), or why it is not a JSON object.
+fn view_of(line: &[u8]) -> Result<RecordView, String> {
+    let text = std::str::from_utf8(line).map_err(|_| "not UTF-8".to_string())?;
+    // The view straight from the text (no JSON tree of the whole line); where that fails, the
+    // tree says why.
+    match serde_json::from_str::<RecordView>(text) {
+        Ok(v) if text.trim_start().starts_with('{') => Ok(v),
+        _ => {
+            let v: serde_json::Value =
+                serde_json::from_str(text).map_err(|e| format!("not JSON ({e})"))?;
+            if !v.is_object() {
+                return Err("not a JSON object".to_string());
+            }
+            Ok(RecordView::of(&v))
+        }
+    }
 }
 
 /// The row of one line.

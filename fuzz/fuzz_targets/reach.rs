@@ -4,7 +4,7 @@
 //! number that comes out is finite. Included by the targets with `#[path]`.
 
 use grasp_sim::mesh::{align, sliced_mass_properties, Mesh};
-use grasp_sim::slice::Plane;
+use grasp_sim::slice::{Plane, SliceOptions};
 
 /// The slicer and the union on `mesh`: no panic, finite results.
 pub fn reach(mesh: &Mesh) {
@@ -20,7 +20,7 @@ pub fn reach(mesh: &Mesh) {
         Plane::vertical(1.0),
     ];
     for plane in &planes {
-        let s = grasp_sim::slice::slice(&a.mesh, plane);
+        let s = grasp_sim::slice::slice(&a.mesh, plane, SliceOptions::default());
         let joined = s.clone().joined(1.0);
         let bridged = s.bridged_within(5.0, 0.2);
         for c in joined.contours.iter().chain(&bridged.contours) {

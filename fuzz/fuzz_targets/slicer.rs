@@ -2,7 +2,7 @@
 //! are finite and lie on the plane, its normals are unit vectors.
 #![no_main]
 use grasp_sim::objects::thesis_objects;
-use grasp_sim::slice::{slice, Plane};
+use grasp_sim::slice::{slice, Plane, SliceOptions};
 use libfuzzer_sys::fuzz_target;
 use nalgebra::{Point3, Vector3};
 use std::sync::OnceLock;
@@ -27,7 +27,7 @@ fuzz_target!(|data: &[u8]| {
         return;
     }
     let plane = Plane::new(Point3::new(f[0], f[1], f[2]), u, v);
-    let s = slice(mesh, &plane);
+    let s = slice(mesh, &plane, SliceOptions::default());
     for c in &s.contours {
         assert!(c.is_closed, "a closed manifold gives closed contours");
         assert_eq!(c.points.len(), c.normals.len());

@@ -2,7 +2,7 @@
 //! aligned and sliced.
 #![no_main]
 use grasp_sim::mesh::{align, parse_stl, LengthUnit};
-use grasp_sim::slice::{slice, Plane};
+use grasp_sim::slice::{slice, Plane, SliceOptions};
 use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
@@ -11,6 +11,10 @@ fuzz_target!(|data: &[u8]| {
         assert!(loaded.mesh.vertices.iter().all(|p| p.iter().all(|c| c.is_finite())));
         let a = align(&loaded.mesh);
         assert!(a.height_mm.is_finite());
-        let _ = slice(&a.mesh, &Plane::horizontal(a.height_mm / 2.0));
+        let _ = slice(
+            &a.mesh,
+            &Plane::horizontal(a.height_mm / 2.0),
+            SliceOptions::default(),
+        );
     }
 });

@@ -130,26 +130,10 @@ pub fn run_streaming(
         // The watchdog: kill the worker at the deadline.
         if let Some(deadline) = deadline {
             let (timed_out, finished) = (&timed_out, &finished);
-            scope.spawn(move || {
-                while !finished.load(std::sync::atomic::Ordering::Relaxed) {
-                    if Instant::now() >= deadline {
-                        timed_out.store(true, std::sync::atomic::Ordering::Relaxed);
-                        kill(pid);
-                        return;
-                    }
-                    std::thread::sleep(Duration::from_millis(50));
-                }
-            });
+            scope.spawn(move || watch(pid, deadline, timed_out, finished));
         }
         if let Some(out) = stdout {
-            use std::io::BufRead;
-            for line in std::io::BufReader::new(out).lines() {
-                match line {
-                    Ok(l) if !l.trim().is_empty() => on_line(&l),
-                    Ok(_) => {}
-                    Err(_) => break,
-                }
-            }
+            each_line(out, on_line);
         }
         finished.store(true, std::sync::atomic::Ordering::Relaxed);
     });
@@ -178,6 +162,36 @@ pub fn run_streaming(
                 signal_name(sig)
             ))
         })
+}
+
+/// Kills the worker `pid` at `deadline`, setting `timed_out`, unless `finished` is set first.
+fn watch(
+    pid: u32,
+    deadline: Instant,
+    timed_out: &std::sync::atomic::AtomicBool,
+    finished: &std::sync::atomic::AtomicBool,
+) {
+    while !finished.load(std::sync::atomic::Ordering::Relaxed) {
+        if Instant::now() >= deadline {
+            timed_out.store(true, std::sync::atomic::Ordering::Relaxed);
+            kill(pid);
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
+/// Calls `on_line` with each line of `out` that is not blank, as it comes, until its end or
+/// the first read that fails.
+fn each_line(out: impl std::io::Read, on_line: &(dyn Fn(&str) + Sync)) {
+    use std::io::BufRead;
+    for line in std::io::BufReader::new(out).lines() {
+        match line {
+            Ok(l) if !l.trim().is_empty() => on_line(&l),
+            Ok(_) => {}
+            Err(_) => break,
+        }
+    }
 }
 
 /// Sends `SIGKILL` to the process `pid` (a worker past its time).

@@ -243,24 +243,12 @@ impl Held {
 pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
     let template = request.worker.template()?;
     check_outputs(request)?;
-    // The output folders locked for this run: a second run into one is refused (issue 56).
-    let export = request.worker.export.as_ref().map(|e| e.dir.clone());
-    let _folders = [&request.npz, &export]
-        .into_iter()
-        .flatten()
-        .map(|d| crate::pipeline::lock_output_dir(d))
-        .collect::<anyhow::Result<Vec<_>>>()?;
+    let _folders = lock_output_folders(request)?;
     let mut items = batch::expand(&request.inputs)?;
     if let Some(shard) = request.shard {
         items = shard.of(&items);
     }
-    let keys: Vec<Key> = items
-        .par_iter()
-        .map(|item| Key {
-            input: item.path().display().to_string(),
-            input_hash: request.worker.input_hash(item, &template),
-        })
-        .collect();
+    let keys = keys_of(request, &items, &template);
     let _lock = match &request.out {
         Some(path) => Some(journal::RunLock::take(path)?),
         None => None,
@@ -273,15 +261,7 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
     let todo: Vec<usize> = (0..items.len())
         .filter(|&i| !held.get(&keys[i]).is_some_and(Held::is_complete))
         .collect();
-    if let Some(path) = request.out.as_ref().filter(|_| request.resume) {
-        eprintln!(
-            "resume: {} of {} complete in {}; labelling {}",
-            items.len() - todo.len(),
-            batch::plural(items.len(), "object"),
-            path.display(),
-            todo.len()
-        );
-    }
+    report_resume(request, items.len(), todo.len());
     let jobs = request
         .jobs
         .unwrap_or_else(batch::command::default_jobs)
@@ -289,11 +269,7 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
     let worker = (!request.in_process)
         .then(|| worker(request, (jobs / todo.len().max(1)).max(1)))
         .transpose()?;
-    let keeper = Keeper {
-        journal: journal.as_ref(),
-        lines: Mutex::new(Vec::new()),
-        error: Mutex::new(None),
-    };
+    let keeper = Keeper::new(journal.as_ref());
     let summaries: Mutex<Vec<(usize, ObjectSummary)>> = Mutex::new(Vec::new());
     let done = std::sync::atomic::AtomicUsize::new(0);
     progress.begin(todo.len());
@@ -327,34 +303,122 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
         Err(_) => work(),
     }
     progress.end();
-    let (new_lines, error) = (keeper.lines, keeper.error);
-    if let Some(e) = error.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        return Err(e);
-    }
-    for l in new_lines.into_inner().unwrap_or_else(|p| p.into_inner()) {
-        held.entry(l.key.clone())
-            .or_default()
-            .lines
-            .insert(l.grasp_index, l);
-    }
+    hold_lines(&mut held, keeper.into_lines()?);
     let mut summaries = summaries.into_inner().unwrap_or_else(|p| p.into_inner());
     summaries.sort_by_key(|(i, _)| *i);
     let (errors, grasps) = write_all(request, &keys, &held, journal, &summaries)?;
     if let Some(dir) = &request.npz {
         write_npz(dir, &keys, &held, &template, &request.worker, &items)?;
     }
-    let samples: usize = summaries.iter().map(|(_, s)| s.samples_checked).sum();
     let seconds = t0.elapsed().as_secs_f64();
+    report_totals(grasps, items.len(), &summaries, errors, seconds, jobs);
+    Ok(if errors > 0 { 2 } else { 0 })
+}
+
+/// Adds `lines` to what `held` holds of their objects, each in place of a line of the same
+/// object and grasp index.
+fn hold_lines(held: &mut HashMap<Key, Held>, lines: Vec<ReadLine>) {
+    for l in lines {
+        held.entry(l.key.clone())
+            .or_default()
+            .lines
+            .insert(l.grasp_index, l);
+    }
+}
+
+/// Locks the output folders of this run (`--npz`, `--export-mjcf`): a second run into one is
+/// refused (issue 56). The locks hold while the returned guards live.
+///
+/// # Errors
+/// A folder that cannot be written or is locked by another run.
+fn lock_output_folders(request: &Request) -> anyhow::Result<Vec<crate::files::FolderLock>> {
+    let export = request.worker.export.as_ref().map(|e| e.dir.clone());
+    [&request.npz, &export]
+        .into_iter()
+        .flatten()
+        .map(|d| crate::pipeline::lock_output_dir(d))
+        .collect()
+}
+
+/// Each item's key: its input as given and the hash of what decides its lines.
+fn keys_of(request: &Request, items: &[Item], template: &Scenario) -> Vec<Key> {
+    items
+        .par_iter()
+        .map(|item| Key {
+            input: item.path().display().to_string(),
+            input_hash: request.worker.input_hash(item, template),
+        })
+        .collect()
+}
+
+/// With `--out FILE --resume`, says how many of the `objects` the file already completes and
+/// how many (`todo`) are labelled now.
+fn report_resume(request: &Request, objects: usize, todo: usize) {
+    if let Some(path) = request.out.as_ref().filter(|_| request.resume) {
+        eprintln!(
+            "resume: {} of {} complete in {}; labelling {}",
+            objects - todo,
+            batch::plural(objects, "object"),
+            path.display(),
+            todo
+        );
+    }
+}
+
+/// The run's last line: the grasps labelled over the `objects`, this run's share, the errors,
+/// and the perturbed checks' rate over `seconds` on `jobs` jobs.
+fn report_totals(
+    grasps: usize,
+    objects: usize,
+    summaries: &[(usize, ObjectSummary)],
+    errors: usize,
+    seconds: f64,
+    jobs: usize,
+) {
+    let samples: usize = summaries.iter().map(|(_, s)| s.samples_checked).sum();
     eprintln!(
         "label: {} labelled in {} ({} this run) with {} errors; {} perturbed checks in {seconds:.1} s ({:.2} a second) on {jobs} jobs",
         batch::plural(grasps, "grasp"),
-        batch::plural(items.len(), "object"),
+        batch::plural(objects, "object"),
         summaries.iter().map(|(_, s)| s.labelled).sum::<usize>(),
         errors,
         samples,
         samples as f64 / seconds.max(1e-9),
     );
-    Ok(if errors > 0 { 2 } else { 0 })
+}
+
+/// The files `--merge` names: each file as given, each folder's `.jsonl` files in name order.
+///
+/// # Errors
+/// A folder that cannot be read.
+fn merge_files(merge: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+    let mut files = Vec::new();
+    for m in merge {
+        if m.is_dir() {
+            let mut found: Vec<PathBuf> = std::fs::read_dir(m)
+                .with_context(|| format!("{}: cannot read folder", m.display()))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "jsonl"))
+                .collect();
+            found.sort();
+            files.extend(found);
+        } else {
+            files.push(m.clone());
+        }
+    }
+    Ok(files)
+}
+
+/// Writes `text` to `out` atomically, or to standard output without one.
+///
+/// # Errors
+/// A write that failed.
+fn write_text(out: Option<&Path>, text: &str) -> anyhow::Result<()> {
+    match out {
+        Some(path) => journal::write_atomically(path, text.as_bytes())?,
+        None => std::io::stdout().lock().write_all(text.as_bytes())?,
+    }
+    Ok(())
 }
 
 /// Checks that every output `request` names can be written, before any work.
@@ -384,7 +448,16 @@ struct Keeper<'a> {
     error: Mutex<Option<anyhow::Error>>,
 }
 
-impl Keeper<'_> {
+impl<'a> Keeper<'a> {
+    /// A keeper appending to `journal`, when given, with no line kept yet.
+    fn new(journal: Option<&'a journal::Journal>) -> Keeper<'a> {
+        Keeper {
+            journal,
+            lines: Mutex::new(Vec::new()),
+            error: Mutex::new(None),
+        }
+    }
+
     /// Keeps `line` (a line that is not a label line is dropped).
     fn keep(&self, line: Line) {
         let Ok(r) = read_line(&line.text) else {
@@ -397,6 +470,17 @@ impl Keeper<'_> {
                 .get_or_insert(e.into());
         }
         self.lines.lock().unwrap_or_else(|p| p.into_inner()).push(r);
+    }
+
+    /// The lines kept, in the order they came.
+    ///
+    /// # Errors
+    /// The first append to the journal that failed.
+    fn into_lines(self) -> anyhow::Result<Vec<ReadLine>> {
+        if let Some(e) = self.error.into_inner().unwrap_or_else(|p| p.into_inner()) {
+            return Err(e);
+        }
+        Ok(self.lines.into_inner().unwrap_or_else(|p| p.into_inner()))
     }
 }
 
@@ -660,20 +744,7 @@ pub fn run_worker(
 /// `label --merge`: the shard files' lines for these inputs, in input order, checked: every
 /// input's object there exactly once and complete.
 fn merge(request: &Request, keys: &[Key]) -> anyhow::Result<u8> {
-    let mut files = Vec::new();
-    for m in &request.merge {
-        if m.is_dir() {
-            let mut found: Vec<PathBuf> = std::fs::read_dir(m)
-                .with_context(|| format!("{}: cannot read folder", m.display()))?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "jsonl"))
-                .collect();
-            found.sort();
-            files.extend(found);
-        } else {
-            files.push(m.clone());
-        }
-    }
+    let files = merge_files(&request.merge)?;
     let mut held: HashMap<Key, Held> = HashMap::new();
     let mut duplicated = Vec::new();
     for f in &files {
@@ -729,10 +800,7 @@ fn merge(request: &Request, keys: &[Key]) -> anyhow::Result<u8> {
         );
     }
     let (text, errors, grasps) = ordered(keys, &held);
-    match &request.out {
-        Some(path) => journal::write_atomically(path, text.as_bytes())?,
-        None => std::io::stdout().lock().write_all(text.as_bytes())?,
-    }
+    write_text(request.out.as_deref(), &text)?;
     eprintln!(
         "merge: {} of {} from {}, every input exactly once, {errors} errors",
         batch::plural(grasps, "grasp"),
@@ -799,17 +867,7 @@ pub fn check(request: &CheckRequest, progress: &dyn Progress) -> anyhow::Result<
     if let Some(path) = &request.out {
         check_output_file(path).context("--out")?;
     }
-    let args = WorkerArgs {
-        template: None,
-        units: request.units,
-        params: LabelParams {
-            grasps: 0,
-            samples: request.samples,
-            candidates: 0,
-        },
-        gravity: request.gravity,
-        export: None,
-    };
+    let args = request.worker_args();
     let template = args.template()?;
     let item = batch::classify(request.input.clone()).ok_or_else(|| {
         anyhow::anyhow!(
@@ -857,17 +915,8 @@ pub fn check(request: &CheckRequest, progress: &dyn Progress) -> anyhow::Result<
     // In line order.
     let mut records = out.into_inner().unwrap_or_else(|p| p.into_inner());
     records.sort_by_key(|l| l.order);
-    let mut text = String::new();
-    let mut errors = 0;
-    for r in &records {
-        text.push_str(&r.text);
-        text.push('\n');
-        errors += usize::from(r.is_error);
-    }
-    match &request.out {
-        Some(path) => journal::write_atomically(path, text.as_bytes())?,
-        None => std::io::stdout().lock().write_all(text.as_bytes())?,
-    }
+    let (text, errors) = joined_lines(&records);
+    write_text(request.out.as_deref(), &text)?;
     eprintln!(
         "check: {}: {} of {} checked ({errors} could not be), {} with hold probability >= 0.5; {} perturbed checks in {:.1} s",
         summary.object,
@@ -878,4 +927,34 @@ pub fn check(request: &CheckRequest, progress: &dyn Progress) -> anyhow::Result<
         summary.wall_ms / 1000.0
     );
     Ok(if errors > 0 { 2 } else { 0 })
+}
+
+impl CheckRequest {
+    /// The worker settings of a check: the built-in template, no grasps to plan, the request's
+    /// units, samples and gravity, no MJCF export.
+    fn worker_args(&self) -> WorkerArgs {
+        WorkerArgs {
+            template: None,
+            units: self.units,
+            params: LabelParams {
+                grasps: 0,
+                samples: self.samples,
+                candidates: 0,
+            },
+            gravity: self.gravity,
+            export: None,
+        }
+    }
+}
+
+/// The lines' texts, one a line, and how many of them are error lines.
+fn joined_lines(records: &[Line]) -> (String, usize) {
+    let mut text = String::new();
+    let mut errors = 0;
+    for r in records {
+        text.push_str(&r.text);
+        text.push('\n');
+        errors += usize::from(r.is_error);
+    }
+    (text, errors)
 }

@@ -79,42 +79,9 @@ impl GraspLine {
             }
         })?;
         let obj = v.as_object().ok_or("not a JSON object")?;
-        let pose = obj.get("palm_pose").ok_or("no `palm_pose`")?;
-        let palm_pose = match pose {
-            serde_json::Value::Array(_) => matrix4(pose)?,
-            serde_json::Value::Object(_) => pose_of_report(pose)?,
-            _ => {
-                return Err(
-                    "`palm_pose` is neither a 4 x 4 list nor {position_mm, quaternion_wxyz}".into(),
-                )
-            }
-        };
-        check_rigid(&palm_pose)?;
-        if let Some(x) = (0..3)
-            .map(|i| palm_pose[i][3])
-            .find(|x| x.abs() > MAX_POSITION_MM)
-        {
-            return Err(format!(
-                "`palm_pose`'s translation {x} mm is farther than {MAX_POSITION_MM} mm from the file's origin"
-            ));
-        }
+        let palm_pose = palm_pose_of(obj.get("palm_pose").ok_or("no `palm_pose`")?)?;
         let angles = obj.get("joint_angles_deg").ok_or("no `joint_angles_deg`")?;
-        let joint_angles_deg = pairs(angles, "joint_angles_deg")?;
-        if joint_angles_deg.len() != fingers {
-            return Err(format!(
-                "`joint_angles_deg` has {} fingers' angles, the hand has {fingers} fingers",
-                joint_angles_deg.len()
-            ));
-        }
-        if let Some(a) = joint_angles_deg
-            .iter()
-            .flatten()
-            .find(|a| a.abs() > MAX_JOINT_DEG)
-        {
-            return Err(format!(
-                "`joint_angles_deg`: {a}° is outside [-{MAX_JOINT_DEG}°, {MAX_JOINT_DEG}°]"
-            ));
-        }
+        let joint_angles_deg = joint_angles_of(angles, fingers)?;
         let axis = match obj.get("axis_name") {
             None | Some(serde_json::Value::Null) => GraspAxis::THESIS,
             Some(serde_json::Value::String(name)) => GraspAxis::from_name(name).ok_or_else(|| {
@@ -249,6 +216,52 @@ fn short(v: &serde_json::Value) -> String {
     } else {
         s
     }
+}
+
+/// A given grasp's `palm_pose` (a 4 x 4 nested list or `{position_mm, quaternion_wxyz}`):
+/// rigid, and within [`MAX_POSITION_MM`] of the file's origin.
+fn palm_pose_of(pose: &serde_json::Value) -> Result<[[f64; 4]; 4], String> {
+    let palm_pose = match pose {
+        serde_json::Value::Array(_) => matrix4(pose)?,
+        serde_json::Value::Object(_) => pose_of_report(pose)?,
+        _ => {
+            return Err(
+                "`palm_pose` is neither a 4 x 4 list nor {position_mm, quaternion_wxyz}".into(),
+            )
+        }
+    };
+    check_rigid(&palm_pose)?;
+    if let Some(x) = (0..3)
+        .map(|i| palm_pose[i][3])
+        .find(|x| x.abs() > MAX_POSITION_MM)
+    {
+        return Err(format!(
+            "`palm_pose`'s translation {x} mm is farther than {MAX_POSITION_MM} mm from the file's origin"
+        ));
+    }
+    Ok(palm_pose)
+}
+
+/// A given grasp's `joint_angles_deg`: one `[θ1, θ2]` per finger of a hand of `fingers`, each
+/// within [`MAX_JOINT_DEG`].
+fn joint_angles_of(angles: &serde_json::Value, fingers: usize) -> Result<Vec<[f64; 2]>, String> {
+    let joint_angles_deg = pairs(angles, "joint_angles_deg")?;
+    if joint_angles_deg.len() != fingers {
+        return Err(format!(
+            "`joint_angles_deg` has {} fingers' angles, the hand has {fingers} fingers",
+            joint_angles_deg.len()
+        ));
+    }
+    if let Some(a) = joint_angles_deg
+        .iter()
+        .flatten()
+        .find(|a| a.abs() > MAX_JOINT_DEG)
+    {
+        return Err(format!(
+            "`joint_angles_deg`: {a}° is outside [-{MAX_JOINT_DEG}°, {MAX_JOINT_DEG}°]"
+        ));
+    }
+    Ok(joint_angles_deg)
 }
 
 /// A 4 × 4 nested list of numbers.

@@ -264,6 +264,46 @@ struct Posed {
     shape: sim::ObjectShape,
 }
 
+/// Per grasp being checked: its nominal check, its samples' checks, and how many of them are
+/// done.
+type Slot = (
+    Option<SimOutcome>,
+    Vec<Option<(Perturbation, SimOutcome)>>,
+    usize,
+);
+
+/// Runs one check of a grasp, its nominal check (`k` = `None`) or its sample `k`, and stores it
+/// in the grasp's `slot`; returns true if and only if it was the last of the grasp's `samples +
+/// 1` checks to finish.
+fn run_task(case: &sim::Case, slot: &Mutex<Slot>, k: Option<usize>, samples: usize) -> bool {
+    match k {
+        None => {
+            let out = sim::check(case);
+            let mut slot = slot.lock().unwrap_or_else(|e| e.into_inner());
+            slot.0 = Some(out);
+            slot.2 += 1;
+            slot.2 == samples + 1
+        }
+        Some(k) => {
+            let run = sim::robust::check_sample(case, k);
+            let mut slot = slot.lock().unwrap_or_else(|e| e.into_inner());
+            slot.1[k] = Some(run);
+            slot.2 += 1;
+            slot.2 == samples + 1
+        }
+    }
+}
+
+/// The nominal check and the samples' checks of a grasp whose checks are all done, taken out of
+/// its `slot`; `None` if one is missing.
+fn take_checks(slot: &Mutex<Slot>) -> Option<(SimOutcome, Vec<(Perturbation, SimOutcome)>)> {
+    let (nominal, runs) = {
+        let mut slot = slot.lock().unwrap_or_else(|e| e.into_inner());
+        (slot.0.take(), std::mem::take(&mut slot.1))
+    };
+    Some((nominal?, runs.into_iter().collect::<Option<Vec<_>>>()?))
+}
+
 /// Checks every grasp of `grasps` (the nominal check and `scenario.sim.robust.samples` samples
 /// each), all the object's checks spread over the cores, and calls `emit` with each grasp's
 /// record as soon as its checks are done. Returns the perturbed checks run and how many grasps
@@ -280,12 +320,6 @@ fn check_all(
         .iter()
         .map(|g| object.case(scenario, &g.pose, &g.shape))
         .collect();
-    // Per grasp: its nominal check, its samples' checks, when it started.
-    type Slot = (
-        Option<SimOutcome>,
-        Vec<Option<(Perturbation, SimOutcome)>>,
-        usize,
-    );
     let slots: Vec<Mutex<Slot>> = grasps
         .iter()
         .map(|_| Mutex::new((None, vec![None; samples], 0)))
@@ -301,31 +335,10 @@ fn check_all(
             .unwrap_or_else(|e| e.into_inner())
             .get_or_insert_with(Instant::now);
         let case = &cases[g];
-        let done = match k {
-            None => {
-                let out = sim::check(case);
-                let mut slot = slots[g].lock().unwrap_or_else(|e| e.into_inner());
-                slot.0 = Some(out);
-                slot.2 += 1;
-                slot.2 == samples + 1
-            }
-            Some(k) => {
-                let run = sim::robust::check_sample(case, k);
-                let mut slot = slots[g].lock().unwrap_or_else(|e| e.into_inner());
-                slot.1[k] = Some(run);
-                slot.2 += 1;
-                slot.2 == samples + 1
-            }
-        };
-        if !done {
+        if !run_task(case, &slots[g], k, samples) {
             return;
         }
-        let (nominal, runs) = {
-            let mut slot = slots[g].lock().unwrap_or_else(|e| e.into_inner());
-            (slot.0.take(), std::mem::take(&mut slot.1))
-        };
-        let (Some(nominal), Some(runs)) = (nominal, runs.into_iter().collect::<Option<Vec<_>>>())
-        else {
+        let Some((nominal, runs)) = take_checks(&slots[g]) else {
             return;
         };
         let started = starts[g]

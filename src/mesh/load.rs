@@ -914,15 +914,6 @@ const FACET_LINES: [(&str, usize); 7] = [
 /// [`stl_ascii`]'s parser: the triangles of every solid, or the error's detail, `line N
 /// (`the line`): expected ...` (or `line N (end of file)`).
 fn parse_ascii_stl(text: &str) -> Result<Vec<[[f32; 3]; 3]>, String> {
-    let quote = |l: &str| {
-        let l = l.trim();
-        let short: String = l.chars().take(80).collect();
-        if short.len() < l.len() {
-            format!("`{short}...`")
-        } else {
-            format!("`{short}`")
-        }
-    };
     let mut out = Vec::new();
     // Where in the grammar: None between solids, Some(step) inside one (step 0: a facet or
     // `endsolid`).
@@ -945,7 +936,7 @@ fn parse_ascii_stl(text: &str) -> Result<Vec<[[f32; 3]; 3]>, String> {
                     } else {
                         "expected `solid` or the end of the file after `endsolid`"
                     };
-                    return Err(format!("line {n} ({}): {want}", quote(line)));
+                    return Err(format!("line {n} ({}): {want}", quote_line(line)));
                 }
                 solids += 1;
                 state = Some(0);
@@ -957,38 +948,8 @@ fn parse_ascii_stl(text: &str) -> Result<Vec<[[f32; 3]; 3]>, String> {
             state = None;
             continue;
         }
-        let (keyword, count) = FACET_LINES[step];
-        let want = || {
-            let nums = if count == 3 { " x y z" } else { "" };
-            if step == 0 {
-                format!("expected `{keyword}{nums}` or `endsolid`")
-            } else {
-                format!("expected `{keyword}{nums}`")
-            }
-        };
-        let kw: Vec<&str> = keyword.split(' ').collect();
-        let mut all = std::iter::once(first).chain(words);
-        if !kw.iter().all(|k| all.next() == Some(*k)) {
-            return Err(format!("line {n} ({}): {}", quote(line), want()));
-        }
-        let numbers: Vec<&str> = all.collect();
-        if numbers.len() != count {
-            return Err(format!("line {n} ({}): {}", quote(line), want()));
-        }
-        let mut v = [0f32; 3];
-        for (k, w) in numbers.iter().enumerate() {
-            match w.parse::<f32>() {
-                Ok(x) if x.is_finite() => v[k] = x,
-                Ok(_) => {
-                    return Err(format!(
-                        "line {n} ({}): {}, with finite numbers",
-                        quote(line),
-                        want()
-                    ))
-                }
-                Err(e) => return Err(format!("line {n} ({}): {} ({e})", quote(line), want())),
-            }
-        }
+        let v = facet_line(step, std::iter::once(first).chain(words))
+            .map_err(|want| format!("line {n} ({}): {want}", quote_line(line)))?;
         if (2..=4).contains(&step) {
             corners[step - 2] = v;
         }
@@ -1009,6 +970,50 @@ fn parse_ascii_stl(text: &str) -> Result<Vec<[[f32; 3]; 3]>, String> {
             Err(format!("line {} (end of file): {want}", last + 1))
         }
     }
+}
+
+/// A line of an ASCII STL as an error message quotes it: trimmed, and cut to 80 characters
+/// (with `...`) when longer, in backquotes.
+fn quote_line(l: &str) -> String {
+    let l = l.trim();
+    let short: String = l.chars().take(80).collect();
+    if short.len() < l.len() {
+        format!("`{short}...`")
+    } else {
+        format!("`{short}`")
+    }
+}
+
+/// The facet line at `step` of [`FACET_LINES`], given as its `words`: its numbers (zeros for a
+/// line without any), or what was expected (`expected ...`, with why a number was refused).
+fn facet_line<'a>(step: usize, words: impl Iterator<Item = &'a str>) -> Result<[f32; 3], String> {
+    let (keyword, count) = FACET_LINES[step];
+    let want = || {
+        let nums = if count == 3 { " x y z" } else { "" };
+        if step == 0 {
+            format!("expected `{keyword}{nums}` or `endsolid`")
+        } else {
+            format!("expected `{keyword}{nums}`")
+        }
+    };
+    let kw: Vec<&str> = keyword.split(' ').collect();
+    let mut all = words;
+    if !kw.iter().all(|k| all.next() == Some(*k)) {
+        return Err(want());
+    }
+    let numbers: Vec<&str> = all.collect();
+    if numbers.len() != count {
+        return Err(want());
+    }
+    let mut v = [0f32; 3];
+    for (k, w) in numbers.iter().enumerate() {
+        match w.parse::<f32>() {
+            Ok(x) if x.is_finite() => v[k] = x,
+            Ok(_) => return Err(format!("{}, with finite numbers", want())),
+            Err(e) => return Err(format!("{} ({e})", want())),
+        }
+    }
+    Ok(v)
 }
 
 fn read_triangles(
@@ -1133,49 +1138,15 @@ pub(super) fn build(
         });
     }
 
-    let mut topology = mesh.topology();
-    // Faces written the wrong way round on a shell would each subtract their share of the
-    // volume (a 40 mm cube with one of its 12 triangles turned read as 32 cm³ and was then
-    // flipped whole): they are turned to agree with their neighbours first.
     let mut notes = Vec::new();
-    if topology.misoriented_edges > 0 {
-        let turned = mesh.orient_consistently();
-        let before = topology.misoriented_edges;
-        topology = mesh.topology();
-        notes.push(format!(
-            "{turned} of {} triangles were wound against their neighbours ({before} edges walked \
-             the same way by both triangles); turned to agree with them",
-            mesh.triangles.len()
-        ));
-    }
+    let topology = oriented(&mut mesh, &mut notes);
     let holes_filled = if topology.boundary_edges > 0 {
         mesh.fill_small_holes(SMALL_HOLE_MM)
     } else {
         0
     };
-    // Of an open surface, the volume about the bounding box's centre depends on the frame the
-    // file was written in, and so would whether it is turned inside-out: its sign is taken from
-    // the fan about the surface's own centroid, which moves with it (issue 30).
-    let volume = if topology.boundary_edges > 0 {
-        super::align::covariant_signed_volume(&mesh)
-    } else {
-        super::mass_properties(&mesh).volume_mm3
-    };
+    let volume = enclosed_volume(&mesh, topology.boundary_edges > 0, diag2, path)?;
     let mut was_inverted = false;
-    // A closed surface of any real size encloses a volume well above rounding noise. The
-    // noise was taken from the bounding box alone (1e-9 of its diagonal cubed), which called a
-    // closed 10 km rod of 20 mm and a 0.001 × 1000 mm needle surfaces enclosing nothing
-    // (issue 56): a volume is kept as well when it stands above the rounding of its own
-    // terms, the triangles' tetrahedra about the box's centre (each good to the f32
-    // coordinates, some 1e-7 of itself), so that each reaches the check of what is wrong with
-    // it (too large for the planner's steps, too thin for the hand).
-    let noise = 1e-9 * diag2.powf(1.5);
-    if volume.abs() <= noise && volume.abs() <= 1e-5 * volume_terms(&mesh) {
-        return Err(MeshError::NoVolume {
-            path: p(),
-            volume_mm3: volume,
-        });
-    }
     if volume < 0.0 {
         mesh.flip();
         was_inverted = true;
@@ -1194,6 +1165,57 @@ pub(super) fn build(
         notes,
         mass_kg: None,
     })
+}
+
+/// The topology of `mesh` after the faces written the wrong way round on a shell are turned
+/// to agree with their neighbours, with a note in `notes` when any were. Such faces would each
+/// subtract their share of the volume (a 40 mm cube with one of its 12 triangles turned read as
+/// 32 cm³ and was then flipped whole).
+fn oriented(mesh: &mut Mesh, notes: &mut Vec<String>) -> Topology {
+    let mut topology = mesh.topology();
+    if topology.misoriented_edges > 0 {
+        let turned = mesh.orient_consistently();
+        let before = topology.misoriented_edges;
+        topology = mesh.topology();
+        notes.push(format!(
+            "{turned} of {} triangles were wound against their neighbours ({before} edges walked \
+             the same way by both triangles); turned to agree with them",
+            mesh.triangles.len()
+        ));
+    }
+    topology
+}
+
+/// The signed volume `mesh` encloses `[mm³]` (`is_open`: it has boundary edges; `diag2`: its
+/// bounding box's diagonal squared).
+///
+/// Of an open surface, the volume about the bounding box's centre depends on the frame the
+/// file was written in, and so would whether it is turned inside-out: its sign is taken from
+/// the fan about the surface's own centroid, which moves with it (issue 30).
+///
+/// # Errors
+/// [`MeshError::NoVolume`] naming `path`, for a volume within rounding noise.
+fn enclosed_volume(mesh: &Mesh, is_open: bool, diag2: f64, path: &Path) -> Result<f64, MeshError> {
+    let volume = if is_open {
+        super::align::covariant_signed_volume(mesh)
+    } else {
+        super::mass_properties(mesh).volume_mm3
+    };
+    // A closed surface of any real size encloses a volume well above rounding noise. The
+    // noise was taken from the bounding box alone (1e-9 of its diagonal cubed), which called a
+    // closed 10 km rod of 20 mm and a 0.001 × 1000 mm needle surfaces enclosing nothing
+    // (issue 56): a volume is kept as well when it stands above the rounding of its own
+    // terms, the triangles' tetrahedra about the box's centre (each good to the f32
+    // coordinates, some 1e-7 of itself), so that each reaches the check of what is wrong with
+    // it (too large for the planner's steps, too thin for the hand).
+    let noise = 1e-9 * diag2.powf(1.5);
+    if volume.abs() <= noise && volume.abs() <= 1e-5 * volume_terms(mesh) {
+        return Err(MeshError::NoVolume {
+            path: path.to_path_buf(),
+            volume_mm3: volume,
+        });
+    }
+    Ok(volume)
 }
 
 /// The most elevation-angle cells [`check_planner_work`] lets the planner hold: 400,000 (a

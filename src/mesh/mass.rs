@@ -145,7 +145,8 @@ fn sliced_mass_properties_with(mesh: &Mesh, n: usize, join_mm: f64) -> MassPrope
         .map(|k| {
             let z_abs = lo.z + (k as f64 + 0.5) * dz;
             let plane = super::slice::Plane::horizontal(z_abs);
-            let s = super::slice::slice(mesh, &plane).joined(join_mm);
+            let s = super::slice::slice(mesh, &plane, super::slice::SliceOptions::default())
+                .joined(join_mm);
             let (mut a, mut sx, mut sy, mut sxx, mut syy, mut sxy) = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0);
             for c in s.contours.iter().filter(|c| c.is_closed) {
                 let np = c.points.len();

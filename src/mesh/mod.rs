@@ -345,25 +345,7 @@ impl Mesh {
                 }
                 let f = scaled(&p);
                 let c = [f.x.floor() as i64, f.y.floor() as i64, f.z.floor() as i64];
-                let near = |k: usize| if f[k] - c[k] as f64 >= 0.5 { 1 } else { -1 };
-                let (nx, ny, nz) = (near(0), near(1), near(2));
-                let mut found: Option<u32> = None;
-                for dx in [0, nx] {
-                    for dy in [0, ny] {
-                        for dz in [0, nz] {
-                            let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
-                                continue;
-                            };
-                            for &v in list {
-                                if (vertices[v as usize] - p).norm() <= tol
-                                    && found.is_none_or(|f| v < f)
-                                {
-                                    found = Some(v);
-                                }
-                            }
-                        }
-                    }
-                }
+                let found = weld_partner(&grid, &vertices, &p, &f, c, tol);
                 ids[k] = match found {
                     Some(v) => v,
                     None => {
@@ -707,6 +689,37 @@ impl Mesh {
         let _ = writeln!(s, "endsolid {name}");
         s
     }
+}
+
+/// The first-appearing vertex of `vertices` within `tol` of `p`, searched in the weld grid's
+/// cell `c` of `p` and, along each axis, the neighbour on the side of the cell's nearer half
+/// (`f`: `p` in units of the cell side, from the grid's origin).
+fn weld_partner(
+    grid: &HashMap<[i64; 3], Vec<u32>, FastHash>,
+    vertices: &[Point3<f64>],
+    p: &Point3<f64>,
+    f: &Vector3<f64>,
+    c: [i64; 3],
+    tol: f64,
+) -> Option<u32> {
+    let near = |k: usize| if f[k] - c[k] as f64 >= 0.5 { 1 } else { -1 };
+    let (nx, ny, nz) = (near(0), near(1), near(2));
+    let mut found: Option<u32> = None;
+    for dx in [0, nx] {
+        for dy in [0, ny] {
+            for dz in [0, nz] {
+                let Some(list) = grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]) else {
+                    continue;
+                };
+                for &v in list {
+                    if (vertices[v as usize] - p).norm() <= tol && found.is_none_or(|f| v < f) {
+                        found = Some(v);
+                    }
+                }
+            }
+        }
+    }
+    found
 }
 
 #[cfg(test)]

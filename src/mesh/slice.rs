@@ -198,70 +198,136 @@ struct Segment {
 /// Contour segments shorter than this are merged away `[mm]`.
 const TINY_SEGMENT_MM: f64 = 1e-9;
 
-/// Cuts `mesh` with `plane`.
-pub fn slice(mesh: &Mesh, plane: &Plane) -> Slice {
-    let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
-    cut(mesh, plane, 0..mesh.triangles.len(), |i| dist[i as usize])
+/// How [`slice()`] cuts: where it finds the triangles the plane may cut, and how far it repairs
+/// and bridges the raw cut. [`SliceOptions::default()`] is the exact cut, repaired, through
+/// every triangle.
+#[derive(Debug, Clone, Copy)]
+pub struct SliceOptions<'a> {
+    /// Finds the triangles the plane may cut through this index, which must have been built
+    /// from the mesh cut ([`SliceIndex::new`]): the same slice, bit for bit, at a cost that
+    /// grows with the triangles cut rather than with the mesh (a search slices thousands of
+    /// finger planes of one mesh). `None`: every triangle is tried.
+    pub index: Option<&'a SliceIndex>,
+    /// Joins the raw cut's open ends and unites its overlapping pieces (the default). `false`:
+    /// the contours as they come (chained, but not joined, united nor bridged: open chains stay
+    /// open, overlapping shells overlap), for a domain whose slices only need to show that
+    /// nothing is graspable ([`crate::plan::domain::cannot_grade`]).
+    pub repair: bool,
+    /// Simplifies the raw cut within this tolerance `[mm]` ([`Contour::simplified`]) before its
+    /// open ends are joined and its overlapping pieces united, where it has any: the union and
+    /// the joining cost grow with the points, and a slice of a many-shell or open mesh has many.
+    /// A slice in closed pieces that do not overlap is the exact cut. 0: no simplification.
+    /// Only a repaired cut is simplified.
+    pub tol_mm: f64,
+    /// Bridges the repaired slice for a finger of this width `[mm]`
+    /// ([`Slice::bridged_within`]`(gap_mm, tol_mm)`). With an index and repairing, through the
+    /// index's plane cache: a plane cut in several frames is repaired and bridged once, in a
+    /// canonical frame, and re-expressed in each frame asked for.
+    pub bridge_gap_mm: Option<f64>,
 }
 
-/// The contours `plane` cuts from `mesh` as they come (chained, but not joined, united nor bridged:
-/// open chains stay open, overlapping shells overlap), without an index: for a domain whose slices
-/// only need to show that nothing is graspable ([`crate::plan::domain::cannot_grade`]).
-pub fn slice_unrepaired(mesh: &Mesh, plane: &Plane) -> Slice {
-    let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
-    let d = |i: u32| dist[i as usize];
-    finish(
-        *plane,
-        raw_contours(mesh, plane, 0..mesh.triangles.len(), &d),
-    )
+impl Default for SliceOptions<'_> {
+    fn default() -> Self {
+        SliceOptions {
+            index: None,
+            repair: true,
+            tol_mm: 0.0,
+            bridge_gap_mm: None,
+        }
+    }
 }
 
-/// [`slice()`] with the triangles the plane may cut found through `index` (built once for the
-/// mesh): the same slice, bit for bit, at a cost that grows with the triangles cut rather than
-/// with the mesh (a search slices thousands of finger planes of one mesh).
-///
-/// `index` must have been built from `mesh` ([`SliceIndex::new`]).
-pub fn slice_indexed(mesh: &Mesh, index: &SliceIndex, plane: &Plane) -> Slice {
-    slice_indexed_within(mesh, index, plane, 0.0)
+impl<'a> SliceOptions<'a> {
+    /// The exact cut, repaired, with the triangles found through `index`.
+    pub fn indexed(index: &'a SliceIndex) -> SliceOptions<'a> {
+        SliceOptions {
+            index: Some(index),
+            ..SliceOptions::default()
+        }
+    }
+
+    /// These options with the raw cut simplified within `tol_mm` before repairing.
+    pub fn within(self, tol_mm: f64) -> SliceOptions<'a> {
+        SliceOptions { tol_mm, ..self }
+    }
+
+    /// These options with the slice bridged for a finger of width `gap_mm`.
+    pub fn bridged(self, gap_mm: f64) -> SliceOptions<'a> {
+        SliceOptions {
+            bridge_gap_mm: Some(gap_mm),
+            ..self
+        }
+    }
+
+    /// These options with the raw cut left unrepaired.
+    pub fn unrepaired(self) -> SliceOptions<'a> {
+        SliceOptions {
+            repair: false,
+            ..self
+        }
+    }
 }
 
-/// [`slice_indexed`], with the raw cut simplified within `tol_mm` ([`Contour::simplified`])
-/// before its open ends are joined and its overlapping pieces united, where it has any: the
-/// union and the joining cost grow with the points, and a slice of a many-shell or open mesh
-/// has many. A slice in closed pieces that do not overlap is the exact cut.
-pub fn slice_indexed_within(mesh: &Mesh, index: &SliceIndex, plane: &Plane, tol_mm: f64) -> Slice {
-    let tris = index.candidates(plane);
-    // A distance is a few flops, the same bits each time it is taken: cheaper than a table.
-    cut_within(
-        mesh,
-        plane,
-        tris.into_iter(),
-        |i| plane.distance(&mesh.vertices[i as usize]),
-        tol_mm,
-    )
+/// Cuts `mesh` with `plane`, as `options` say ([`SliceOptions`]).
+pub fn slice(mesh: &Mesh, plane: &Plane, options: SliceOptions) -> Slice {
+    match (options.index, options.bridge_gap_mm) {
+        (Some(index), Some(gap_mm)) if options.repair => {
+            bridged_through_cache(mesh, index, plane, gap_mm, options.tol_mm)
+        }
+        (_, Some(gap_mm)) => cut_by(mesh, plane, options).bridged_within(gap_mm, options.tol_mm),
+        (_, None) => cut_by(mesh, plane, options),
+    }
 }
 
-/// [`slice_indexed_within`]`(mesh, index, plane, tol_mm)`, then [`Slice::bridged_within`]`(gap_mm,
-/// tol_mm)`: what a finger of width `gap_mm` meets in `plane`. A search cuts the same plane in
-/// many frames (a level palm's finger planes are the horizontal planes at the candidates'
-/// heights, whatever the approach angle), so a slice that needs repairing or bridging (a
-/// many-shell or open mesh: the costly ones) is made once per plane, in the plane's canonical
-/// frame ([`canonical_plane`]: the normal rounded to 1e-9, the offset to 1e-6 mm), and
-/// re-expressed in `plane`'s frame ([`Slice::in_frame_of`]). A plane whose cut is one closed
-/// piece is cut in `plane` itself, as by the two calls. A re-expressed slice differs from the
-/// two calls' by what they differ between frames themselves (i_overlay's rings start where its
-/// grid puts them, the one-sided simplification splits a contour at its first point, and the
-/// closing's bevels move with the vertices kept: 1.4 mm in the tests). Either way the slice
-/// depends only on the
-/// mesh, the plane and the two lengths, never on which planes were cut before nor on threads.
-pub fn slice_indexed_bridged(
+/// The cut of `mesh` by `plane` as `options` say, without bridging: the triangles found through
+/// the index (each distance taken afresh: a few flops, the same bits each time, cheaper than a
+/// table) or all of them (the distances tabulated once), then repaired or only finished.
+fn cut_by(mesh: &Mesh, plane: &Plane, options: SliceOptions) -> Slice {
+    let made = |contours: Vec<Contour>| {
+        if options.repair {
+            repair(*plane, contours, options.tol_mm)
+        } else {
+            finish(*plane, contours)
+        }
+    };
+    match options.index {
+        Some(index) => {
+            let tris = index.candidates(plane);
+            let dist = |i: u32| plane.distance(&mesh.vertices[i as usize]);
+            made(raw_contours(mesh, plane, tris.into_iter(), &dist))
+        }
+        None => {
+            let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
+            let d = |i: u32| dist[i as usize];
+            made(raw_contours(mesh, plane, 0..mesh.triangles.len(), &d))
+        }
+    }
+}
+
+/// The slice with the triangles found through `index`, simplified within `tol_mm`, then
+/// [`Slice::bridged_within`]`(gap_mm, tol_mm)`: what a finger of width `gap_mm` meets in
+/// `plane`. A search cuts the same plane in many frames (a level palm's finger planes are the
+/// horizontal planes at the candidates' heights, whatever the approach angle), so a slice that
+/// needs repairing or bridging (a many-shell or open mesh: the costly ones) is made once per
+/// plane, in the plane's canonical frame ([`canonical_plane`]: the normal rounded to 1e-9, the
+/// offset to 1e-6 mm), and re-expressed in `plane`'s frame ([`Slice::in_frame_of`]). A plane
+/// whose cut is one closed piece is cut in `plane` itself, as by slicing and bridging
+/// directly. A re-expressed slice differs from the direct one by what the direct ones differ
+/// between frames themselves (i_overlay's rings start where its grid puts them, the one-sided
+/// simplification splits a contour at its first point, and the closing's bevels move with the
+/// vertices kept: 1.4 mm in the tests). Either way the slice depends only on the mesh, the
+/// plane and the two lengths, never on which planes were cut before nor on threads.
+fn bridged_through_cache(
     mesh: &Mesh,
     index: &SliceIndex,
     plane: &Plane,
     gap_mm: f64,
     tol_mm: f64,
 ) -> Slice {
-    let direct = || slice_indexed_within(mesh, index, plane, tol_mm).bridged_within(gap_mm, tol_mm);
+    let direct = || {
+        cut_by(mesh, plane, SliceOptions::indexed(index).within(tol_mm))
+            .bridged_within(gap_mm, tol_mm)
+    };
     let Some(key) = plane_key(plane, gap_mm, tol_mm) else {
         return direct();
     };
@@ -357,7 +423,7 @@ fn canonical_plane(key: &PlaneKey) -> Plane {
 
 impl Slice {
     /// The slice re-expressed in the 2D frame of `plane`, a plane through the same points (up to
-    /// the rounding of [`slice_indexed_bridged`]'s key) with the same normal: every point and
+    /// the rounding of [`bridged_through_cache`]'s key) with the same normal: every point and
     /// normal mapped through 3D, the contours sorted again ([`finish`]).
     pub fn in_frame_of(&self, plane: &Plane) -> Slice {
         let from = &self.plane;
@@ -401,7 +467,8 @@ pub struct SliceIndex {
     nodes: Vec<BvhNode>,
     order: Vec<u32>,
     triangles: usize,
-    /// Bridged slices of the planes [`slice_indexed_bridged`] has cut, by [`PlaneKey`].
+    /// Bridged slices of the planes [`slice()`] has cut and bridged through this index, by
+    /// [`PlaneKey`].
     planes: PlaneCache,
 }
 
@@ -575,29 +642,6 @@ impl SliceIndex {
         }
         out
     }
-}
-
-/// The cut of `mesh` by `plane` through the triangles `tris` (in increasing index order), with
-/// `dist` the signed distance of a vertex from the plane.
-fn cut(
-    mesh: &Mesh,
-    plane: &Plane,
-    tris: impl Iterator<Item = usize>,
-    dist: impl Fn(u32) -> f64,
-) -> Slice {
-    cut_within(mesh, plane, tris, dist, 0.0)
-}
-
-/// [`cut`], simplifying the contours within `tol_mm` first when they need joining or uniting.
-fn cut_within(
-    mesh: &Mesh,
-    plane: &Plane,
-    tris: impl Iterator<Item = usize>,
-    dist: impl Fn(u32) -> f64,
-    tol_mm: f64,
-) -> Slice {
-    let contours = raw_contours(mesh, plane, tris, &dist);
-    repair(*plane, contours, tol_mm)
 }
 
 /// The contours `plane` cuts from the triangles `tris`, chained but not repaired: open chains
@@ -1448,7 +1492,7 @@ mod tests {
             (Plane::horizontal(90.0), 0, 0.0, 0.0),
         ];
         for (plane, count, area, length) in table {
-            let s = slice(&b, &plane);
+            let s = slice(&b, &plane, SliceOptions::default());
             assert_eq!(s.contours.len(), count, "{plane:?}");
             assert_eq!(s.open_count(), 0, "{plane:?}");
             let a: f64 = s.contours.iter().map(Contour::signed_area).sum();
@@ -1483,8 +1527,8 @@ mod tests {
                 for pitch_deg in [-12.0f64, 0.0, 7.0, 30.0, 90.0] {
                     let plane = Plane::finger(Point3::new(3.0, -2.0, z), pitch_deg.to_radians());
                     assert_eq!(
-                        slice_indexed(&mesh, &index, &plane),
-                        slice(&mesh, &plane),
+                        slice(&mesh, &plane, SliceOptions::indexed(&index)),
+                        slice(&mesh, &plane, SliceOptions::default()),
                         "z {z}, pitch {pitch_deg}"
                     );
                     planes += 1;
@@ -1492,7 +1536,10 @@ mod tests {
             }
             for z in [lo.z, hi.z] {
                 let plane = Plane::horizontal(z);
-                assert_eq!(slice_indexed(&mesh, &index, &plane), slice(&mesh, &plane));
+                assert_eq!(
+                    slice(&mesh, &plane, SliceOptions::indexed(&index)),
+                    slice(&mesh, &plane, SliceOptions::default())
+                );
             }
             assert_eq!(planes, 125);
         }
@@ -1562,11 +1609,20 @@ mod tests {
                 let base = Plane::finger(Point3::new(40.0, 3.0, z), pitch_deg.to_radians());
                 for (turn, du, dv) in [(0.0, 0.0, 0.0), (0.7, -12.5, 4.0), (2.9, 30.0, -8.0)] {
                     let plane = reframed(&base, turn, du, dv);
-                    let direct =
-                        slice_indexed_within(&mesh, &warm, &plane, tol).bridged_within(gap, tol);
-                    let cached = slice_indexed_bridged(&mesh, &warm, &plane, gap, tol);
-                    let cold =
-                        slice_indexed_bridged(&mesh, &SliceIndex::new(&mesh), &plane, gap, tol);
+                    let direct = slice(&mesh, &plane, SliceOptions::indexed(&warm).within(tol))
+                        .bridged_within(gap, tol);
+                    let cached = slice(
+                        &mesh,
+                        &plane,
+                        SliceOptions::indexed(&warm).within(tol).bridged(gap),
+                    );
+                    let cold = slice(
+                        &mesh,
+                        &plane,
+                        SliceOptions::indexed(&SliceIndex::new(&mesh))
+                            .within(tol)
+                            .bridged(gap),
+                    );
                     assert_eq!(cached, cold, "z {z}, pitch {pitch_deg}, turn {turn}");
                     // The direct slice itself moves with the frame: i_overlay's rings start
                     // where its grid puts them, the one-sided simplification splits a contour at
@@ -1598,8 +1654,13 @@ mod tests {
                 for (turn, du, dv) in [(0.0, 0.0, 0.0), (1.1, 5.0, -3.0)] {
                     let plane = reframed(&base, turn, du, dv);
                     assert_eq!(
-                        slice_indexed_bridged(&mesh, &index, &plane, 14.0, 0.5),
-                        slice_indexed_within(&mesh, &index, &plane, 0.5).bridged_within(14.0, 0.5)
+                        slice(
+                            &mesh,
+                            &plane,
+                            SliceOptions::indexed(&index).within(0.5).bridged(14.0)
+                        ),
+                        slice(&mesh, &plane, SliceOptions::indexed(&index).within(0.5))
+                            .bridged_within(14.0, 0.5)
                     );
                 }
             }
@@ -1623,7 +1684,7 @@ mod tests {
         assert!((areas[0] - 1200.0).abs() < 1e-6 && (areas[1] - 1200.0).abs() < 1e-6);
         let circle = std::f64::consts::PI * 64.0;
         assert!(areas[2] < circle && areas[2] > 0.98 * circle, "{areas:?}");
-        let repaired = slice_indexed(&mesh, &index, &plane);
+        let repaired = slice(&mesh, &plane, SliceOptions::indexed(&index));
         assert_eq!(repaired.contours.len(), 2);
         assert!((repaired.contours[0].signed_area() - 2000.0).abs() < 1e-3);
         let key = |(a, b): (Point2<f64>, Point2<f64>)| [a.x, a.y, b.x, b.y].map(f64::to_bits);
@@ -1643,7 +1704,7 @@ mod tests {
     #[test]
     fn a_cylinder_cut_across_is_nearly_a_circle() {
         let c = cylinder(40.0, 124.0);
-        let s = slice(&c, &Plane::horizontal(62.0));
+        let s = slice(&c, &Plane::horizontal(62.0), SliceOptions::default());
         assert_eq!(s.contours.len(), 1);
         let area = s.contours[0].signed_area();
         let circle = PI * 20.0 * 20.0;

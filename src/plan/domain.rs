@@ -13,7 +13,7 @@
 use super::PlannerParams;
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice, slice_unrepaired, Contour, Plane, Slice};
+use crate::slice::{slice, Contour, Plane, Slice, SliceOptions};
 use nalgebra::Point2;
 use rayon::prelude::*;
 
@@ -79,13 +79,13 @@ impl Domain {
             .map(|a| {
                 let plane = Plane::vertical(a.to_radians());
                 if hopeless {
-                    slice_unrepaired(mesh, &plane)
+                    slice(mesh, &plane, SliceOptions::default().unrepaired())
                 } else {
                     // The slice as the hand meets it (issue 30): pieces closer than a finger
                     // bridged, dents shallower than the relief filled, gaps narrower than a
                     // finger filled; curvature is graded on this contour.
                     let (w, relief) = (hand.finger_width_mm(), hand.relief_mm());
-                    slice(mesh, &plane)
+                    slice(mesh, &plane, SliceOptions::default())
                         .bridged_prepared(w, relief)
                         .simplified(relief)
                         .filled_vertically(w)

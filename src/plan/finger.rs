@@ -24,7 +24,7 @@ use super::palm::{PalmPlacement, PENETRATION_TOL_MM};
 use super::{Relaxation, RuleSet};
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice_indexed_bridged, Slice, SliceIndex};
+use crate::slice::{Slice, SliceIndex, SliceOptions};
 use nalgebra::{Point2, Rotation2, Vector2};
 use std::f64::consts::PI;
 
@@ -115,7 +115,10 @@ pub fn place_finger(
     let mirror = f.side.sign();
     let slice = |dz: f64| {
         let plane = palm.finger_plane(f.height_mm + dz);
-        slice_indexed_bridged(mesh, index, &plane, 2.0 * o, hand.relief_mm())
+        let options = SliceOptions::indexed(index)
+            .within(hand.relief_mm())
+            .bridged(2.0 * o);
+        crate::slice::slice(mesh, &plane, options)
     };
     // Each plane is built once (its segments copied, the palm's outline checked: a
     // `PalmPenetration`, which no rule set relaxes) and its ALS placed on it.
@@ -232,26 +235,7 @@ fn place_finger_extended(
             .fold(f64::NEG_INFINITY, f64::max);
         (theta2, first.is_tip_contact)
     } else {
-        let touched: Vec<(usize, &FingerPlane)> = planes
-            .iter()
-            .enumerate()
-            .zip(&als)
-            .filter(|(_, a)| a.is_ok())
-            .map(|(p, _)| p)
-            .collect();
-        let p2 = phalanx2_at(&touched, hand, first.theta1_deg)?;
-        // The finger's contacts at its own angles: phalanx 1 in the planes whose ALS set θ1
-        // (the others' phalanx 1 would touch only further closed), phalanx 2 where it stops.
-        for (c, a) in contacts.iter_mut().zip(&als) {
-            let sets_theta1 = a
-                .as_ref()
-                .is_ok_and(|a| first.theta1_deg - a.theta1_deg <= SAME_THETA1_DEG);
-            *c = [if sets_theta1 { c[0] } else { None }, None];
-        }
-        for (k, c) in p2.contacts {
-            contacts[k][1] = Some(c);
-        }
-        (p2.theta2_deg, p2.is_tip_contact)
+        phalanx2_stop(&als, planes, hand, first.theta1_deg, &mut contacts)?
     };
     let finger = AlsAngles {
         theta2_deg: theta2,
@@ -284,6 +268,38 @@ fn place_finger_extended(
         bottom: pick(2),
         relaxations,
     })
+}
+
+/// Where phalanx 2 stops with phalanx 1 at `theta1_deg` (the finger's, set by the ALS that
+/// closed joint 1 the furthest), in the planes of the ALS that touch: `(θ2, is_tip_contact)`.
+/// `contacts` (each ALS's own, on entry) become the finger's at its own angles: phalanx 1 in
+/// the planes whose ALS set θ1 (the others' phalanx 1 would touch only further closed),
+/// phalanx 2 where it stops.
+fn phalanx2_stop(
+    als: &[Result<AlsAngles, FingerRejection>; 3],
+    planes: &[FingerPlane; 3],
+    hand: &Hand,
+    theta1_deg: f64,
+    contacts: &mut [[Option<PlaneContact>; 2]; 3],
+) -> Result<(f64, bool), FingerRejection> {
+    let touched: Vec<(usize, &FingerPlane)> = planes
+        .iter()
+        .enumerate()
+        .zip(als)
+        .filter(|(_, a)| a.is_ok())
+        .map(|(p, _)| p)
+        .collect();
+    let p2 = phalanx2_at(&touched, hand, theta1_deg)?;
+    for (c, a) in contacts.iter_mut().zip(als) {
+        let sets_theta1 = a
+            .as_ref()
+            .is_ok_and(|a| theta1_deg - a.theta1_deg <= SAME_THETA1_DEG);
+        *c = [if sets_theta1 { c[0] } else { None }, None];
+    }
+    for (k, c) in p2.contacts {
+        contacts[k][1] = Some(c);
+    }
+    Ok((p2.theta2_deg, p2.is_tip_contact))
 }
 
 /// One finger slice plane, ready for the phalanges: the contour's segments in the palm's 2D
@@ -731,6 +747,7 @@ mod tests {
                 u: nalgebra::Vector3::x(),
                 v: nalgebra::Vector3::y(),
             },
+            crate::slice::SliceOptions::default(),
         );
         assert_eq!(
             place_als(&s, &hand, 1.0),

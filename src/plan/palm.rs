@@ -25,7 +25,7 @@
 use super::geom2::ConvexPolygon;
 use crate::hand::Hand;
 use crate::mesh::Mesh;
-use crate::slice::{slice, Plane, Slice};
+use crate::slice::{slice, Plane, Slice, SliceOptions};
 use nalgebra::{Point2, Point3, Vector2, Vector3};
 
 /// Tolerance for penetration tests `[mm]`: well under a facet's chord error for the bundled
@@ -83,8 +83,12 @@ pub fn place_palm(
 /// finger width: it depends on the angle only, so a search cuts it once per angle and hands it
 /// to [`place_palm_on`] for every elevation.
 pub fn vertical_slice(mesh: &Mesh, hand: &Hand, approach_rad: f64) -> Slice {
-    slice(mesh, &Plane::vertical(approach_rad))
-        .bridged_within(hand.finger_width_mm(), hand.relief_mm())
+    slice(
+        mesh,
+        &Plane::vertical(approach_rad),
+        SliceOptions::default(),
+    )
+    .bridged_within(hand.finger_width_mm(), hand.relief_mm())
 }
 
 /// [`place_palm`] in `vslice`, the [`vertical_slice`] at `approach_rad`; with `back_off`, a

@@ -769,9 +769,7 @@ impl RecordView {
 
 /// The verdict `name` names, if any.
 fn verdict_named(name: Option<&str>) -> Option<Verdict> {
-    [Verdict::Hold, Verdict::Slip, Verdict::Drop]
-        .into_iter()
-        .find(|v| Some(v.as_str()) == name)
+    name.and_then(Verdict::named)
 }
 
 /// `T` from `v` when `v` is an object, else `T`'s default (every field absent).

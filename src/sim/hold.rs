@@ -236,25 +236,13 @@ fn direction_outcome(
     } else {
         rotation_deg
     };
-    let verdict = if decided_by.is_drop() {
-        Verdict::Drop
-    } else if decided_by == DecidedBy::Closing {
-        // No hold ran (`closing_decides`): a provisional verdict by contact alone, which the
-        // candidate search replaces by a full check before it reports or chooses the grasp.
-        if in_contact {
-            Verdict::Slip
-        } else {
-            Verdict::Drop
-        }
-    } else if translation_mm <= params.hold.hold_translation_mm
-        && judged_rotation <= params.hold.hold_rotation_deg
-    {
-        Verdict::Hold
-    } else if in_contact {
-        Verdict::Slip
-    } else {
-        Verdict::Drop
-    };
+    let verdict = judged(
+        decided_by,
+        in_contact,
+        translation_mm,
+        judged_rotation,
+        params,
+    );
     DirectionOutcome {
         gravity: [gravity.x, gravity.y, gravity.z],
         verdict,
@@ -275,6 +263,37 @@ fn direction_outcome(
         decided_at_s,
         decided_by,
         translation_at_decision_mm: at_decision_mm,
+    }
+}
+
+/// The verdict on a direction decided by `decided_by`, where the object moved `translation_mm`
+/// and turned `rotation_deg` (as judged) relative to the palm, touching the hand or not
+/// (`in_contact`): the hold thresholds of `params` decide between hold and the rest.
+fn judged(
+    decided_by: DecidedBy,
+    in_contact: bool,
+    translation_mm: f64,
+    rotation_deg: f64,
+    params: &SimParams,
+) -> Verdict {
+    if decided_by.is_drop() {
+        Verdict::Drop
+    } else if decided_by == DecidedBy::Closing {
+        // No hold ran (`closing_decides`): a provisional verdict by contact alone, which the
+        // candidate search replaces by a full check before it reports or chooses the grasp.
+        if in_contact {
+            Verdict::Slip
+        } else {
+            Verdict::Drop
+        }
+    } else if translation_mm <= params.hold.hold_translation_mm
+        && rotation_deg <= params.hold.hold_rotation_deg
+    {
+        Verdict::Hold
+    } else if in_contact {
+        Verdict::Slip
+    } else {
+        Verdict::Drop
     }
 }
 

@@ -32,6 +32,13 @@ impl Verdict {
             Verdict::Drop => "drop",
         }
     }
+
+    /// The verdict whose name ([`Verdict::as_str`]) is `name`; `None` for any other string.
+    pub fn named(name: &str) -> Option<Verdict> {
+        [Verdict::Hold, Verdict::Slip, Verdict::Drop]
+            .into_iter()
+            .find(|v| v.as_str() == name)
+    }
 }
 
 impl std::fmt::Display for Verdict {
@@ -412,6 +419,16 @@ impl Fidelity {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_verdict_is_named_by_its_own_name_only() {
+        for v in [Verdict::Hold, Verdict::Slip, Verdict::Drop] {
+            assert_eq!(Verdict::named(v.as_str()), Some(v));
+        }
+        for other in ["", "Hold", "HOLD", " hold", "hold ", "held", "error"] {
+            assert_eq!(Verdict::named(other), None, "{other:?}");
+        }
+    }
 
     #[test]
     fn decided_by_serialises_as_its_name() {

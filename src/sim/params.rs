@@ -636,6 +636,25 @@ macro_rules! sim_keyed {
 /// A key and what is wrong with its value.
 type Invalid = (&'static str, String);
 
+/// One number's allowed range: `(key, value, low, low included, high, unit)`.
+type NumberRange = (&'static str, f64, f64, bool, f64, &'static str);
+
+/// The range `(0, hi]` of `key`, whose value is `v`: a positive number up to `hi`.
+fn positive(key: &'static str, v: f64, hi: f64, unit: &'static str) -> NumberRange {
+    (key, v, 0.0, false, hi, unit)
+}
+
+/// `Ok` when the value is finite and within its range; else the key and a message stating
+/// the range.
+fn check_range((key, v, lo, closed, hi, unit): NumberRange) -> Result<(), Invalid> {
+    let above = if closed { v >= lo } else { v > lo };
+    if !(v.is_finite() && above && v <= hi) {
+        let open = if closed { '[' } else { '(' };
+        return Err((key, format!("must be in {open}{lo}, {hi}]{unit}, got {v}")));
+    }
+    Ok(())
+}
+
 impl SimParams {
     /// Checks every value's range, and `override_angles` against a hand of `fingers` fingers:
     /// the key and the problem of the first one out of range.
@@ -658,77 +677,48 @@ impl SimParams {
     /// (0: the value must be positive) or inclusive where zero means "none".
     fn validate_positive(&self) -> Result<(), Invalid> {
         let s = self;
-        // (key, value, low, low included, high, unit)
-        let ranges: [(&'static str, f64, f64, bool, f64, &str); 16] = [
-            (
-                "sim.duration_s",
-                s.hold.duration_s,
-                0.0,
-                false,
-                3600.0,
-                " s",
-            ),
-            (
-                "sim.timestep_s",
-                s.solver.timestep_s,
-                0.0,
-                false,
-                0.05,
-                " s",
-            ),
-            (
+        let ranges: [NumberRange; 16] = [
+            positive("sim.duration_s", s.hold.duration_s, 3600.0, " s"),
+            positive("sim.timestep_s", s.solver.timestep_s, 0.05, " s"),
+            positive(
                 "sim.torque_limit_nm",
                 s.fingers.torque_limit_nm,
-                0.0,
-                false,
                 1000.0,
                 " N·m",
             ),
-            (
+            positive(
                 "sim.joint1_lock_torque_nm",
                 s.fingers.joint1_lock_torque_nm,
-                0.0,
-                false,
                 10_000.0,
                 " N·m",
             ),
-            (
+            positive(
                 "sim.hold_translation_mm",
                 s.hold.hold_translation_mm,
-                0.0,
-                false,
                 1000.0,
                 " mm",
             ),
-            (
+            positive(
                 "sim.hold_rotation_deg",
                 s.hold.hold_rotation_deg,
-                0.0,
-                false,
                 180.0,
                 "°",
             ),
-            (
+            positive(
                 "sim.close_duration_s",
                 s.closing.close_duration_s,
-                0.0,
-                false,
                 600.0,
                 " s",
             ),
-            (
+            positive(
                 "sim.motor_stiffness_nm_per_rad",
                 s.fingers.motor_stiffness_nm_per_rad,
-                0.0,
-                false,
                 1e6,
                 " N·m/rad",
             ),
-            (
+            positive(
                 "sim.finger_density_kg_m3",
                 s.fingers.finger_density_kg_m3,
-                0.0,
-                false,
                 100_000.0,
                 " kg/m³",
             ),
@@ -740,56 +730,24 @@ impl SimParams {
                 1e6,
                 " Hz",
             ),
-            (
-                "sim.open_margin_deg",
-                s.closing.open_margin_deg,
-                0.0,
-                false,
-                90.0,
-                "°",
-            ),
-            (
-                "sim.rest_window_s",
-                s.early.rest_window_s,
-                0.0,
-                false,
-                10.0,
-                " s",
-            ),
-            (
-                "sim.rest_safety",
-                s.early.rest_safety,
-                0.0,
-                false,
-                100.0,
-                "",
-            ),
-            ("sim.rest_margin", s.early.rest_margin, 0.0, false, 1.0, ""),
-            (
+            positive("sim.open_margin_deg", s.closing.open_margin_deg, 90.0, "°"),
+            positive("sim.rest_window_s", s.early.rest_window_s, 10.0, " s"),
+            positive("sim.rest_safety", s.early.rest_safety, 100.0, ""),
+            positive("sim.rest_margin", s.early.rest_margin, 1.0, ""),
+            positive(
                 "sim.max_penetration_mm",
                 s.hold.max_penetration_mm,
-                0.0,
-                false,
                 1000.0,
                 " mm",
             ),
-            (
+            positive(
                 "sim.max_closing_shift_mm",
                 s.hold.max_closing_shift_mm,
-                0.0,
-                false,
                 1000.0,
                 " mm",
             ),
         ];
-        for (key, v, lo, closed, hi, unit) in ranges {
-            let above = if closed { v >= lo } else { v > lo };
-            if !(v.is_finite() && above && v <= hi) {
-                let open = if closed { '[' } else { '(' };
-                return Err((key, format!("must be in {open}{lo}, {hi}]{unit}, got {v}")));
-            }
-        }
-        Ok(())
+        ranges.into_iter().try_for_each(check_range)
     }
 
     /// The iteration counts and `max_checked`: 1 to 100.

@@ -32,29 +32,7 @@ pub struct Request {
 /// # Errors
 /// A bad template or input list, an output that cannot be written, or every setting invalid.
 pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
-    // One parameter swept twice would make a grid whose two columns set the same value, the
-    // second overwriting the first at every setting.
-    for (k, sweep) in request.sweeps.iter().enumerate() {
-        if request.sweeps[..k].iter().any(|s| s.name == sweep.name) {
-            anyhow::bail!(
-                "--param: `{}` is given twice; sweep each parameter once (NAME=START:END:STEP)",
-                sweep.name
-            );
-        }
-    }
-    let settings = super::grid_size(&request.sweeps);
-    if settings > super::MAX_SETTINGS {
-        let sizes: Vec<String> = request
-            .sweeps
-            .iter()
-            .map(|s| s.values.len().to_string())
-            .collect();
-        anyhow::bail!(
-            "--param: the grid has {settings} settings ({}); at most {} are run, so sweep fewer values",
-            sizes.join(" x "),
-            super::MAX_SETTINGS
-        );
-    }
+    check_sweeps(&request.sweeps)?;
     let template = match &request.template {
         Some(p) => Scenario::load_template(p)?,
         None => batch::default_template(),
@@ -114,6 +92,34 @@ pub fn run(request: &Request, progress: &dyn Progress) -> anyhow::Result<u8> {
             .join(", ")
     );
     Ok(if result.skipped.is_empty() { 0 } else { 2 })
+}
+
+/// Checks the sweeps before any work: each parameter swept once, at most
+/// [`super::MAX_SETTINGS`] settings in the grid.
+///
+/// # Errors
+/// The parameter given twice, or the grid's size, naming `--param`.
+fn check_sweeps(sweeps: &[Sweep]) -> anyhow::Result<()> {
+    // One parameter swept twice would make a grid whose two columns set the same value, the
+    // second overwriting the first at every setting.
+    for (k, sweep) in sweeps.iter().enumerate() {
+        if sweeps[..k].iter().any(|s| s.name == sweep.name) {
+            anyhow::bail!(
+                "--param: `{}` is given twice; sweep each parameter once (NAME=START:END:STEP)",
+                sweep.name
+            );
+        }
+    }
+    let settings = super::grid_size(sweeps);
+    if settings > super::MAX_SETTINGS {
+        let sizes: Vec<String> = sweeps.iter().map(|s| s.values.len().to_string()).collect();
+        anyhow::bail!(
+            "--param: the grid has {settings} settings ({}); at most {} are run, so sweep fewer values",
+            sizes.join(" x "),
+            super::MAX_SETTINGS
+        );
+    }
+    Ok(())
 }
 
 /// Writes tune.csv, tune.json and the score plots into `out`; returns the plots' paths.

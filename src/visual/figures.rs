@@ -8,7 +8,7 @@ use crate::mesh::Mesh;
 use crate::plan::kinematics::{inward_normal, phalanx1_direction};
 use crate::plan::search::Grasp;
 use crate::plan::GradedDomain;
-use crate::slice::{slice, Slice};
+use crate::slice::{slice, Slice, SliceOptions};
 use nalgebra::{Point2, Rotation2, Vector2};
 
 const OBJECT: &str = "#333";
@@ -217,7 +217,11 @@ pub fn finger_planes(g: &Grasp, hand: &Hand) -> String {
 pub fn finger(g: &Grasp, hand: &Hand, mesh: &Mesh, k: usize) -> String {
     let f = &hand.finger_list[k];
     let mirror = f.side.sign();
-    let s = slice(mesh, &g.palm.finger_plane(f.height_mm));
+    let s = slice(
+        mesh,
+        &g.palm.finger_plane(f.height_mm),
+        SliceOptions::default(),
+    );
     let (x, y) = bounds(&s);
     let als = &g.fingers[k].centre;
     let c = FingerChain::new(hand, als.theta1_deg, als.theta2_deg);

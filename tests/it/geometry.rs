@@ -2,7 +2,7 @@
 
 use grasp_sim::mesh::{align, load_stl, mass_properties, parse_stl, LengthUnit, Mesh};
 use grasp_sim::objects;
-use grasp_sim::slice::{slice, Plane};
+use grasp_sim::slice::{slice, Plane, SliceOptions};
 use nalgebra::{Point3, Rotation3, Unit, Vector3};
 use std::f64::consts::PI;
 use std::path::Path;
@@ -25,7 +25,7 @@ fn sphere_slice_through_centre_is_one_circle_of_radius_r() {
         Plane::vertical(0.3),
         Plane::vertical(0.0),
     ] {
-        let s = slice(&sphere, &plane);
+        let s = slice(&sphere, &plane, SliceOptions::default());
         assert_eq!(
             s.contours.len(),
             1,
@@ -64,7 +64,7 @@ fn sphere_slice_through_centre_is_one_circle_of_radius_r() {
 fn cylinder_slice_has_the_right_diameter_at_any_height() {
     let cyl = objects::cylinder(40.0, 124.0);
     for z in [0.5, 7.0, 33.3, 62.0, 112.0, 123.9] {
-        let s = slice(&cyl, &Plane::horizontal(z));
+        let s = slice(&cyl, &Plane::horizontal(z), SliceOptions::default());
         assert_eq!(s.contours.len(), 1);
         let c = &s.contours[0];
         let (min, max) = c.points.iter().fold((f64::MAX, 0.0f64), |(lo, hi), p| {
@@ -78,7 +78,11 @@ fn cylinder_slice_has_the_right_diameter_at_any_height() {
         );
     }
     // A vertical slice is the 40 × 124 rectangle.
-    let s = slice(&cyl, &Plane::vertical(10f64.to_radians()));
+    let s = slice(
+        &cyl,
+        &Plane::vertical(10f64.to_radians()),
+        SliceOptions::default(),
+    );
     assert_eq!(s.contours.len(), 1);
     let c = &s.contours[0];
     let xs: Vec<f64> = c.points.iter().map(|p| p.x).collect();
@@ -97,7 +101,7 @@ fn pyramid_slices_match_fig_3_3() {
     let pyr = objects::pyramid(a, h);
     // (b) vertical slice through the apex, parallel to a base edge: the triangle
     // (−a/2, 0), (a/2, 0), (0, h).
-    let s = slice(&pyr, &Plane::vertical(0.0));
+    let s = slice(&pyr, &Plane::vertical(0.0), SliceOptions::default());
     assert_eq!(s.contours.len(), 1);
     let c = &s.contours[0];
     assert!(
@@ -132,7 +136,7 @@ fn pyramid_slices_match_fig_3_3() {
     }
     // (d) horizontal slice at height z: a square of side a(1 − z/h).
     for z in [10.0, 45.0, 80.0] {
-        let s = slice(&pyr, &Plane::horizontal(z));
+        let s = slice(&pyr, &Plane::horizontal(z), SliceOptions::default());
         assert_eq!(s.contours.len(), 1);
         let side = a * (1.0 - z / h);
         let area = s.contours[0].signed_area();
@@ -147,7 +151,7 @@ fn pyramid_slices_match_fig_3_3() {
 #[test]
 fn a_through_hole_gives_two_contours_with_the_outer_marked() {
     let tube = objects::tube(20.0, 50.0, 40.0, 48);
-    let s = slice(&tube, &Plane::horizontal(13.0));
+    let s = slice(&tube, &Plane::horizontal(13.0), SliceOptions::default());
     assert_eq!(s.contours.len(), 2);
     let outer = s.outermost.expect("an outermost contour");
     let hole = 1 - outer;
@@ -161,7 +165,7 @@ fn a_through_hole_gives_two_contours_with_the_outer_marked() {
         assert!(c.normals[i].dot(&nalgebra::center(&a, &b).coords) < 0.0);
     }
     // A vertical slice through the axis cuts the wall twice: two separate parts, no hole.
-    let s = slice(&tube, &Plane::vertical(0.0));
+    let s = slice(&tube, &Plane::vertical(0.0), SliceOptions::default());
     assert_eq!(s.contours.len(), 2);
     assert!(s.contours.iter().all(|c| c.is_closed && !c.is_hole()));
     for c in &s.contours {
@@ -179,7 +183,11 @@ fn planes_through_vertices_edges_and_faces_still_chain() {
     // columns, and horizontal planes at 0 and 124 lie in its caps.
     let prism = objects::prism(15.0, 30.0, 124.0);
     for deg in [0.0, 2.5, 10.0, 45.0, 63.43494882, 90.0, 137.5] {
-        let s = slice(&prism, &Plane::vertical(f64::to_radians(deg)));
+        let s = slice(
+            &prism,
+            &Plane::vertical(f64::to_radians(deg)),
+            SliceOptions::default(),
+        );
         assert_eq!(s.contours.len(), 1, "angle {deg}");
         assert!(s.contours[0].is_closed, "angle {deg}");
         assert!(s.contours[0]
@@ -189,11 +197,16 @@ fn planes_through_vertices_edges_and_faces_still_chain() {
     }
     // A plane lying in a cap is taken just below it: in the top cap it gives the whole outline,
     // in the bottom cap nothing (as just below the object).
-    let s = slice(&prism, &Plane::horizontal(124.0));
+    let s = slice(&prism, &Plane::horizontal(124.0), SliceOptions::default());
     assert_eq!(s.contours.len(), 1);
     assert!((s.contours[0].signed_area() - 15.0 * 30.0).abs() < 1e-9);
-    assert!(slice(&prism, &Plane::horizontal(0.0)).is_empty());
-    assert!(slice(&prism, &Plane::horizontal(124.0 + 1e-9)).is_empty());
+    assert!(slice(&prism, &Plane::horizontal(0.0), SliceOptions::default()).is_empty());
+    assert!(slice(
+        &prism,
+        &Plane::horizontal(124.0 + 1e-9),
+        SliceOptions::default()
+    )
+    .is_empty());
 }
 
 #[test]
@@ -201,7 +214,7 @@ fn tilted_finger_plane_cuts_an_ellipse() {
     let cyl = objects::cylinder(40.0, 124.0);
     let pitch = 20f64.to_radians();
     let plane = Plane::finger(Point3::new(0.0, 0.0, 60.0), pitch);
-    let s = slice(&cyl, &plane);
+    let s = slice(&cyl, &plane, SliceOptions::default());
     assert_eq!(s.contours.len(), 1);
     // A cylinder cut at an angle: an ellipse with semi-axes r / cos(pitch) and r.
     let expected = PI * 20.0 * 20.0 / pitch.cos();
@@ -287,8 +300,12 @@ fn a_rotated_shifted_cylinder_is_aligned_back() {
     // Slices after alignment equal the unrotated cylinder's (within rounding and the 0.005 mm
     // chord error: a cylinder's slices do not depend on its turn about its axis).
     for z in [7.0, 62.0, 117.0] {
-        let a = slice(&aligned.mesh, &Plane::horizontal(z));
-        let b = slice(&base, &Plane::horizontal(z));
+        let a = slice(
+            &aligned.mesh,
+            &Plane::horizontal(z),
+            SliceOptions::default(),
+        );
+        let b = slice(&base, &Plane::horizontal(z), SliceOptions::default());
         assert_eq!(a.contours.len(), 1);
         let (aa, ba) = (a.contours[0].signed_area(), b.contours[0].signed_area());
         assert!(rel_err(aa, ba) < 1e-6, "area {aa} vs {ba} at z = {z}");
@@ -301,7 +318,11 @@ fn a_rotated_shifted_cylinder_is_aligned_back() {
         }
     }
     for deg in [0.0, 40.0, 130.0] {
-        let a = slice(&aligned.mesh, &Plane::vertical(f64::to_radians(deg)));
+        let a = slice(
+            &aligned.mesh,
+            &Plane::vertical(f64::to_radians(deg)),
+            SliceOptions::default(),
+        );
         assert_eq!(a.contours.len(), 1);
         let area = a.contours[0].signed_area();
         assert!(
@@ -352,7 +373,10 @@ fn ascii_and_binary_forms_give_identical_results() {
     assert_eq!(sa.mesh, sb.mesh);
     assert_eq!(sa.to_aligned, sb.to_aligned);
     let p = Plane::vertical(0.7);
-    assert_eq!(slice(&sa.mesh, &p), slice(&sb.mesh, &p));
+    assert_eq!(
+        slice(&sa.mesh, &p, SliceOptions::default()),
+        slice(&sb.mesh, &p, SliceOptions::default())
+    );
 }
 
 #[test]

@@ -345,7 +345,7 @@ fn a_cheap_bound_rejects_objects_too_short_or_too_thin_before_bridging() {
     let built = Domain::build(d10, &params, &hand);
     for (k, s) in built.slices.iter().enumerate() {
         let plane = grasp_sim::slice::Plane::vertical(built.angles_deg[k].to_radians());
-        let bridged = grasp_sim::slice::slice(d10, &plane)
+        let bridged = grasp_sim::slice::slice(d10, &plane, Default::default())
             .bridged_prepared(hand.finger_width_mm(), hand.relief_mm());
         assert_eq!(*s, bridged, "slice {k}");
     }
@@ -393,7 +393,11 @@ fn grooves_narrower_than_a_finger_are_graded_as_the_plain_side() {
         assert!((g - p).abs() < 1e-9, "index {}: {g} vs {p}", i + 1);
     }
     // The exact cut at 0°: some elevation crossing a groove edge is ungraspable.
-    let exact = grasp_sim::slice::slice(&grooved, &grasp_sim::slice::Plane::vertical(0.0));
+    let exact = grasp_sim::slice::slice(
+        &grooved,
+        &grasp_sim::slice::Plane::vertical(0.0),
+        Default::default(),
+    );
     let c = &exact.contours[0];
     let mut ungraspable = 0;
     for &z in &dg.elevations {

@@ -5,7 +5,7 @@ use grasp_sim::mesh::{mass_properties, Mesh};
 use grasp_sim::plan::{Relaxation, RuleSet};
 use grasp_sim::report::RunReport;
 use grasp_sim::scenario::Scenario;
-use grasp_sim::slice::{slice, Plane};
+use grasp_sim::slice::{slice, Plane, SliceOptions};
 use grasp_sim::{run, RunOptions};
 use nalgebra::{Point3, Rotation3, Vector3};
 use std::f64::consts::TAU;
@@ -184,11 +184,11 @@ fn overlapping_boxes_have_the_union_volume_and_one_contour() {
         "Izz {} expected {izz}",
         props.inertia[(2, 2)]
     );
-    let s = slice(&m, &Plane::horizontal(40.0));
+    let s = slice(&m, &Plane::horizontal(40.0), SliceOptions::default());
     assert_eq!(s.contours.len(), 1, "{:?}", s.contours.len());
     assert!((s.contours[0].signed_area() - 2400.0).abs() < 1e-6);
     // The vertical slice through both boxes: one 60 x 80 outline, not two overlapping ones.
-    let v = slice(&m, &Plane::vertical(0.0));
+    let v = slice(&m, &Plane::vertical(0.0), SliceOptions::default());
     assert_eq!(v.contours.len(), 1);
     assert!((v.contours[0].signed_area() - 4800.0).abs() < 1e-6);
 }
@@ -206,10 +206,10 @@ fn a_box_with_a_cylinder_pushed_half_in_is_one_solid() {
     let err = (props.volume_mm3 - want).abs() / want;
     assert!(err < 1e-3, "volume {} expected {want}", props.volume_mm3);
     // Inside the box the cylinder adds nothing to the slice; above it the slice is the circle.
-    let s = slice(&m, &Plane::horizontal(20.0));
+    let s = slice(&m, &Plane::horizontal(20.0), SliceOptions::default());
     assert_eq!(s.contours.len(), 1);
     assert!((s.contours[0].signed_area() - 3600.0).abs() < 1e-6);
-    let s = slice(&m, &Plane::horizontal(40.0));
+    let s = slice(&m, &Plane::horizontal(40.0), SliceOptions::default());
     assert_eq!(s.contours.len(), 1);
     assert!((s.contours[0].signed_area() - facet_area).abs() < 1e-6);
 }
@@ -223,7 +223,7 @@ fn a_mesh_with_one_missing_triangle_slices_closed_and_plans_as_whole() {
     let m = mesh(&holed);
     assert_eq!(m.topology().boundary_edges, 3);
     for z in [10.0, 60.0, 110.0] {
-        let s = slice(&m, &Plane::horizontal(z));
+        let s = slice(&m, &Plane::horizontal(z), SliceOptions::default());
         assert!(
             s.contours.iter().all(|c| c.is_closed),
             "open slice at z {z}"

@@ -69,28 +69,7 @@ impl Slice {
 /// The quadrilaterals (as rings, counter-clockwise) that fill the vertical gaps of `slice`
 /// narrower than `w`.
 fn vertical_gaps(slice: &Slice, w: f64) -> Vec<Vec<[f64; 2]>> {
-    let mut edges: Vec<Edge> = Vec::new();
-    for c in slice.contours.iter().filter(|c| c.is_closed) {
-        for i in 0..c.segment_count() {
-            let (p, q) = c.segment(i);
-            if (q.x - p.x).abs() <= VERTICAL_MM {
-                continue;
-            }
-            edges.push(if q.x > p.x {
-                Edge {
-                    a: p,
-                    b: q,
-                    material_above: true,
-                }
-            } else {
-                Edge {
-                    a: q,
-                    b: p,
-                    material_above: false,
-                }
-            });
-        }
-    }
+    let mut edges = sweep_edges(slice);
     if edges.len() < 4 {
         return Vec::new();
     }
@@ -133,17 +112,9 @@ fn vertical_gaps(slice: &Slice, w: f64) -> Vec<Vec<[f64; 2]>> {
             if !edges[f].material_above {
                 continue;
             }
-            let (lo, hi) = (&edges[e], &edges[f]);
-            let (l0, l1) = (hi.z_at(x0) - lo.z_at(x0), hi.z_at(x1) - lo.z_at(x1));
-            let (from, to) = match (l0 < w, l1 < w) {
-                (true, true) => (x0, x1),
-                (true, false) => (x0, x0 + (w - l0) / (l1 - l0) * (x1 - x0)),
-                (false, true) => (x1 - (w - l1) / (l0 - l1) * (x1 - x0), x1),
-                (false, false) => continue,
-            };
-            if to <= from {
+            let Some((from, to)) = narrow_span(&edges[e], &edges[f], x0, x1, w) else {
                 continue;
-            }
+            };
             let i = match open.get(&(e, f)) {
                 Some(&i) if pieces[i].3 == from => {
                     pieces[i].3 = to;
@@ -163,19 +134,67 @@ fn vertical_gaps(slice: &Slice, w: f64) -> Vec<Vec<[f64; 2]>> {
     }
     pieces
         .into_iter()
-        .map(|(e, f, from, to)| {
-            let (lo, hi) = (&edges[e], &edges[f]);
-            // Reaching OVERLAP_MM into the material below and above, so that the union meets
-            // an overlap and not two edges that coincide to round-off (on which i_overlay's
-            // snapping leaves slivers and spikes).
-            vec![
-                [from, lo.z_at(from) - OVERLAP_MM],
-                [to, lo.z_at(to) - OVERLAP_MM],
-                [to, hi.z_at(to) + OVERLAP_MM],
-                [from, hi.z_at(from) + OVERLAP_MM],
-            ]
-        })
+        .map(|(e, f, from, to)| filling_ring(&edges[e], &edges[f], from, to))
         .collect()
+}
+
+/// The non-vertical edges of `slice`'s closed contours, each oriented by increasing `x` with
+/// the side its material is on, in the contours' order.
+fn sweep_edges(slice: &Slice) -> Vec<Edge> {
+    let mut edges: Vec<Edge> = Vec::new();
+    for c in slice.contours.iter().filter(|c| c.is_closed) {
+        for i in 0..c.segment_count() {
+            let (p, q) = c.segment(i);
+            if (q.x - p.x).abs() <= VERTICAL_MM {
+                continue;
+            }
+            edges.push(if q.x > p.x {
+                Edge {
+                    a: p,
+                    b: q,
+                    material_above: true,
+                }
+            } else {
+                Edge {
+                    a: q,
+                    b: p,
+                    material_above: false,
+                }
+            });
+        }
+    }
+    edges
+}
+
+/// Where, within the slab `[x0, x1]`, the gap between the edges `lo` (below) and `hi` (above)
+/// is narrower than `w`: `(from, to)`, or `None` where it is nowhere (the gap's height is linear
+/// in `x`, so this is one interval).
+fn narrow_span(lo: &Edge, hi: &Edge, x0: f64, x1: f64, w: f64) -> Option<(f64, f64)> {
+    let (l0, l1) = (hi.z_at(x0) - lo.z_at(x0), hi.z_at(x1) - lo.z_at(x1));
+    let (from, to) = match (l0 < w, l1 < w) {
+        (true, true) => (x0, x1),
+        (true, false) => (x0, x0 + (w - l0) / (l1 - l0) * (x1 - x0)),
+        (false, true) => (x1 - (w - l1) / (l0 - l1) * (x1 - x0), x1),
+        (false, false) => return None,
+    };
+    if to <= from {
+        return None;
+    }
+    Some((from, to))
+}
+
+/// The quadrilateral (counter-clockwise) that fills the gap between `lo` and `hi` from `x =
+/// from` to `to`.
+fn filling_ring(lo: &Edge, hi: &Edge, from: f64, to: f64) -> Vec<[f64; 2]> {
+    // Reaching OVERLAP_MM into the material below and above, so that the union meets an
+    // overlap and not two edges that coincide to round-off (on which i_overlay's snapping
+    // leaves slivers and spikes).
+    vec![
+        [from, lo.z_at(from) - OVERLAP_MM],
+        [to, lo.z_at(to) - OVERLAP_MM],
+        [to, hi.z_at(to) + OVERLAP_MM],
+        [from, hi.z_at(from) + OVERLAP_MM],
+    ]
 }
 
 #[cfg(test)]
