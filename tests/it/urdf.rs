@@ -368,3 +368,50 @@ fn open_shells_enclose_the_same_volume_in_a_turned_frame() {
         );
     }
 }
+
+/// A URDF names its links' geometry in a few bytes each, and each box is 576 triangles: 4,000
+/// boxes (0.7 MB of URDF) would make 2.3 million triangles, past the bound of
+/// `MAX_URDF_TRIANGLES`, and is refused with one line naming the file and how far it got, before
+/// the mesh is made (60,000 boxes took more than 10 GB before the bound). 1,000 boxes stay under
+/// it and load.
+#[test]
+fn a_urdf_of_too_many_primitives_is_refused_before_its_mesh_is_made() {
+    let dir = tempfile::tempdir().unwrap();
+    let boxes = |n: usize| -> String {
+        let links: String = (0..n)
+            .map(|k| {
+                format!(
+                    "<link name=\"l{k}\"><collision><geometry><box size=\"0.01 0.01 0.01\"/>\
+                     </geometry></collision></link>\n"
+                )
+            })
+            .collect();
+        let joints: String = (1..n)
+            .map(|k| {
+                format!(
+                    "<joint name=\"j{k}\" type=\"fixed\"><parent link=\"l0\"/><child \
+                     link=\"l{k}\"/><origin xyz=\"{} {} 0\"/></joint>\n",
+                    0.011 * (k % 100) as f64,
+                    0.011 * (k / 100) as f64
+                )
+            })
+            .collect();
+        format!("<robot name=\"r\">\n{links}{joints}</robot>\n")
+    };
+    let limit = grasp_sim::mesh::urdf::MAX_URDF_TRIANGLES;
+    assert_eq!(limit, 2_000_000);
+    let many = write(dir.path(), "many.urdf", boxes(4000));
+    let out = run(&["--no-sim"], &many);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert_eq!(err.trim_end().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("many.urdf")
+            && err.contains("more than 2000000 triangles")
+            && err.contains("the first 3473 of its 4000 pieces of geometry make 2000448"),
+        "{err}"
+    );
+    let fewer = write(dir.path(), "fewer.urdf", boxes(1000));
+    let loaded = grasp_sim::mesh::load_mesh(&fewer, grasp_sim::mesh::LengthUnit::M).unwrap();
+    assert_eq!(loaded.mesh.triangles.len(), 1000 * 576);
+}
