@@ -1099,4 +1099,160 @@ mod tests {
             Err("sim.override_index")
         );
     }
+
+    /// A value with every group away from its defaults, the fields serialised only when not at
+    /// their defaults included.
+    fn non_default() -> SimParams {
+        let mut p = SimParams {
+            gravity: GravityMode::Six,
+            protocol: Protocol::Full,
+            ..SimParams::default()
+        };
+        p.solver.hand_joints = HandJoints::Impulse;
+        p.fingers.balanced_squeeze = false;
+        p.closing.refine_contacts = true;
+        p.closing.reseat = false;
+        p.closing.approach = Approach::Timed;
+        p.hold.closing_decides = true;
+        p.early.rest_margin = 0.75;
+        p.selection.max_checked = 4;
+        p.input.override_angles = Some(vec![[90.0, 80.5], [45.0, 30.0]]);
+        p.input.override_index = Some(7);
+        p.robust.samples = 8;
+        p.robust.replay_sample = Some(3);
+        p.robust.choose = Choose::Robust;
+        p
+    }
+
+    /// The `Debug` text, as the batch input hash reads it, pinned: the flat `[sim]` table's
+    /// fields in their order.
+    #[test]
+    fn debug_text_is_pinned() {
+        assert_eq!(
+            format!("{:?}", SimParams::default()),
+            "SimParams { gravity: Down, protocol: Fast, rest_window_s: 0.05, rest_safety: 2.0, \
+            rest_margin: 0.8, duration_s: 2.0, timestep_s: 0.0010416666666666667, \
+            squeeze_deg: 3.0, squeeze2_deg: 3.0, torque_limit_nm: 1.0, \
+            joint1_lock_torque_nm: 10.0, hold_translation_mm: 5.0, hold_rotation_deg: 5.0, \
+            close_duration_s: 0.5, close_until_stalled: true, solver_iterations: 8, \
+            pgs_iterations: 8, stabilization_iterations: 2, \
+            motor_stiffness_nm_per_rad: 20.0, motor_damping_nms_per_rad: 0.2, \
+            finger_density_kg_m3: 1000.0, contact_stiffness_hz: 10000.0, \
+            hand_joints: Multibody, hold_solver_iterations: 8, open_margin_deg: 20.0, \
+            refine_contacts: false, reseat: true, override_angles: None, \
+            override_index: None, max_checked: 8, max_penetration_mm: 2.0, \
+            max_closing_shift_mm: 5.0, min_on_plan_fraction: 0.5, closing_decides: false, \
+            balanced_squeeze: true, approach: Together, samples: 1, seed: 0, \
+            pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
+            mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: None, \
+            choose: First, choose_min_lower_bound: 0.8 }"
+        );
+        assert_eq!(
+            format!("{:?}", non_default()),
+            "SimParams { gravity: Six, protocol: Full, rest_window_s: 0.05, rest_safety: 2.0, \
+            rest_margin: 0.75, duration_s: 2.0, timestep_s: 0.0010416666666666667, \
+            squeeze_deg: 3.0, squeeze2_deg: 3.0, torque_limit_nm: 1.0, \
+            joint1_lock_torque_nm: 10.0, hold_translation_mm: 5.0, hold_rotation_deg: 5.0, \
+            close_duration_s: 0.5, close_until_stalled: true, solver_iterations: 8, \
+            pgs_iterations: 8, stabilization_iterations: 2, \
+            motor_stiffness_nm_per_rad: 20.0, motor_damping_nms_per_rad: 0.2, \
+            finger_density_kg_m3: 1000.0, contact_stiffness_hz: 10000.0, \
+            hand_joints: Impulse, hold_solver_iterations: 8, open_margin_deg: 20.0, \
+            refine_contacts: true, reseat: false, override_angles: Some([[90.0, 80.5], \
+            [45.0, 30.0]]), override_index: Some(7), max_checked: 4, \
+            max_penetration_mm: 2.0, max_closing_shift_mm: 5.0, min_on_plan_fraction: 0.5, \
+            closing_decides: true, balanced_squeeze: false, approach: Timed, samples: 8, \
+            seed: 0, pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
+            mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: Some(3), \
+            choose: Robust, choose_min_lower_bound: 0.8 }"
+        );
+    }
+
+    /// The serialised parameters (a scenario's JSON, which the batch input hash reads), pinned:
+    /// the groups' nesting, their fields' order, and the fields left out at their defaults.
+    #[test]
+    fn serialised_parameters_are_pinned() {
+        assert_eq!(
+            serde_json::to_string(&SimParams::default()).unwrap(),
+            concat!(
+                r#"{"gravity":"down","#,
+                r#""protocol":"fast","#,
+                r#""solver":{"timestep_s":0.0010416666666666667,"solver_iterations":8,"#,
+                r#""pgs_iterations":8,"stabilization_iterations":2,"#,
+                r#""contact_stiffness_hz":10000.0,"#,
+                r#""hold_solver_iterations":8},"#,
+                r#""fingers":{"squeeze_deg":3.0,"squeeze2_deg":3.0,"torque_limit_nm":1.0,"#,
+                r#""joint1_lock_torque_nm":10.0,"motor_stiffness_nm_per_rad":20.0,"#,
+                r#""motor_damping_nms_per_rad":0.2,"finger_density_kg_m3":1000.0,"#,
+                r#""balanced_squeeze":true},"#,
+                r#""closing":{"close_duration_s":0.5,"close_until_stalled":true,"#,
+                r#""open_margin_deg":20.0,"approach":"together","reseat":true},"#,
+                r#""hold":{"duration_s":2.0,"hold_translation_mm":5.0,"hold_rotation_deg":5.0,"#,
+                r#""max_penetration_mm":2.0,"max_closing_shift_mm":5.0,"#,
+                r#""min_on_plan_fraction":0.5,"#,
+                r#""closing_decides":false},"#,
+                r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.8},"#,
+                r#""selection":{"max_checked":8},"#,
+                r#""input":{"override_angles":null,"override_index":null}}"#,
+            )
+        );
+        assert_eq!(
+            serde_json::to_string(&non_default()).unwrap(),
+            concat!(
+                r#"{"gravity":"six","#,
+                r#""protocol":"full","#,
+                r#""solver":{"timestep_s":0.0010416666666666667,"solver_iterations":8,"#,
+                r#""pgs_iterations":8,"stabilization_iterations":2,"#,
+                r#""contact_stiffness_hz":10000.0,"#,
+                r#""hand_joints":"impulse","hold_solver_iterations":8},"#,
+                r#""fingers":{"squeeze_deg":3.0,"squeeze2_deg":3.0,"torque_limit_nm":1.0,"#,
+                r#""joint1_lock_torque_nm":10.0,"motor_stiffness_nm_per_rad":20.0,"#,
+                r#""motor_damping_nms_per_rad":0.2,"finger_density_kg_m3":1000.0,"#,
+                r#""balanced_squeeze":false},"#,
+                r#""closing":{"close_duration_s":0.5,"close_until_stalled":true,"#,
+                r#""open_margin_deg":20.0,"approach":"timed","refine_contacts":true},"#,
+                r#""hold":{"duration_s":2.0,"hold_translation_mm":5.0,"hold_rotation_deg":5.0,"#,
+                r#""max_penetration_mm":2.0,"max_closing_shift_mm":5.0,"#,
+                r#""min_on_plan_fraction":0.5,"#,
+                r#""closing_decides":true},"#,
+                r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.75},"#,
+                r#""selection":{"max_checked":4},"#,
+                r#""input":{"override_angles":[[90.0,80.5],[45.0,30.0]],"override_index":7},"#,
+                r#""robust":{"samples":8,"seed":0,"pose_offset_mm":2.0,"pose_rotation_deg":3.0,"#,
+                r#""friction_range_pct":15.0,"mass_range_pct":15.0,"torque_range_pct":10.0,"#,
+                r#""replay_sample":3,"choose":"robust","choose_min_lower_bound":0.8}}"#,
+            )
+        );
+    }
+
+    /// serde's messages for a mistyped key (every key, in the table's order) and a wrong type.
+    #[test]
+    fn parse_messages_are_pinned() {
+        let err = toml::from_str::<SimParams>("torque_limt_nm = 1.0").unwrap_err();
+        assert!(
+            err.to_string().ends_with(
+                "unknown field `torque_limt_nm`, expected one of `gravity`, `protocol`, \
+                `rest_window_s`, `rest_safety`, `rest_margin`, `duration_s`, `timestep_s`, \
+                `squeeze_deg`, `squeeze2_deg`, `torque_limit_nm`, `joint1_lock_torque_nm`, \
+                `hold_translation_mm`, `hold_rotation_deg`, `close_duration_s`, \
+                `close_until_stalled`, `solver_iterations`, `pgs_iterations`, \
+                `stabilization_iterations`, `motor_stiffness_nm_per_rad`, \
+                `motor_damping_nms_per_rad`, `finger_density_kg_m3`, `contact_stiffness_hz`, \
+                `hand_joints`, `hold_solver_iterations`, `open_margin_deg`, \
+                `refine_contacts`, `reseat`, `override_angles`, `override_index`, \
+                `max_checked`, `max_penetration_mm`, `max_closing_shift_mm`, \
+                `min_on_plan_fraction`, `closing_decides`, `balanced_squeeze`, `approach`, \
+                `samples`, `seed`, `pose_offset_mm`, `pose_rotation_deg`, \
+                `friction_range_pct`, `mass_range_pct`, `torque_range_pct`, `replay_sample`, \
+                `choose`, `choose_min_lower_bound`\n"
+            ),
+            "{err}"
+        );
+        let err = toml::from_str::<SimParams>("duration_s = \"long\"").unwrap_err();
+        assert!(
+            err.to_string()
+                .ends_with("invalid type: string \"long\", expected f64\n"),
+            "{err}"
+        );
+    }
 }
