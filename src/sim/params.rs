@@ -6,6 +6,10 @@
 //! a flat view (the private `flat::SimParams`, the same name so that serde's messages and the
 //! `Debug` text are the flat table's) and converted. serde's `flatten` cannot be used here: it
 //! does not work with `deny_unknown_fields`, which names a mistyped key.
+//!
+//! The table is declared once, in the `sim_table!` invocation: each key with its type and group,
+//! from which the flat struct and both conversions are made. A new key is a field of its group
+//! (its doc comment and default there), a row at the end of the table, and its validation.
 
 use crate::messages::keyed;
 use serde::Deserialize;
@@ -440,190 +444,106 @@ impl std::fmt::Debug for SimParams {
     }
 }
 
-/// The `[sim]` table as written: one field per key, in the order serde's messages list them.
-mod flat {
-    use super::{Approach, Choose, GravityMode, HandJoints, Protocol};
-    use serde::Deserialize;
+/// Declares the `[sim]` table once, as rows `key: Type => group` (`=> group` left out for a
+/// key of [`SimParams`] itself), and makes of it the private `flat` module: the flat struct
+/// `flat::SimParams`, one field per key in the rows' order, which serde reads the table into,
+/// and the conversions both ways, each key moved to or from the field of the same name in its
+/// group. The key's doc comment is on that field; the row's type must be the field's (the
+/// compiler checks it), and a group field with no row fails the test `every_group_field_is_a_key`.
+macro_rules! sim_table {
+    ($($key:ident : $ty:ty $(=> $group:ident)?),+ $(,)?) => {
+        /// The `[sim]` table as written: one field per key, in the rows' order.
+        mod flat {
+            use super::*;
 
-    /// The flat `[sim]` table (see the module docs of [`super`]).
-    #[derive(Debug, Clone, PartialEq, Deserialize)]
-    #[serde(deny_unknown_fields, default)]
-    pub(super) struct SimParams {
-        pub(super) gravity: GravityMode,
-        pub(super) protocol: Protocol,
-        pub(super) rest_window_s: f64,
-        pub(super) rest_safety: f64,
-        pub(super) rest_margin: f64,
-        pub(super) duration_s: f64,
-        pub(super) timestep_s: f64,
-        pub(super) squeeze_deg: f64,
-        pub(super) squeeze2_deg: f64,
-        pub(super) torque_limit_nm: f64,
-        pub(super) joint1_lock_torque_nm: f64,
-        pub(super) hold_translation_mm: f64,
-        pub(super) hold_rotation_deg: f64,
-        pub(super) close_duration_s: f64,
-        pub(super) close_until_stalled: bool,
-        pub(super) solver_iterations: usize,
-        pub(super) pgs_iterations: usize,
-        pub(super) stabilization_iterations: usize,
-        pub(super) motor_stiffness_nm_per_rad: f64,
-        pub(super) motor_damping_nms_per_rad: f64,
-        pub(super) finger_density_kg_m3: f64,
-        pub(super) contact_stiffness_hz: f64,
-        pub(super) hand_joints: HandJoints,
-        pub(super) hold_solver_iterations: usize,
-        pub(super) open_margin_deg: f64,
-        pub(super) refine_contacts: bool,
-        pub(super) reseat: bool,
-        pub(super) override_angles: Option<Vec<[f64; 2]>>,
-        pub(super) override_index: Option<usize>,
-        pub(super) max_checked: usize,
-        pub(super) max_penetration_mm: f64,
-        pub(super) max_closing_shift_mm: f64,
-        pub(super) min_on_plan_fraction: f64,
-        pub(super) closing_decides: bool,
-        pub(super) balanced_squeeze: bool,
-        pub(super) approach: Approach,
-        pub(super) samples: usize,
-        pub(super) seed: u64,
-        pub(super) pose_offset_mm: f64,
-        pub(super) pose_rotation_deg: f64,
-        pub(super) friction_range_pct: f64,
-        pub(super) mass_range_pct: f64,
-        pub(super) torque_range_pct: f64,
-        pub(super) replay_sample: Option<usize>,
-        pub(super) choose: Choose,
-        pub(super) choose_min_lower_bound: f64,
-    }
+            /// The flat `[sim]` table (see the module docs of [`super`]).
+            #[derive(Debug, Clone, PartialEq, Deserialize)]
+            #[serde(deny_unknown_fields, default)]
+            pub(super) struct SimParams {
+                $(pub(super) $key: $ty,)+
+            }
 
-    impl Default for SimParams {
-        fn default() -> Self {
-            super::SimParams::default().into()
-        }
-    }
+            /// Every key, in the rows' order.
+            #[cfg(test)]
+            pub(super) const KEYS: &[&str] = &[$(stringify!($key)),+];
 
-    impl From<SimParams> for super::SimParams {
-        fn from(s: SimParams) -> Self {
-            super::SimParams {
-                gravity: s.gravity,
-                protocol: s.protocol,
-                solver: super::SolverParams {
-                    timestep_s: s.timestep_s,
-                    solver_iterations: s.solver_iterations,
-                    pgs_iterations: s.pgs_iterations,
-                    stabilization_iterations: s.stabilization_iterations,
-                    contact_stiffness_hz: s.contact_stiffness_hz,
-                    hand_joints: s.hand_joints,
-                    hold_solver_iterations: s.hold_solver_iterations,
-                },
-                fingers: super::FingerParams {
-                    squeeze_deg: s.squeeze_deg,
-                    squeeze2_deg: s.squeeze2_deg,
-                    torque_limit_nm: s.torque_limit_nm,
-                    joint1_lock_torque_nm: s.joint1_lock_torque_nm,
-                    motor_stiffness_nm_per_rad: s.motor_stiffness_nm_per_rad,
-                    motor_damping_nms_per_rad: s.motor_damping_nms_per_rad,
-                    finger_density_kg_m3: s.finger_density_kg_m3,
-                    balanced_squeeze: s.balanced_squeeze,
-                },
-                closing: super::ClosingParams {
-                    close_duration_s: s.close_duration_s,
-                    close_until_stalled: s.close_until_stalled,
-                    open_margin_deg: s.open_margin_deg,
-                    approach: s.approach,
-                    refine_contacts: s.refine_contacts,
-                    reseat: s.reseat,
-                },
-                hold: super::HoldParams {
-                    duration_s: s.duration_s,
-                    hold_translation_mm: s.hold_translation_mm,
-                    hold_rotation_deg: s.hold_rotation_deg,
-                    max_penetration_mm: s.max_penetration_mm,
-                    max_closing_shift_mm: s.max_closing_shift_mm,
-                    min_on_plan_fraction: s.min_on_plan_fraction,
-                    closing_decides: s.closing_decides,
-                },
-                early: super::EarlyParams {
-                    rest_window_s: s.rest_window_s,
-                    rest_safety: s.rest_safety,
-                    rest_margin: s.rest_margin,
-                },
-                selection: super::SelectionParams {
-                    max_checked: s.max_checked,
-                },
-                input: super::InputParams {
-                    override_angles: s.override_angles,
-                    override_index: s.override_index,
-                },
-                robust: super::RobustParams {
-                    samples: s.samples,
-                    seed: s.seed,
-                    pose_offset_mm: s.pose_offset_mm,
-                    pose_rotation_deg: s.pose_rotation_deg,
-                    friction_range_pct: s.friction_range_pct,
-                    mass_range_pct: s.mass_range_pct,
-                    torque_range_pct: s.torque_range_pct,
-                    replay_sample: s.replay_sample,
-                    choose: s.choose,
-                    choose_min_lower_bound: s.choose_min_lower_bound,
-                },
+            impl Default for SimParams {
+                fn default() -> Self {
+                    super::SimParams::default().into()
+                }
+            }
+
+            impl From<SimParams> for super::SimParams {
+                fn from(s: SimParams) -> Self {
+                    let mut p = super::SimParams::default();
+                    $(p.$($group.)?$key = s.$key;)+
+                    p
+                }
+            }
+
+            impl From<super::SimParams> for SimParams {
+                fn from(s: super::SimParams) -> Self {
+                    SimParams {
+                        $($key: s.$($group.)?$key,)+
+                    }
+                }
             }
         }
-    }
+    };
+}
 
-    impl From<super::SimParams> for SimParams {
-        fn from(s: super::SimParams) -> Self {
-            SimParams {
-                gravity: s.gravity,
-                protocol: s.protocol,
-                rest_window_s: s.early.rest_window_s,
-                rest_safety: s.early.rest_safety,
-                rest_margin: s.early.rest_margin,
-                duration_s: s.hold.duration_s,
-                timestep_s: s.solver.timestep_s,
-                squeeze_deg: s.fingers.squeeze_deg,
-                squeeze2_deg: s.fingers.squeeze2_deg,
-                torque_limit_nm: s.fingers.torque_limit_nm,
-                joint1_lock_torque_nm: s.fingers.joint1_lock_torque_nm,
-                hold_translation_mm: s.hold.hold_translation_mm,
-                hold_rotation_deg: s.hold.hold_rotation_deg,
-                close_duration_s: s.closing.close_duration_s,
-                close_until_stalled: s.closing.close_until_stalled,
-                solver_iterations: s.solver.solver_iterations,
-                pgs_iterations: s.solver.pgs_iterations,
-                stabilization_iterations: s.solver.stabilization_iterations,
-                motor_stiffness_nm_per_rad: s.fingers.motor_stiffness_nm_per_rad,
-                motor_damping_nms_per_rad: s.fingers.motor_damping_nms_per_rad,
-                finger_density_kg_m3: s.fingers.finger_density_kg_m3,
-                contact_stiffness_hz: s.solver.contact_stiffness_hz,
-                hand_joints: s.solver.hand_joints,
-                hold_solver_iterations: s.solver.hold_solver_iterations,
-                open_margin_deg: s.closing.open_margin_deg,
-                refine_contacts: s.closing.refine_contacts,
-                reseat: s.closing.reseat,
-                override_angles: s.input.override_angles,
-                override_index: s.input.override_index,
-                max_checked: s.selection.max_checked,
-                max_penetration_mm: s.hold.max_penetration_mm,
-                max_closing_shift_mm: s.hold.max_closing_shift_mm,
-                min_on_plan_fraction: s.hold.min_on_plan_fraction,
-                closing_decides: s.hold.closing_decides,
-                balanced_squeeze: s.fingers.balanced_squeeze,
-                approach: s.closing.approach,
-                samples: s.robust.samples,
-                seed: s.robust.seed,
-                pose_offset_mm: s.robust.pose_offset_mm,
-                pose_rotation_deg: s.robust.pose_rotation_deg,
-                friction_range_pct: s.robust.friction_range_pct,
-                mass_range_pct: s.robust.mass_range_pct,
-                torque_range_pct: s.robust.torque_range_pct,
-                replay_sample: s.robust.replay_sample,
-                choose: s.robust.choose,
-                choose_min_lower_bound: s.robust.choose_min_lower_bound,
-            }
-        }
-    }
+// The `[sim]` keys in the order serde's messages list them and the `Debug` text prints them
+// (the batch input hash reads it: a new key goes at the end). Each key's doc comment is on its
+// group's field of the same name. The groups stay declared apart from the table: their fields'
+// order is that of the serialised parameters, which the batch input hash reads too, and is not
+// the table's (`approach` comes before `refine_contacts` in `closing`, after it here).
+sim_table! {
+    gravity: GravityMode,
+    protocol: Protocol,
+    rest_window_s: f64 => early,
+    rest_safety: f64 => early,
+    rest_margin: f64 => early,
+    duration_s: f64 => hold,
+    timestep_s: f64 => solver,
+    squeeze_deg: f64 => fingers,
+    squeeze2_deg: f64 => fingers,
+    torque_limit_nm: f64 => fingers,
+    joint1_lock_torque_nm: f64 => fingers,
+    hold_translation_mm: f64 => hold,
+    hold_rotation_deg: f64 => hold,
+    close_duration_s: f64 => closing,
+    close_until_stalled: bool => closing,
+    solver_iterations: usize => solver,
+    pgs_iterations: usize => solver,
+    stabilization_iterations: usize => solver,
+    motor_stiffness_nm_per_rad: f64 => fingers,
+    motor_damping_nms_per_rad: f64 => fingers,
+    finger_density_kg_m3: f64 => fingers,
+    contact_stiffness_hz: f64 => solver,
+    hand_joints: HandJoints => solver,
+    hold_solver_iterations: usize => solver,
+    open_margin_deg: f64 => closing,
+    refine_contacts: bool => closing,
+    reseat: bool => closing,
+    override_angles: Option<Vec<[f64; 2]>> => input,
+    override_index: Option<usize> => input,
+    max_checked: usize => selection,
+    max_penetration_mm: f64 => hold,
+    max_closing_shift_mm: f64 => hold,
+    min_on_plan_fraction: f64 => hold,
+    closing_decides: bool => hold,
+    balanced_squeeze: bool => fingers,
+    approach: Approach => closing,
+    samples: usize => robust,
+    seed: u64 => robust,
+    pose_offset_mm: f64 => robust,
+    pose_rotation_deg: f64 => robust,
+    friction_range_pct: f64 => robust,
+    mass_range_pct: f64 => robust,
+    torque_range_pct: f64 => robust,
+    replay_sample: Option<usize> => robust,
+    choose: Choose => robust,
+    choose_min_lower_bound: f64 => robust,
 }
 
 /// `[("sim.<field>", s.<group>.<field>), ...]`: each grouped value with its `[sim]` key.
@@ -1055,6 +975,191 @@ mod tests {
                 "override_angles = [[90.0, 90.0], [90.0, 90.0], [90.0, 90.0]]\noverride_index = 0"
             ),
             Err("sim.override_index")
+        );
+    }
+
+    /// A value with every group away from its defaults, the fields serialised only when not at
+    /// their defaults included.
+    fn non_default() -> SimParams {
+        let mut p = SimParams {
+            gravity: GravityMode::Six,
+            protocol: Protocol::Full,
+            ..SimParams::default()
+        };
+        p.solver.hand_joints = HandJoints::Impulse;
+        p.fingers.balanced_squeeze = false;
+        p.closing.refine_contacts = true;
+        p.closing.reseat = false;
+        p.closing.approach = Approach::Timed;
+        p.hold.closing_decides = true;
+        p.early.rest_margin = 0.75;
+        p.selection.max_checked = 4;
+        p.input.override_angles = Some(vec![[90.0, 80.5], [45.0, 30.0]]);
+        p.input.override_index = Some(7);
+        p.robust.samples = 8;
+        p.robust.replay_sample = Some(3);
+        p.robust.choose = Choose::Robust;
+        p
+    }
+
+    /// The `Debug` text, as the batch input hash reads it, pinned: the flat `[sim]` table's
+    /// fields in their order.
+    #[test]
+    fn debug_text_is_pinned() {
+        assert_eq!(
+            format!("{:?}", SimParams::default()),
+            "SimParams { gravity: Down, protocol: Fast, rest_window_s: 0.05, rest_safety: 2.0, \
+            rest_margin: 0.8, duration_s: 2.0, timestep_s: 0.0010416666666666667, \
+            squeeze_deg: 3.0, squeeze2_deg: 3.0, torque_limit_nm: 1.0, \
+            joint1_lock_torque_nm: 10.0, hold_translation_mm: 5.0, hold_rotation_deg: 5.0, \
+            close_duration_s: 0.5, close_until_stalled: true, solver_iterations: 8, \
+            pgs_iterations: 8, stabilization_iterations: 2, \
+            motor_stiffness_nm_per_rad: 20.0, motor_damping_nms_per_rad: 0.2, \
+            finger_density_kg_m3: 1000.0, contact_stiffness_hz: 10000.0, \
+            hand_joints: Multibody, hold_solver_iterations: 8, open_margin_deg: 20.0, \
+            refine_contacts: false, reseat: true, override_angles: None, \
+            override_index: None, max_checked: 8, max_penetration_mm: 2.0, \
+            max_closing_shift_mm: 5.0, min_on_plan_fraction: 0.5, closing_decides: false, \
+            balanced_squeeze: true, approach: Together, samples: 1, seed: 0, \
+            pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
+            mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: None, \
+            choose: First, choose_min_lower_bound: 0.8 }"
+        );
+        assert_eq!(
+            format!("{:?}", non_default()),
+            "SimParams { gravity: Six, protocol: Full, rest_window_s: 0.05, rest_safety: 2.0, \
+            rest_margin: 0.75, duration_s: 2.0, timestep_s: 0.0010416666666666667, \
+            squeeze_deg: 3.0, squeeze2_deg: 3.0, torque_limit_nm: 1.0, \
+            joint1_lock_torque_nm: 10.0, hold_translation_mm: 5.0, hold_rotation_deg: 5.0, \
+            close_duration_s: 0.5, close_until_stalled: true, solver_iterations: 8, \
+            pgs_iterations: 8, stabilization_iterations: 2, \
+            motor_stiffness_nm_per_rad: 20.0, motor_damping_nms_per_rad: 0.2, \
+            finger_density_kg_m3: 1000.0, contact_stiffness_hz: 10000.0, \
+            hand_joints: Impulse, hold_solver_iterations: 8, open_margin_deg: 20.0, \
+            refine_contacts: true, reseat: false, override_angles: Some([[90.0, 80.5], \
+            [45.0, 30.0]]), override_index: Some(7), max_checked: 4, \
+            max_penetration_mm: 2.0, max_closing_shift_mm: 5.0, min_on_plan_fraction: 0.5, \
+            closing_decides: true, balanced_squeeze: false, approach: Timed, samples: 8, \
+            seed: 0, pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
+            mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: Some(3), \
+            choose: Robust, choose_min_lower_bound: 0.8 }"
+        );
+    }
+
+    /// The serialised parameters (a scenario's JSON, which the batch input hash reads), pinned:
+    /// the groups' nesting, their fields' order, and the fields left out at their defaults.
+    #[test]
+    fn serialised_parameters_are_pinned() {
+        assert_eq!(
+            serde_json::to_string(&SimParams::default()).unwrap(),
+            concat!(
+                r#"{"gravity":"down","#,
+                r#""protocol":"fast","#,
+                r#""solver":{"timestep_s":0.0010416666666666667,"solver_iterations":8,"#,
+                r#""pgs_iterations":8,"stabilization_iterations":2,"#,
+                r#""contact_stiffness_hz":10000.0,"#,
+                r#""hold_solver_iterations":8},"#,
+                r#""fingers":{"squeeze_deg":3.0,"squeeze2_deg":3.0,"torque_limit_nm":1.0,"#,
+                r#""joint1_lock_torque_nm":10.0,"motor_stiffness_nm_per_rad":20.0,"#,
+                r#""motor_damping_nms_per_rad":0.2,"finger_density_kg_m3":1000.0,"#,
+                r#""balanced_squeeze":true},"#,
+                r#""closing":{"close_duration_s":0.5,"close_until_stalled":true,"#,
+                r#""open_margin_deg":20.0,"approach":"together","reseat":true},"#,
+                r#""hold":{"duration_s":2.0,"hold_translation_mm":5.0,"hold_rotation_deg":5.0,"#,
+                r#""max_penetration_mm":2.0,"max_closing_shift_mm":5.0,"#,
+                r#""min_on_plan_fraction":0.5,"#,
+                r#""closing_decides":false},"#,
+                r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.8},"#,
+                r#""selection":{"max_checked":8},"#,
+                r#""input":{"override_angles":null,"override_index":null}}"#,
+            )
+        );
+        assert_eq!(
+            serde_json::to_string(&non_default()).unwrap(),
+            concat!(
+                r#"{"gravity":"six","#,
+                r#""protocol":"full","#,
+                r#""solver":{"timestep_s":0.0010416666666666667,"solver_iterations":8,"#,
+                r#""pgs_iterations":8,"stabilization_iterations":2,"#,
+                r#""contact_stiffness_hz":10000.0,"#,
+                r#""hand_joints":"impulse","hold_solver_iterations":8},"#,
+                r#""fingers":{"squeeze_deg":3.0,"squeeze2_deg":3.0,"torque_limit_nm":1.0,"#,
+                r#""joint1_lock_torque_nm":10.0,"motor_stiffness_nm_per_rad":20.0,"#,
+                r#""motor_damping_nms_per_rad":0.2,"finger_density_kg_m3":1000.0,"#,
+                r#""balanced_squeeze":false},"#,
+                r#""closing":{"close_duration_s":0.5,"close_until_stalled":true,"#,
+                r#""open_margin_deg":20.0,"approach":"timed","refine_contacts":true},"#,
+                r#""hold":{"duration_s":2.0,"hold_translation_mm":5.0,"hold_rotation_deg":5.0,"#,
+                r#""max_penetration_mm":2.0,"max_closing_shift_mm":5.0,"#,
+                r#""min_on_plan_fraction":0.5,"#,
+                r#""closing_decides":true},"#,
+                r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.75},"#,
+                r#""selection":{"max_checked":4},"#,
+                r#""input":{"override_angles":[[90.0,80.5],[45.0,30.0]],"override_index":7},"#,
+                r#""robust":{"samples":8,"seed":0,"pose_offset_mm":2.0,"pose_rotation_deg":3.0,"#,
+                r#""friction_range_pct":15.0,"mass_range_pct":15.0,"torque_range_pct":10.0,"#,
+                r#""replay_sample":3,"choose":"robust","choose_min_lower_bound":0.8}}"#,
+            )
+        );
+    }
+
+    /// Every field of every group is a row of the `[sim]` table (a field left out of it would
+    /// be neither read nor printed), and the conversions lose nothing.
+    #[test]
+    fn every_group_field_is_a_key() {
+        // The leaf names of the serialised groups: the fields left out at their defaults are
+        // in one of the two values.
+        let mut fields = std::collections::BTreeSet::new();
+        for p in [SimParams::default(), non_default()] {
+            let serde_json::Value::Object(top) = serde_json::to_value(p).unwrap() else {
+                panic!("not an object");
+            };
+            for (name, value) in top {
+                match value {
+                    serde_json::Value::Object(group) => fields.extend(group.keys().cloned()),
+                    _ => {
+                        fields.insert(name);
+                    }
+                }
+            }
+        }
+        let keys: std::collections::BTreeSet<String> =
+            flat::KEYS.iter().map(|k| k.to_string()).collect();
+        assert_eq!(fields, keys);
+        assert_eq!(
+            SimParams::from(flat::SimParams::from(non_default())),
+            non_default()
+        );
+    }
+
+    /// serde's messages for a mistyped key (every key, in the table's order) and a wrong type.
+    #[test]
+    fn parse_messages_are_pinned() {
+        let err = toml::from_str::<SimParams>("torque_limt_nm = 1.0").unwrap_err();
+        assert!(
+            err.to_string().ends_with(
+                "unknown field `torque_limt_nm`, expected one of `gravity`, `protocol`, \
+                `rest_window_s`, `rest_safety`, `rest_margin`, `duration_s`, `timestep_s`, \
+                `squeeze_deg`, `squeeze2_deg`, `torque_limit_nm`, `joint1_lock_torque_nm`, \
+                `hold_translation_mm`, `hold_rotation_deg`, `close_duration_s`, \
+                `close_until_stalled`, `solver_iterations`, `pgs_iterations`, \
+                `stabilization_iterations`, `motor_stiffness_nm_per_rad`, \
+                `motor_damping_nms_per_rad`, `finger_density_kg_m3`, `contact_stiffness_hz`, \
+                `hand_joints`, `hold_solver_iterations`, `open_margin_deg`, \
+                `refine_contacts`, `reseat`, `override_angles`, `override_index`, \
+                `max_checked`, `max_penetration_mm`, `max_closing_shift_mm`, \
+                `min_on_plan_fraction`, `closing_decides`, `balanced_squeeze`, `approach`, \
+                `samples`, `seed`, `pose_offset_mm`, `pose_rotation_deg`, \
+                `friction_range_pct`, `mass_range_pct`, `torque_range_pct`, `replay_sample`, \
+                `choose`, `choose_min_lower_bound`\n"
+            ),
+            "{err}"
+        );
+        let err = toml::from_str::<SimParams>("duration_s = \"long\"").unwrap_err();
+        assert!(
+            err.to_string()
+                .ends_with("invalid type: string \"long\", expected f64\n"),
+            "{err}"
         );
     }
 }
