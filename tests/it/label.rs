@@ -283,16 +283,10 @@ fn resume_after_a_kill_loses_no_finished_grasp() {
     assert_eq!(strip(&after), strip(&whole));
 }
 
-/// `scripts/slurm_array.sh` with `GRASP_SIM_COMMAND=label`: two array tasks and their merge
-/// give the plain run's lines.
-#[test]
-fn slurm_array_tasks_label_as_one_run_does() {
-    let dir = tempfile::tempdir().unwrap();
-    let inputs = ["assets/objects/cup.stl", "assets/objects/cylinder_d40.stl"];
-    let flags = ["--grasps", "2", "--samples", "1"];
-    let plain = dir.path().join("plain.jsonl");
+/// `label` of `inputs` with `flags` in one plain run, into `dir`/plain.jsonl; its path.
+fn plain_label(dir: &Path, inputs: &[&str], flags: &[&str]) -> std::path::PathBuf {
+    let plain = dir.join("plain.jsonl");
     let o = grasp_sim()
-        .current_dir(root())
         .arg("label")
         .args(flags)
         .args(inputs)
@@ -306,6 +300,17 @@ fn slurm_array_tasks_label_as_one_run_does() {
         "{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    plain
+}
+
+/// `scripts/slurm_array.sh` with `GRASP_SIM_COMMAND=label`: two array tasks and their merge
+/// give the plain run's lines.
+#[test]
+fn slurm_array_tasks_label_as_one_run_does() {
+    let dir = tempfile::tempdir().unwrap();
+    let inputs = ["assets/objects/cup.stl", "assets/objects/cylinder_d40.stl"];
+    let flags = ["--grasps", "2", "--samples", "1"];
+    let plain = plain_label(dir.path(), &inputs, &flags);
     let out = dir.path().join("run");
     let slurm = |mode: &str, id: Option<u32>| {
         let mut c = std::process::Command::new("bash");
@@ -360,21 +365,7 @@ fn ray_tasks_label_as_one_run_does() {
     let dir = tempfile::tempdir().unwrap();
     let inputs = ["assets/objects/cup.stl", "assets/objects/cylinder_d40.stl"];
     let flags = ["--grasps", "2", "--samples", "1"];
-    let plain = dir.path().join("plain.jsonl");
-    let o = grasp_sim()
-        .arg("label")
-        .args(flags)
-        .args(inputs)
-        .arg("--out")
-        .arg(&plain)
-        .output()
-        .unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    let plain = plain_label(dir.path(), &inputs, &flags);
     let results = dir.path().join("results.jsonl");
     let out = std::process::Command::new("python3")
         .current_dir(root())

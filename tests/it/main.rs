@@ -50,6 +50,24 @@ pub fn squeeze_closing() -> grasp_sim::scenario::SimParams {
     params
 }
 
+/// `v` without its wall-clock times (`wall_ms`, `timings_ms`) at any depth: what must be the
+/// same, bit for bit, between two runs of the same input.
+pub fn timeless(mut v: serde_json::Value) -> serde_json::Value {
+    fn strip(v: &mut serde_json::Value) {
+        match v {
+            serde_json::Value::Object(m) => {
+                m.remove("wall_ms");
+                m.remove("timings_ms");
+                m.values_mut().for_each(strip);
+            }
+            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+            _ => {}
+        }
+    }
+    strip(&mut v);
+    v
+}
+
 /// The repository root.
 pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

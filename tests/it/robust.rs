@@ -57,20 +57,7 @@ fn run_on(threads: usize, s: &Scenario) -> RunReport {
 
 /// The report's JSON without its wall-clock times.
 fn timeless(r: &RunReport) -> serde_json::Value {
-    fn strip(v: &mut serde_json::Value) {
-        match v {
-            serde_json::Value::Object(m) => {
-                m.remove("wall_ms");
-                m.remove("timings_ms");
-                m.values_mut().for_each(strip);
-            }
-            serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
-            _ => {}
-        }
-    }
-    let mut v = serde_json::to_value(r).unwrap();
-    strip(&mut v);
-    v
+    crate::timeless(serde_json::to_value(r).unwrap())
 }
 
 /// The all-held lower bound of n samples: n / (n + z²), z the 95 % normal quantile.

@@ -846,21 +846,6 @@ fn a_given_grasp_is_checked_as_given() {
 /// a damaged file is made again. Every run's JSON is the uncached run's, timings aside.
 #[test]
 fn a_collider_cache_gives_the_same_check_and_is_read_back() {
-    fn timeless(mut v: serde_json::Value) -> serde_json::Value {
-        fn strip(v: &mut serde_json::Value) {
-            match v {
-                serde_json::Value::Object(m) => {
-                    m.remove("wall_ms");
-                    m.remove("timings_ms");
-                    m.values_mut().for_each(strip);
-                }
-                serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
-                _ => {}
-            }
-        }
-        strip(&mut v);
-        v
-    }
     let dir = tempfile::tempdir().unwrap();
     let cache = dir.path().join("colliders");
     let scenario = "assets/real/scenarios/mw_hammer.toml";
@@ -871,7 +856,7 @@ fn a_collider_cache_gives_the_same_check_and_is_read_back() {
             cmd.arg("--collider-cache").arg(c);
         }
         let out = crate::succeed(cmd.arg(scenario));
-        timeless(serde_json::from_slice(&out.stdout).unwrap())
+        crate::timeless(serde_json::from_slice(&out.stdout).unwrap())
     };
     let files = |d: &std::path::Path| -> Vec<std::path::PathBuf> {
         let mut v: Vec<_> = std::fs::read_dir(d)
