@@ -396,8 +396,12 @@ fn merge(request: &Request, keys: &[Key]) -> anyhow::Result<u8> {
     Ok(exit_status(&counts, 0))
 }
 
-/// The files `--merge` names: each file given, and the `*.jsonl` of each folder, sorted.
-fn shard_files(given: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
+/// The files `--merge` names: each file given, and the `*.jsonl` of each folder, sorted (for
+/// `batch` and `label`).
+///
+/// # Errors
+/// A folder that cannot be read.
+pub(crate) fn shard_files(given: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
     let mut files = Vec::new();
     for m in given {
         if m.is_dir() {

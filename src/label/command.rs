@@ -387,28 +387,6 @@ fn report_totals(
     );
 }
 
-/// The files `--merge` names: each file as given, each folder's `.jsonl` files in name order.
-///
-/// # Errors
-/// A folder that cannot be read.
-fn merge_files(merge: &[PathBuf]) -> anyhow::Result<Vec<PathBuf>> {
-    let mut files = Vec::new();
-    for m in merge {
-        if m.is_dir() {
-            let mut found: Vec<PathBuf> = std::fs::read_dir(m)
-                .with_context(|| format!("{}: cannot read folder", m.display()))?
-                .filter_map(|e| e.ok().map(|e| e.path()))
-                .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "jsonl"))
-                .collect();
-            found.sort();
-            files.extend(found);
-        } else {
-            files.push(m.clone());
-        }
-    }
-    Ok(files)
-}
-
 /// Writes `text` to `out` atomically, or to standard output without one.
 ///
 /// # Errors
@@ -744,7 +722,7 @@ pub fn run_worker(
 /// `label --merge`: the shard files' lines for these inputs, in input order, checked: every
 /// input's object there exactly once and complete.
 fn merge(request: &Request, keys: &[Key]) -> anyhow::Result<u8> {
-    let files = merge_files(&request.merge)?;
+    let files = crate::batch::command::shard_files(&request.merge)?;
     let mut held: HashMap<Key, Held> = HashMap::new();
     let mut duplicated = Vec::new();
     for f in &files {
