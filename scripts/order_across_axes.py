@@ -4,13 +4,13 @@
     python3 scripts/order_across_axes.py LABELS.jsonl [--folds K]
 
 Reads a `grasp-sim label` file and, for each objective of `grasp-sim tune --labels` (first,
-checks, auc), tunes the four significance factors by the same coordinate descent with the same
+checks, auc), tunes the five significance factors by the same coordinate descent with the same
 folds (a SHA-256 of the object's name), two ways:
 
   - within: the planner's order today (src/plan/order.rs): axis plans in search order, each
     axis's candidates by falling score; this reproduces `tune --labels`'s held-out figures;
-  - across: one score over every labelled candidate of the object, the axis plan's rank a fifth
-    term (`- w * axis_plan`, w from 2, which is the thesis's order, tuned with the others), so a
+  - across: one score over every labelled candidate of the object, the axis plan's rank one
+    more term (`- w * axis_plan`, w from 2, which is the thesis's order, tuned with the others), so a
     later axis's candidate can be checked first.
 
 Prints, per objective and way, the held-out mean hold probability of the first candidate and
@@ -25,7 +25,8 @@ import sys
 from collections import defaultdict
 
 MAX_CHECKED = 8
-TERMS = ["centred", "opposed", "spread", "margin"]
+TERMS = ["centred", "opposed", "spread", "margin", "even"]
+N = len(TERMS)
 
 
 def load(path):
@@ -48,8 +49,8 @@ def fold_of(name, k):
 
 
 def score(c, x, across):
-    s = -c["place"] / max(c["found"], 1) + sum(a * b for a, b in zip(x[:4], c["t"]))
-    return s - x[4] * c["axis"] if across else s
+    s = -c["place"] / max(c["found"], 1) + sum(a * b for a, b in zip(x[:N], c["t"]))
+    return s - x[N] * c["axis"] if across else s
 
 
 def ordered(cands, x, across):
@@ -93,8 +94,8 @@ def value(m, objective):
 
 def descend(objs, names, objective, across):
     """Coordinate descent as src/tune/order.rs's `descend`, from the thesis's order."""
-    x = [0.0, 0.0, 0.0, 0.0, 2.0 if across else 0.0]
-    dims = range(5 if across else 4)
+    x = [0.0] * N + [2.0 if across else 0.0]
+    dims = range(N + 1 if across else N)
     best = value(measure(objs, names, x, across), objective)
     step = 8.0
     while step >= 0.125:
@@ -140,7 +141,7 @@ def main(argv):
         return 2
     objs = load(args[0])
     names = sorted(objs)
-    thesis = measure(objs, names, [0.0] * 5, False)
+    thesis = measure(objs, names, [0.0] * (N + 1), False)
     lowest = {n: min(c["axis"] for c in objs[n]) for n in names}
     ceiling_first = sum(max(c["hold"] for c in objs[n] if c["axis"] == lowest[n]) for n in names) / len(names)
     ceiling_any = sum(max(c["hold"] for c in objs[n]) for n in names) / len(names)

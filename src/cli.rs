@@ -520,7 +520,7 @@ pub struct TuneArgs {
     #[arg(required_unless_present = "labels", value_name = "DIR | SCENARIO")]
     pub inputs: Vec<PathBuf>,
     /// Tune the order's significance factors (`[planner] sf_centred`, `sf_opposed`,
-    /// `sf_spread`, `sf_margin`) against the candidates of a `grasp-sim label` file instead of
+    /// `sf_spread`, `sf_margin`, `sf_even`) against the candidates of a `grasp-sim label` file instead of
     /// sweeping a grid: no simulation, k-fold cross-validation over objects (docs/USAGE.md
     /// "Tuning the order").
     #[arg(long, value_name = "FILE.jsonl", conflicts_with_all = ["inputs", "params"])]

@@ -5,7 +5,8 @@
 //! lower place goes with a higher hold probability about half the time). The terms here are
 //! what the physics check rewards and the thesis's grade ignores, each computed from the
 //! planned grasp alone (no check) and each weighted by its own significance factor
-//! (`[planner] sf_centred`, `sf_opposed`, `sf_spread`, `sf_margin`). A candidate's score is
+//! (`[planner] sf_centred`, `sf_opposed`, `sf_spread`, `sf_margin`, `sf_even`). A candidate's
+//! score is
 //!
 //! ```text
 //! score = −place / found + Σ sf_k · term_k
@@ -41,6 +42,12 @@ pub struct OrderTerms {
     /// joint at its limit, 0.5: at mid-range). A joint at its limit cannot close further when
     /// the object settles.
     pub margin: f64,
+    /// Minus the spread (largest less smallest) of the fingers' planned joint-2 bends, over
+    /// joint 2's range (0: the three bent alike). The closing's predicted push: the fingers
+    /// close with equal torque-limited motors, joint 2 last; fingers bent alike meet the object
+    /// together and their pushes balance, while a finger bent far more or less than the others
+    /// meets it early or late and pushes the object alone while the others close.
+    pub even: f64,
 }
 
 /// The significance factors of the terms (`[planner] sf_*`).
@@ -54,6 +61,8 @@ pub struct OrderFactors {
     pub spread: f64,
     /// `sf_margin`.
     pub margin: f64,
+    /// `sf_even`.
+    pub even: f64,
 }
 
 impl OrderFactors {
@@ -64,6 +73,7 @@ impl OrderFactors {
             opposed: p.sf_opposed,
             spread: p.sf_spread,
             margin: p.sf_margin,
+            even: p.sf_even,
         }
     }
 
@@ -73,17 +83,24 @@ impl OrderFactors {
     }
 
     /// The factors in the order of [`NAMES`].
-    pub fn as_array(&self) -> [f64; 4] {
-        [self.centred, self.opposed, self.spread, self.margin]
+    pub fn as_array(&self) -> [f64; TERMS] {
+        [
+            self.centred,
+            self.opposed,
+            self.spread,
+            self.margin,
+            self.even,
+        ]
     }
 
     /// The factors from an array in the order of [`NAMES`].
-    pub fn from_array(a: [f64; 4]) -> OrderFactors {
+    pub fn from_array(a: [f64; TERMS]) -> OrderFactors {
         OrderFactors {
             centred: a[0],
             opposed: a[1],
             spread: a[2],
             margin: a[3],
+            even: a[4],
         }
     }
 
@@ -91,12 +108,21 @@ impl OrderFactors {
     pub fn score(&self, place: usize, found: usize, terms: &OrderTerms) -> f64 {
         let t = terms.as_array();
         let f = self.as_array();
-        -(place as f64) / (found.max(1) as f64) + (0..4).map(|k| f[k] * t[k]).sum::<f64>()
+        -(place as f64) / (found.max(1) as f64) + (0..TERMS).map(|k| f[k] * t[k]).sum::<f64>()
     }
 }
 
+/// How many terms the order has.
+pub const TERMS: usize = 5;
+
 /// The `[planner]` keys of the factors, in order.
-pub const NAMES: [&str; 4] = ["sf_centred", "sf_opposed", "sf_spread", "sf_margin"];
+pub const NAMES: [&str; TERMS] = [
+    "sf_centred",
+    "sf_opposed",
+    "sf_spread",
+    "sf_margin",
+    "sf_even",
+];
 
 /// The largest magnitude a factor may have: the thesis term (the place, from 0 to −1) is then
 /// outweighed a hundredfold; more says nothing more.
@@ -104,17 +130,24 @@ pub const MAX_FACTOR: f64 = 100.0;
 
 impl OrderTerms {
     /// The terms in the order of [`NAMES`].
-    pub fn as_array(&self) -> [f64; 4] {
-        [self.centred, self.opposed, self.spread, self.margin]
+    pub fn as_array(&self) -> [f64; TERMS] {
+        [
+            self.centred,
+            self.opposed,
+            self.spread,
+            self.margin,
+            self.even,
+        ]
     }
 
     /// The terms from an array in the order of [`NAMES`].
-    pub fn from_array(a: [f64; 4]) -> OrderTerms {
+    pub fn from_array(a: [f64; TERMS]) -> OrderTerms {
         OrderTerms {
             centred: a[0],
             opposed: a[1],
             spread: a[2],
             margin: a[3],
+            even: a[4],
         }
     }
 }
@@ -160,6 +193,19 @@ pub fn terms(g: &Grasp, aligned: &AlignedObject, hand: &Hand) -> OrderTerms {
             ((t - a).min(b - t) / range).clamp(0.0, 0.5)
         })
         .fold(0.5, f64::min);
+    let [a2, b2] = hand.joints.theta2_range_deg;
+    let (lo2, hi2) = g
+        .fingers
+        .iter()
+        .map(|f| f.centre.theta2_deg)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), t| {
+            (lo.min(t), hi.max(t))
+        });
+    let even = if g.fingers.is_empty() {
+        0.0
+    } else {
+        -(hi2 - lo2) / (b2 - a2).abs().max(1e-9)
+    };
     OrderTerms {
         centred: if contacts.is_empty() {
             0.0
@@ -169,6 +215,7 @@ pub fn terms(g: &Grasp, aligned: &AlignedObject, hand: &Hand) -> OrderTerms {
         opposed: -push.norm(),
         spread,
         margin,
+        even,
     }
 }
 
@@ -203,12 +250,13 @@ mod tests {
             opposed: -0.1,
             spread: 0.7,
             margin: 0.2,
+            even: -0.1,
         };
         let f = OrderFactors::default();
         assert!(f.is_thesis());
         assert_eq!(f.score(0, 10, &t), 0.0);
         assert_eq!(f.score(5, 10, &t), -0.5);
-        let g = OrderFactors::from_array([0.0, 0.0, 2.0, 0.0]);
+        let g = OrderFactors::from_array([0.0, 0.0, 2.0, 0.0, 0.0]);
         assert!(!g.is_thesis());
         assert!((g.score(5, 10, &t) - (-0.5 + 1.4)).abs() < 1e-12);
     }

@@ -38,7 +38,7 @@ pub struct PlannerParams {
     /// candidates, not seconds, so the answer does not depend on the machine. 0: no limit.
     pub candidate_budget: usize,
     /// The significance factor of [`super::order::OrderTerms::centred`] (issue 58; 0: the
-    /// thesis's order). The four `sf_*` factors below reorder each axis's candidates by
+    /// thesis's order). The five `sf_*` factors below reorder each axis's candidates by
     /// [`super::order::OrderFactors::score`].
     pub sf_centred: f64,
     /// The factor of [`super::order::OrderTerms::opposed`].
@@ -47,6 +47,8 @@ pub struct PlannerParams {
     pub sf_spread: f64,
     /// The factor of [`super::order::OrderTerms::margin`].
     pub sf_margin: f64,
+    /// The factor of [`super::order::OrderTerms::even`].
+    pub sf_even: f64,
 }
 
 /// The default [`PlannerParams::candidate_budget`]: a rule set's candidates over all axes.
@@ -75,6 +77,7 @@ impl Default for PlannerParams {
             sf_opposed: 0.0,
             sf_spread: 0.0,
             sf_margin: 0.0,
+            sf_even: 0.0,
         }
     }
 }
@@ -146,7 +149,8 @@ impl PlannerParams {
                 ),
             ));
         }
-        for (key, v) in keyed!("planner", p; sf_centred, sf_opposed, sf_spread, sf_margin,) {
+        for (key, v) in keyed!("planner", p; sf_centred, sf_opposed, sf_spread, sf_margin, sf_even,)
+        {
             let m = super::order::MAX_FACTOR;
             if !(v.is_finite() && v.abs() <= m) {
                 return Err((

@@ -16,7 +16,7 @@
 //! - `auc`: the probability that a candidate that holds as planned (`as_planned_probability`
 //!   at least 0.5) scores above one that does not, over the candidates of each object, pooled.
 //!
-//! The search is coordinate descent over the four factors with a shrinking step (8, 4, ..., 1/8),
+//! The search is coordinate descent over the five factors with a shrinking step (8, 4, ..., 1/8),
 //! from the thesis's order (every factor 0). It is chosen over a grid, which grows as the
 //! step count to the fourth power, and over CMA-ES or a Bayesian search, which need random
 //! draws and many more evaluations: the objective costs microseconds, is piecewise constant in
@@ -28,7 +28,7 @@
 //! by the tuning that scores it, is what decides adoption; the factors written are those tuned
 //! on every object.
 
-use crate::plan::order::{OrderFactors, OrderTerms, NAMES};
+use crate::plan::order::{OrderFactors, OrderTerms, NAMES, TERMS};
 use anyhow::Context;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -112,6 +112,7 @@ pub fn read_labels(path: &Path) -> anyhow::Result<Labels> {
                     t("opposed")?,
                     t("spread")?,
                     t("margin")?,
+                    t("even")?,
                 ]),
                 hold: v["hold_probability"].as_f64()?,
                 as_planned: v["as_planned_probability"].as_f64()?,
@@ -236,7 +237,7 @@ fn value(m: &Measures, objective: Objective) -> f64 {
 
 /// The factors coordinate descent finds on `names` (see the module docs).
 pub fn descend(labels: &Labels, names: &[&str], objective: Objective) -> OrderFactors {
-    let mut x = [0.0f64; 4];
+    let mut x = [0.0f64; TERMS];
     let mut best = value(
         &measure(labels, names, &OrderFactors::from_array(x)),
         objective,
@@ -248,7 +249,7 @@ pub fn descend(labels: &Labels, names: &[&str], objective: Objective) -> OrderFa
         while improved && rounds < 50 {
             improved = false;
             rounds += 1;
-            for k in 0..4 {
+            for k in 0..TERMS {
                 for dir in [1.0, -1.0] {
                     let mut y = x;
                     y[k] = (y[k] + dir * step).clamp(
@@ -469,7 +470,7 @@ mod tests {
             axis_plan: 0,
             place,
             found: 100,
-            terms: OrderTerms::from_array([0.0, 0.0, spread, 0.0]),
+            terms: OrderTerms::from_array([0.0, 0.0, spread, 0.0, 0.0]),
             hold,
             as_planned: hold,
         }

@@ -40,7 +40,7 @@ fn factors_at_zero_give_the_thesis_order_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
     let zero = cup_with(
         dir.path(),
-        "sf_centred = 0.0\nsf_opposed = 0.0\nsf_spread = 0.0\nsf_margin = 0.0",
+        "sf_centred = 0.0\nsf_opposed = 0.0\nsf_spread = 0.0\nsf_margin = 0.0\nsf_even = 0.0",
     );
     let thesis = grasps(&root().join("scenarios/cup.toml"));
     assert_eq!(thesis.len(), 40);
@@ -86,4 +86,19 @@ fn a_large_factor_puts_the_grasp_its_term_prefers_first() {
         );
     }
     assert_eq!(first["grade"]["place"], 0);
+    // `even`: minus the spread of the planned joint-2 bends over the thesis hand's 90° range.
+    for l in &lines {
+        let bends: Vec<f64> = l["joint_angles_deg"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|f| f[1].as_f64().unwrap())
+            .collect();
+        let spread2 = bends.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+            - bends.iter().cloned().fold(f64::INFINITY, f64::min);
+        let even = l["grade"]["terms"]["even"].as_f64().unwrap();
+        assert!(spread2 > 0.0 || even == 0.0);
+        assert!((even + spread2 / 90.0).abs() < 1e-9, "{even} {spread2}");
+    }
+    assert!(lines.iter().any(|l| l["grade"]["terms"]["even"].as_f64().unwrap() < -0.01));
 }
