@@ -154,11 +154,14 @@ fn object_meshes(input: &ExportInput) -> Vec<(String, Mesh)> {
     let mut meshes: Vec<(String, Mesh)> = Vec::new();
     match input.case.object.shape.as_compound() {
         Some(compound) => {
-            for (k, (_, part)) in compound.shapes().iter().enumerate() {
+            for (k, (pose, part)) in compound.shapes().iter().enumerate() {
                 if let Some(poly) = part.as_convex_polyhedron() {
+                    // Where the part's pose puts it (a decomposition moved into another axis's
+                    // frame: `ObjectShape::moved`).
                     let points: Vec<Point3<f64>> = poly
                         .points()
                         .iter()
+                        .map(|p| *pose * *p)
                         .map(|p| Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
                         .collect();
                     let soup: Vec<[Point3<f64>; 3]> = poly

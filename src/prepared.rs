@@ -83,14 +83,26 @@ impl PreparedObject {
         self.props.volume_mm3
     }
 
-    /// The collider of the object aligned as `a` is, whatever the grasp (made once per axis):
-    /// its convex hull if the mesh is convex, else its convex decomposition.
+    /// The collider of the object aligned as `a` is, whatever the grasp: its convex hull if the
+    /// mesh is convex, else its convex decomposition. The decomposition is made once per object,
+    /// in the thesis axis's frame ([`Self::aligned`]), and moved into any other axis's frame
+    /// ([`ObjectShape::moved`]); a hull, which costs milliseconds, is made in each.
     pub fn own_shape(&self, a: &AlignedObject) -> ObjectShape {
-        let mut shapes = self.shapes.lock().unwrap_or_else(|e| e.into_inner());
-        shapes
-            .entry(a.axis)
-            .or_insert_with(|| ObjectShape::cached(&a.mesh, self.props.volume_mm3))
-            .clone()
+        if let Some(s) = self.shapes_lock().get(&a.axis) {
+            return s.clone();
+        }
+        let thesis = (a.axis != self.aligned.axis).then(|| self.own_shape(&self.aligned));
+        let moved = thesis.and_then(|t| {
+            let motion = a.to_aligned * self.aligned.to_aligned.inverse();
+            t.moved(&motion, crate::sim::collider::is_revolution(&a.mesh))
+        });
+        let shape = moved.unwrap_or_else(|| ObjectShape::cached(&a.mesh, self.props.volume_mm3));
+        self.shapes_lock().entry(a.axis).or_insert(shape).clone()
+    }
+
+    /// The colliders made so far, by axis.
+    fn shapes_lock(&self) -> std::sync::MutexGuard<'_, BTreeMap<GraspAxis, ObjectShape>> {
+        self.shapes.lock().unwrap_or_else(|e| e.into_inner())
     }
 
     /// The collider for a check of `pose` on the object aligned as `a`: [`Self::own_shape`],

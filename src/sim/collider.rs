@@ -264,6 +264,14 @@ fn decomposition_key(mesh: &Mesh) -> [u8; 32] {
     h.finalize().into()
 }
 
+/// True if and only if `mesh` (aligned) is inertially a body of revolution about its aligned Z:
+/// its two transverse principal moments agree within 0.1 % ([`ObjectShape::is_revolution`]).
+pub fn is_revolution(mesh: &Mesh) -> bool {
+    let props = crate::mesh::mass_properties(mesh);
+    let (ixx, iyy) = (props.inertia[(0, 0)], props.inertia[(1, 1)]);
+    (ixx - iyy).abs() <= 1e-3 * ixx.abs().max(iyy.abs())
+}
+
 impl ObjectShape {
     /// [`ObjectShape::from_mesh`], with convex decompositions (0.1–0.4 s each) and rebuilt hulls
     /// (tens of milliseconds) kept for the rest of the process: the same mesh gives the same
@@ -283,9 +291,7 @@ impl ObjectShape {
     /// The convex hull of `mesh` (aligned, millimetres) if the mesh is convex (hull volume within
     /// 2 % of `volume_mm3`), a convex decomposition otherwise.
     pub fn from_mesh(mesh: &Mesh, volume_mm3: f64) -> ObjectShape {
-        let props = crate::mesh::mass_properties(mesh);
-        let (ixx, iyy) = (props.inertia[(0, 0)], props.inertia[(1, 1)]);
-        let is_revolution = (ixx - iyy).abs() <= 1e-3 * ixx.abs().max(iyy.abs());
+        let is_revolution = is_revolution(mesh);
         let points: Vec<Vector> = mesh.vertices.iter().map(convert::point_m).collect();
         // The hull once: parry's polyhedron of it (`SharedShape::convex_hull` is this and
         // `convex_mesh`), its own mass, and its planes where it is rebuilt.
@@ -351,6 +357,34 @@ impl ObjectShape {
             }
         }
         Self::decomposition(mesh, &points, is_revolution)
+    }
+
+    /// This convex decomposition moved by `motion` (from the aligned frame it was made in to
+    /// another aligned frame of the same object, millimetres): the same parts, each placed by
+    /// the motion, rather than a decomposition made again in the other frame (V-HACD voxelises
+    /// along the frame's axes, so it would be another, and it costs 0.1–1.5 s an object).
+    /// `is_revolution` is the other frame's. `None` for any other collider.
+    pub fn moved(
+        &self,
+        motion: &nalgebra::Isometry3<f64>,
+        is_revolution: bool,
+    ) -> Option<ObjectShape> {
+        if self.kind != ColliderKind::ConvexDecomposition {
+            return None;
+        }
+        let by = convert::pose(&motion.translation.vector.into(), &motion.rotation);
+        let parts = self
+            .shape
+            .as_compound()?
+            .shapes()
+            .iter()
+            .map(|(pose, part)| (by * *pose, part.clone()))
+            .collect();
+        Some(ObjectShape {
+            shape: SharedShape::compound(parts),
+            is_revolution,
+            ..self.clone()
+        })
     }
 
     /// The convex decomposition (V-HACD) of `mesh`, whose vertices in metres are `points`.
@@ -1101,6 +1135,59 @@ mod tests {
         let b = ObjectShape::cached(&prism, v);
         assert_eq!(a.kind, ColliderKind::ConvexHull);
         assert!(!std::sync::Arc::ptr_eq(&a.shape.0, &b.shape.0));
+    }
+
+    #[test]
+    fn a_decomposition_moved_into_another_frame_is_its_parts_moved() {
+        let objects = crate::objects::thesis_objects();
+        let mesh = &objects.iter().find(|(n, _)| *n == "chapter4").unwrap().1;
+        let mesh = crate::mesh::align(mesh).mesh;
+        let volume = crate::mesh::mass_properties(&mesh).volume_mm3;
+        let made = ObjectShape::from_mesh(&mesh, volume);
+        assert_eq!(made.kind, ColliderKind::ConvexDecomposition);
+        // Every part's vertices where its pose puts them `[m]`.
+        let points = |s: &ObjectShape| -> Vec<nalgebra::Point3<f64>> {
+            let c = s.shape.as_compound().unwrap();
+            c.shapes()
+                .iter()
+                .flat_map(|(pose, p)| {
+                    let poly = p.as_convex_polyhedron().unwrap();
+                    poly.points().iter().map(|v| *pose * *v).collect::<Vec<_>>()
+                })
+                .map(|p| nalgebra::Point3::new(f64::from(p.x), f64::from(p.y), f64::from(p.z)))
+                .collect()
+        };
+        let mass = |s: &ObjectShape| f64::from(s.shape.mass_properties(1.0).mass());
+        // A turn of 90° about x: the same parts, where the decomposition made afresh in the
+        // turned frame is another (V-HACD voxelises along the frame's axes).
+        let turn = nalgebra::Isometry3::new(
+            nalgebra::Vector3::zeros(),
+            nalgebra::Vector3::x() * std::f64::consts::FRAC_PI_2,
+        );
+        let moved = made.moved(&turn, false).unwrap();
+        assert_eq!((moved.kind, moved.parts), (made.kind, made.parts));
+        assert!((mass(&moved) - mass(&made)).abs() <= 1e-5 * mass(&made));
+        let mut there = mesh.clone();
+        there.map_vertices(|p| turn * p);
+        assert_ne!(ObjectShape::from_mesh(&there, volume).parts, made.parts);
+        // Any rigid motion: every vertex where the motion puts it, the volume kept.
+        let motion = nalgebra::Isometry3::new(
+            nalgebra::Vector3::new(12.0, -7.0, 30.0),
+            nalgebra::Vector3::new(0.3, -0.5, 0.9),
+        );
+        let moved = made.moved(&motion, true).unwrap();
+        assert!(moved.is_revolution);
+        for (a, b) in points(&made).iter().zip(points(&moved)) {
+            let want = motion * (a * 1e3) * 1e-3;
+            assert!((want - b).norm() < 1e-6, "{want} {b}");
+        }
+        assert!((mass(&moved) - mass(&made)).abs() <= 1e-5 * mass(&made));
+        // A hull is not moved: it is made in each frame.
+        let prism = crate::objects::prism(40.0, 100.0, 80.0);
+        let v = crate::mesh::mass_properties(&prism).volume_mm3;
+        assert!(ObjectShape::from_mesh(&prism, v)
+            .moved(&motion, false)
+            .is_none());
     }
 
     /// A cylinder of 60 mm and 120 mm on `segments` facets, with a ring every 10 mm.

@@ -100,5 +100,7 @@ fn a_large_factor_puts_the_grasp_its_term_prefers_first() {
         assert!(spread2 > 0.0 || even == 0.0);
         assert!((even + spread2 / 90.0).abs() < 1e-9, "{even} {spread2}");
     }
-    assert!(lines.iter().any(|l| l["grade"]["terms"]["even"].as_f64().unwrap() < -0.01));
+    assert!(lines
+        .iter()
+        .any(|l| l["grade"]["terms"]["even"].as_f64().unwrap() < -0.01));
 }
