@@ -68,7 +68,7 @@ pub use outcome::{
 };
 pub use payload::{check_with_payload, payload_bracket, payload_margin};
 pub use protocol::{check, check_closed, Closed};
-pub use robust::{add_samples, check_candidate, check_nominal, Perturbation, Robust};
+pub use robust::{Perturbation, Robust};
 pub use scene::{Case, SimHand};
 
 /// A body's pose: position `[m]` and orientation, aligned object frame.
