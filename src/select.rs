@@ -132,12 +132,13 @@ pub struct SelectParams<'a> {
     pub collect: usize,
     /// With the physics check: at most this many candidates are checked. `None`: no check.
     pub max_checked: Option<usize>,
-    /// Runs the physics check on a grasp about an axis.
+    /// Runs the physics check on a grasp about an axis ([`crate::sim::entry::search`]).
     #[allow(clippy::type_complexity)]
     pub check: &'a dyn Fn(&AlignedObject, &Grasp) -> SimOutcome,
-    /// The full check (holds run after a failed closing), for `[sim] closing_decides`: when no
-    /// candidate succeeds, the candidates a failed closing decided are checked again with it,
-    /// in order, until the one the full checks would choose is known. `None`: never.
+    /// The full check (holds run after a failed closing, [`crate::sim::entry::search_in_full`]),
+    /// for `[sim] closing_decides`: when no candidate succeeds, the candidates a failed closing
+    /// decided are checked again with it, in order, until the one the full checks would choose
+    /// is known. `None`: never (no check that `check` returns is decided by the closing).
     #[allow(clippy::type_complexity)]
     pub recheck: Option<&'a dyn Fn(&AlignedObject, &Grasp) -> SimOutcome>,
     /// Stage-1 domains kept across calls (a parameter sweep): they depend only on the axis, the

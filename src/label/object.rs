@@ -278,14 +278,14 @@ type Slot = (
 fn run_task(case: &sim::Case, slot: &Mutex<Slot>, k: Option<usize>, samples: usize) -> bool {
     match k {
         None => {
-            let out = sim::check(case);
+            let out = sim::entry::labelled(case);
             let mut slot = slot.lock().unwrap_or_else(|e| e.into_inner());
             slot.0 = Some(out);
             slot.2 += 1;
             slot.2 == samples + 1
         }
         Some(k) => {
-            let run = sim::robust::check_sample(case, k);
+            let run = sim::entry::labelled_sample(case, k);
             let mut slot = slot.lock().unwrap_or_else(|e| e.into_inner());
             slot.1[k] = Some(run);
             slot.2 += 1;

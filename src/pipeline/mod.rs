@@ -503,24 +503,18 @@ fn write_sample_scenes(folder: &std::path::Path, input: &export::ExportInput) ->
     Ok(())
 }
 
-/// The physics check of one planned grasp on `aligned`, as a run does it: the one place that
-/// turns a grasp into a check (the candidate search and `tune` call it).
+/// The physics check `check` (a [`sim::entry`] point) of one planned grasp on `aligned`, as a
+/// run does it: the one place that turns a grasp into a check.
 pub fn check_grasp(
     scenario: &Scenario,
     object: &PreparedObject,
     aligned: &mesh::AlignedObject,
     grasp: &plan::search::Grasp,
+    check: fn(&sim::Case) -> sim::SimOutcome,
 ) -> sim::SimOutcome {
     let pose = sim::SimHand::from_grasp(grasp, &scenario.hand);
     let shape = object.shape(aligned, &pose, &scenario.hand);
-    sim::check_candidate(&object.case(scenario, &pose, &shape))
-}
-
-/// `scenario` with `[sim] closing_decides` off: every check in full.
-fn without_closing_decides(scenario: &Scenario) -> Scenario {
-    let mut s = scenario.clone();
-    s.sim.hold.closing_decides = false;
-    s
+    check(&object.case(scenario, &pose, &shape))
 }
 
 /// Plans across axes and rule sets; with the physics check on the planner's grasps, checks
@@ -532,17 +526,12 @@ fn select_grasps(
     timings: &mut StageTimings,
 ) -> select::Selection {
     let check = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
-        check_grasp(scenario, object, a, g)
+        check_grasp(scenario, object, a, g, sim::entry::search)
     };
-    // `[sim] closing_decides`: the full check, for the candidates a failed closing decided
-    // when none succeeds (`select::SelectParams::recheck`).
-    let full = scenario
-        .sim
-        .hold
-        .closing_decides
-        .then(|| without_closing_decides(scenario));
+    // The full check, for the candidates a failed closing decided when none succeeds
+    // (`select::SelectParams::recheck`).
     let recheck = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
-        check_grasp(full.as_ref().unwrap_or(scenario), object, a, g)
+        check_grasp(scenario, object, a, g, sim::entry::search_in_full)
     };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
     let checks_candidates =
@@ -560,7 +549,7 @@ fn select_grasps(
             collect: options.candidates,
             max_checked: checks_candidates.then_some(max_checked.max(1)),
             check: &check,
-            recheck: full.is_some().then_some(&recheck as _),
+            recheck: Some(&recheck),
             domains: None,
             frame: scenario.object.frame,
         },
@@ -634,15 +623,6 @@ fn run_sim(
     aligned: &mesh::AlignedObject,
     posed: &Posed,
 ) -> Simulated {
-    // `[sim] closing_decides` acts in the candidate search only: the check reported is a full
-    // one (a given grasp, `override_angles`, the replayed sample, the samples).
-    let full;
-    let scenario = if scenario.sim.hold.closing_decides {
-        full = without_closing_decides(scenario);
-        &full
-    } else {
-        scenario
-    };
     // With --no-sim the check's reason is `--no-sim`, unless an MJCF export asked for the pose
     // and there is none: then the reason is why not.
     let (pose, source, done) = match posed {
@@ -656,27 +636,12 @@ fn run_sim(
     let shape = object.shape(aligned, pose, &scenario.hand);
     let case = object.case(scenario, pose, &shape);
     // The candidate search already checked the chosen grasp: the same case, the same outcome.
-    let (mut out, payload, ran) = match done {
-        Some(out) => {
-            let payload = (options.payload && out.verdict == sim::Verdict::Hold)
-                .then(|| sim::payload_bracket(&case));
-            (out.clone(), payload, false)
-        }
-        None if case.params.robust.replay_sample.is_some() => {
-            let out = sim::check_nominal(&case);
-            let payload = (options.payload && out.verdict == sim::Verdict::Hold)
-                .then(|| sim::payload_bracket(&case));
-            (out, payload, true)
-        }
-        None => {
-            let (out, payload) = sim::check_with_payload(&case, options.payload);
-            (out, payload, true)
-        }
-    };
-    // `[sim] samples`: the perturbed checks of the grasp chosen (issue 34).
-    sim::add_samples(&case, &mut out);
+    let sim::entry::Reported {
+        outcome: out,
+        payload,
+    } = sim::entry::reported(&case, done.clone(), options.payload);
     let poses = (out.final_poses.clone(), out.closed_poses.clone());
-    let ran = ran.then(|| out.clone());
+    let ran = done.is_none().then(|| out.clone());
     let report = build::checked_report(out, payload, &case, &shape, source, options);
     (report, Some(poses), ran)
 }

@@ -5,12 +5,13 @@
 //! planner's millimetres and degrees and [`convert`] converts once. The scene is built in the
 //! aligned object frame, where the thesis's weight acts along −Z.
 //!
-//! Files: [`params`] (the `[sim]` table), [`scene`] (the rapier scene and where it starts),
-//! [`collider`] (the object's collision shape), [`protocol`] (the two protocols' drivers),
-//! [`closing`], [`hold`] with [`early`] (the rest rule) and [`flight`] (drop detection),
-//! [`payload`], [`robust`] (the hold probability under perturbation), [`outcome`] (what is
-//! reported), [`contacts`] (the grip's contacts) and
-//! [`convert`] (nalgebra to glam, millimetres to metres).
+//! Files: [`entry`] (the entry points by purpose: which check runs in full, replays a sample or
+//! adds the samples), [`params`] (the `[sim]` table), [`scene`] (the rapier scene and where it
+//! starts), [`collider`] (the object's collision shape), [`protocol`] (the two protocols'
+//! drivers), [`closing`], [`hold`] with [`early`] (the rest rule) and [`flight`] (drop
+//! detection), [`payload`], [`robust`] (the hold probability under perturbation), [`outcome`]
+//! (what is reported), [`contacts`] (the grip's contacts) and [`convert`] (nalgebra to glam,
+//! millimetres to metres).
 //!
 //! Scene ([`scene`]): the palm is a fixed box at the planned pose; each phalanx is a dynamic box
 //! (finger width and thickness 2 × finger offset; phalanx 2's thinned tip as a thinner box); joints
@@ -42,6 +43,7 @@ pub mod contacts;
 pub mod convert;
 pub mod dispatcher;
 pub mod early;
+pub mod entry;
 pub mod fast_hull;
 pub mod flight;
 pub mod hand_shapes;
@@ -66,7 +68,7 @@ pub use outcome::{
 };
 pub use payload::{check_with_payload, payload_bracket, payload_margin};
 pub use protocol::{check, check_closed, Closed};
-pub use robust::{add_samples, check_candidate, check_nominal, Perturbation, Robust};
+pub use robust::{Perturbation, Robust};
 pub use scene::{Case, SimHand};
 
 /// A body's pose: position `[m]` and orientation, aligned object frame.

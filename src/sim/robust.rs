@@ -314,21 +314,6 @@ impl Robust {
     }
 }
 
-/// The main check of `case`: as [`super::check`] does it, or, with `[sim] replay_sample = k`,
-/// under sample `k`'s perturbation (reported in `replay`).
-pub fn check_nominal(case: &Case) -> SimOutcome {
-    match case.params.robust.replay_sample {
-        None => super::check(case),
-        Some(k) => {
-            let p = Perturbation::draw(&case.params.robust, k);
-            let perturbed = Perturbed::of(case, &p);
-            let mut out = super::check(&perturbed.case(case));
-            out.replay = Some(p);
-            out
-        }
-    }
-}
-
 /// Runs `[sim] samples` perturbed checks of `case` in parallel and counts their verdicts.
 pub fn sample(case: &Case) -> Robust {
     let t0 = Instant::now();
@@ -340,7 +325,8 @@ pub fn sample(case: &Case) -> Robust {
 }
 
 /// Sample `k`'s perturbed check of `case`: one of the checks [`sample`] runs, for a caller that
-/// spreads the samples of several grasps over the cores itself (`grasp-sim label`).
+/// spreads the samples of several grasps over the cores itself
+/// ([`super::entry::labelled_sample`]).
 pub fn check_sample(case: &Case, k: usize) -> (Perturbation, SimOutcome) {
     let p = Perturbation::draw(&case.params.robust, k);
     let perturbed = Perturbed::of(case, &p);
@@ -413,35 +399,6 @@ pub fn robust_of(case: &Case, runs: &[(Perturbation, SimOutcome)], wall_ms: f64)
         steps: runs.iter().map(|r| r.1.steps).sum(),
         wall_ms,
         passes: as_planned_interval[0] >= rp.choose_min_lower_bound,
-    }
-}
-
-/// The check of `case` the candidate search runs: the scenario's case as given (never
-/// `[sim] replay_sample`'s perturbation, so that a replay checks the grasp the run without it
-/// chose: [`add_samples`] replays it), and with `choose = "robust"` and more than one sample,
-/// the samples too.
-pub fn check_candidate(case: &Case) -> SimOutcome {
-    let mut out = super::check(case);
-    let rp = &case.params.robust;
-    if rp.samples > 1 && rp.choose == super::params::Choose::Robust {
-        out.robust = Some(sample(case));
-    }
-    out
-}
-
-/// Completes `out`, the main check of the chosen grasp `case`: with `[sim] replay_sample = k`,
-/// replaces it by the check under sample k's perturbation unless it already is that (the
-/// candidate search checks the case as given, so that it chooses the grasp whose sample k is
-/// replayed); then adds the samples when `[sim] samples` asks for more than one and they have
-/// not run yet.
-pub fn add_samples(case: &Case, out: &mut SimOutcome) {
-    if case.params.robust.replay_sample.is_some() && out.replay.is_none() {
-        let robust = out.robust.take();
-        *out = check_nominal(case);
-        out.robust = robust;
-    }
-    if case.params.robust.samples > 1 && out.robust.is_none() {
-        out.robust = Some(sample(case));
     }
 }
 

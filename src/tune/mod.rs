@@ -344,19 +344,24 @@ struct Prepared {
     object: PreparedObject,
 }
 
-/// A simulated grasp: verdict, translation, payload margin of a hold, and the outcome.
+/// A simulated grasp: the candidate search's check of it, or once it was chosen, its check as
+/// reported with the payload margin of a hold.
 #[derive(Clone)]
 struct Simulated {
     /// The check's outcome.
     outcome: sim::SimOutcome,
-    /// The payload margin, for a grasp that held.
+    /// The payload margin, for a chosen grasp that held.
     payload_margin: Option<f64>,
+    /// True if and only if checked as the chosen grasp is reported.
+    reported: bool,
 }
 
 /// Simulated grasps by (axis, fingerprint).
 type SimCache = HashMap<(crate::mesh::GraspAxis, Vec<u64>), Simulated>;
 
-/// The physics check of a pose (and its payload margin when it holds), cached by `key`.
+/// The candidate search's check of a pose, in full ([`sim::entry::search_in_full`]: every check
+/// of a sweep, so that which candidate an object with no hold reports, and so what its samples
+/// measure, does not depend on `slip` against `drop`), cached by `key`.
 fn simulate(
     p: &Prepared,
     pose: &SimHand,
@@ -370,31 +375,39 @@ fn simulate(
         return o.clone();
     }
     let case = p.object.case(&p.scenario, pose, shape);
-    let out = sim::check_candidate(&case);
+    let out = sim::entry::search_in_full(&case);
     counters.sim_runs += 1;
-    let margin = (out.verdict == Verdict::Hold).then(|| sim::payload_margin(&case));
     let o = Simulated {
         outcome: out,
-        payload_margin: margin,
+        payload_margin: None,
+        reported: false,
     };
     sims.insert(key, o.clone());
     o
 }
 
-/// `o` with the chosen grasp's perturbed checks (`[sim] samples` above 1), run once per grasp
-/// and kept in the cache.
+/// `o`, the chosen grasp, checked as a run reports it ([`sim::entry::reported`]: the replayed
+/// sample, the payload margin of a hold, the perturbed checks of `[sim] samples`), once per
+/// grasp and kept in the cache.
 fn sampled(
     p: &Prepared,
     pose: &SimHand,
     shape: &ObjectShape,
     key: (crate::mesh::GraspAxis, Vec<u64>),
-    mut o: Simulated,
+    o: Simulated,
     sims: &mut SimCache,
 ) -> Simulated {
-    if p.scenario.sim.robust.samples > 1 && o.outcome.robust.is_none() {
-        sim::add_samples(&p.object.case(&p.scenario, pose, shape), &mut o.outcome);
-        sims.insert(key, o.clone());
+    if o.reported {
+        return o;
     }
+    let case = p.object.case(&p.scenario, pose, shape);
+    let r = sim::entry::reported(&case, Some(o.outcome), true);
+    let o = Simulated {
+        outcome: r.outcome,
+        payload_margin: r.payload.map(|(held, _)| held),
+        reported: true,
+    };
+    sims.insert(key, o.clone());
     o
 }
 
@@ -454,11 +467,8 @@ pub fn tune_with_progress(
     let mut first_error = None;
     // A bad input is left out (and reported), as in a batch: the others are still tuned on.
     for item in items {
-        let loaded = scenario_for(item, template).and_then(|mut scenario| {
+        let loaded = scenario_for(item, template).and_then(|scenario| {
             let object = PreparedObject::load(&scenario.object, &mut StageTimings::default())?;
-            // Every check of a sweep in full: which candidate an object with no hold reports,
-            // and so what its samples measure, depends on `slip` against `drop`.
-            scenario.sim.hold.closing_decides = false;
             Ok(Prepared { scenario, object })
         });
         match loaded {

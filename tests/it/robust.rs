@@ -349,6 +349,23 @@ fn tune_ranks_settings_by_the_mean_hold_probability_first() {
 }
 
 #[test]
+fn tune_checks_the_chosen_grasp_as_a_run_reports_it() {
+    // With `replay_sample` and one sample, a run reports the replayed check (the cup moves 11
+    // µm under sample 1's perturbation against 1.5 µm unperturbed): so does tune.
+    use grasp_sim::batch::{default_template, expand};
+    use grasp_sim::tune::{parse_sweep, tune};
+    let (dir, s) = variant("cup", "replay_sample = 1", "");
+    let ran = run_on(2, &s);
+    assert_eq!(ran.sim.replay.as_ref().map(|p| p.sample), Some(1));
+    let items = expand(&[dir.path().join("cup.toml")]).unwrap();
+    let sweep = [parse_sweep("sf_c=0.5:0.5:0.1").unwrap()];
+    let r = tune(&items, &default_template(), &sweep, 1, 2).unwrap();
+    let cup = &r.settings[0].objects[0];
+    assert_eq!(cup.translation_mm, ran.sim.translation_mm, "{cup:?}");
+    assert_eq!(cup.verdict, ran.sim.verdict.verdict());
+}
+
+#[test]
 fn the_six_directions_of_a_sample_continue_from_its_one_closing() {
     // Under `six` a perturbed sample closes the hand once and holds each direction from a copy
     // of the closed scene: its steps are one closing's plus each direction's hold, not six
