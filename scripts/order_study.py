@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """How well the planner's order predicts a hold, before and after tuning (issue 58).
 
-    python3 scripts/order_study.py LABELS.jsonl TUNE_DIR FIGURE.svg
+    python3 scripts/order_study.py LABELS.jsonl TUNE_DIR FIGURE.svg [--other OTHER.jsonl]
 
 LABELS.jsonl is a `grasp-sim label` file made with the thesis's order (every `sf_*` factor 0);
 TUNE_DIR the output of `grasp-sim tune --labels LABELS.jsonl --out TUNE_DIR` (its tune.json
@@ -11,13 +11,15 @@ the expected candidates checked before a hold, the AUC of the score against a ho
 (within objects), each term's own AUC, and the ceiling (the best labelled candidate of the
 first axis plan, and of any). Writes FIGURE.svg: each labelled candidate's hold probability
 against its score's rank within its object (0: first), thesis beside tuned (held out).
+With --other, also the same measures on OTHER.jsonl, labels of objects the tuning never saw,
+under the factors tuned on every object of LABELS.jsonl.
 """
 import json
 import statistics
 import sys
 from collections import defaultdict
 
-TERMS = ["centred", "opposed", "spread", "margin"]
+TERMS = ["centred", "opposed", "spread", "margin", "even"]
 
 
 def score(c, f):
@@ -97,15 +99,25 @@ def figure(by, factors_of, path):
         f.write("\n".join(out) + "\n")
 
 
-def main(argv):
-    if len(argv) != 4:
-        print(__doc__, file=sys.stderr)
-        return 2
+def load(path):
     by = defaultdict(list)
-    for line in open(argv[1]):
+    for line in open(path):
         r = json.loads(line)
         if "hold_probability" in r and "grade" in r:
             by[r["object"]].append(r)
+    return by
+
+
+def main(argv):
+    other = None
+    if "--other" in argv:
+        i = argv.index("--other")
+        other = argv[i + 1]
+        argv = argv[:i] + argv[i + 2:]
+    if len(argv) != 4:
+        print(__doc__, file=sys.stderr)
+        return 2
+    by = load(argv[1])
     tune = json.load(open(f"{argv[2]}/tune.json"))
     fold_of = {}
     for fold in tune["folds"]:
@@ -127,6 +139,12 @@ def main(argv):
     best = statistics.mean(max(c["hold_probability"] for c in cands) for cands in by.values())
     print(f"ceiling: the best labelled candidate of the first axis plan {best0:.3f}, of any {best:.3f}")
     print(f"factors tuned on every object: {tune['factors']}")
+    if other:
+        by2 = load(other)
+        print(f"{other}: {len(by2)} objects the tuning never saw, {sum(len(c) for c in by2.values())} candidates")
+        for label, fo in [("thesis's order", lambda _: {}), ("tuned on every object", lambda _: tune["factors"])]:
+            first, checks, auc = measures(by2, fo)
+            print(f"  {label}: first candidate {first:.3f}, expected checks {checks:.2f}, AUC {auc:.3f}")
     figure(by, held, argv[3])
     print(f"wrote {argv[3]}")
     return 0

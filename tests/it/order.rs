@@ -9,6 +9,12 @@ fn cup_with(dir: &std::path::Path, extra: &str) -> std::path::PathBuf {
     let text = std::fs::read_to_string(root().join("scenarios/cup.toml")).unwrap();
     let assets = root().join("assets");
     let text = text.replace("../assets", assets.to_str().unwrap());
+    // The factors given replace the scenario's (the thesis's zeros).
+    let text: String = text
+        .lines()
+        .filter(|l| !extra.lines().any(|e| l.starts_with(e.split('=').next().unwrap())))
+        .map(|l| format!("{l}\n"))
+        .collect();
     let text = if text.contains("[planner]") {
         text.replace("[planner]", &format!("[planner]\n{extra}"))
     } else {
@@ -38,17 +44,32 @@ fn grasps(scenario: &std::path::Path) -> Vec<Value> {
 #[test]
 fn factors_at_zero_give_the_thesis_order_bit_for_bit() {
     let dir = tempfile::tempdir().unwrap();
-    let zero = cup_with(
-        dir.path(),
-        "sf_centred = 0.0\nsf_opposed = 0.0\nsf_spread = 0.0\nsf_margin = 0.0\nsf_even = 0.0",
-    );
+    // The cup's scenario sets every factor to 0: the thesis's order, its first grasp the
+    // thesis's Grasp Parameter Set (thesis 5.3: elevation 23, approach 0°, pitch −7° within its 1°).
     let thesis = grasps(&root().join("scenarios/cup.toml"));
     assert_eq!(thesis.len(), 40);
+    let first = &thesis[0];
+    assert_eq!(first["elevation_index"], 23, "{first}");
+    assert_eq!(first["approach_angle_deg"].as_f64(), Some(0.0), "{first}");
+    let pitch = first["palm_pitch_deg"].as_f64().unwrap();
+    assert!((pitch + 7.0).abs() < 1.0, "{first}");
+    // The zeros written again: the same grasps, bit for bit.
+    let zero = cup_with(dir.path(), "sf_centred = 0.0\nsf_even = 0.0");
     assert_eq!(grasps(&zero), thesis);
     // A factor reorders the axis's grasps: the 40 reported are others, or in another order.
     let centred = grasps(&cup_with(dir.path(), "sf_centred = 100.0"));
     assert_eq!(centred.len(), 40);
     assert_ne!(centred, thesis);
+    // The defaults are not the thesis's order.
+    let defaults = dir.path().join("cup_defaults.toml");
+    let text = std::fs::read_to_string(&zero).unwrap();
+    let text: String = text
+        .lines()
+        .filter(|l| !l.starts_with("sf_"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    std::fs::write(&defaults, text).unwrap();
+    assert_ne!(grasps(&defaults), thesis);
 }
 
 #[test]
