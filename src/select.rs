@@ -62,6 +62,9 @@ pub struct Candidate {
     pub grasp: Grasp,
     /// The physics check's outcome, when it ran on this candidate.
     pub check: Option<SimOutcome>,
+    /// Its place in its axis plan's thesis order (0: the thesis's first), whatever order the
+    /// `[planner] sf_*` factors searched it in: what `grasp-sim tune --labels` reorders.
+    pub thesis_place: usize,
 }
 
 /// Everything the selection did.
@@ -336,7 +339,7 @@ fn search_axis(
     let available = candidate_count(&graded, p.planner);
     // Adds a feasible grasp, checked while checks remain and none has held; false once enough
     // is known.
-    let take = |sel: &mut Selection, g: Grasp| {
+    let take = |sel: &mut Selection, g: Grasp, thesis_place: usize| {
         let check = match p.max_checked {
             Some(max) if sel.checked() < max && !has_hold(sel) => Some((p.check)(&aligned, &g)),
             _ => None,
@@ -345,6 +348,7 @@ fn search_axis(
             axis_plan: slot,
             grasp: g,
             check,
+            thesis_place,
         });
         !is_done(sel, p, collect)
     };
@@ -359,7 +363,7 @@ fn search_axis(
             budget,
             |g| {
                 found += 1;
-                stopped = !take(sel, g);
+                stopped = !take(sel, g, found - 1);
                 !stopped
             },
         )
@@ -372,8 +376,8 @@ fn search_axis(
         let mut slots: Vec<Option<Grasp>> = all.into_iter().map(Some).collect();
         stopped = order
             .into_iter()
-            .filter_map(|i| slots[i].take())
-            .any(|g| !take(sel, g));
+            .filter_map(|i| Some((slots[i].take()?, i)))
+            .any(|(g, i)| !take(sel, g, i));
         searched
     };
     t.search += crate::plan::timings::ms(t0);

@@ -163,7 +163,8 @@ pub struct Grade {
     pub terms: crate::plan::order::OrderTerms,
     /// Which axis plan of the search it came from (0: the first searched).
     pub axis_plan: usize,
-    /// Its place in that axis plan's order (0: the first).
+    /// Its place in that axis plan's thesis order (0: the thesis's first), whatever order the
+    /// `[planner] sf_*` factors searched it in.
     pub place: usize,
     /// The feasible grasps that axis plan found.
     pub found: usize,
@@ -551,17 +552,16 @@ fn pose_picks(
     picks: &[usize],
     export: Option<&MjcfExport>,
 ) -> Result<Vec<Posed>, Error> {
-    // Each candidate's place in its axis plan's order.
-    let mut places = Vec::with_capacity(selection.candidates.len());
-    let mut seen = vec![0usize; selection.axes.len()];
-    for c in &selection.candidates {
-        places.push(Place {
+    // Each candidate's place in its axis plan's thesis order.
+    let places: Vec<Place> = selection
+        .candidates
+        .iter()
+        .map(|c| Place {
             axis_plan: c.axis_plan,
-            place: seen[c.axis_plan],
+            place: c.thesis_place,
             found: selection.axes[c.axis_plan].grasps_found,
-        });
-        seen[c.axis_plan] += 1;
-    }
+        })
+        .collect();
     let hand = &scenario.hand;
     picks
         .iter()

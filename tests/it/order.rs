@@ -12,7 +12,11 @@ fn cup_with(dir: &std::path::Path, extra: &str) -> std::path::PathBuf {
     // The factors given replace the scenario's (the thesis's zeros).
     let text: String = text
         .lines()
-        .filter(|l| !extra.lines().any(|e| l.starts_with(e.split('=').next().unwrap())))
+        .filter(|l| {
+            !extra
+                .lines()
+                .any(|e| l.starts_with(e.split('=').next().unwrap()))
+        })
         .map(|l| format!("{l}\n"))
         .collect();
     let text = if text.contains("[planner]") {
