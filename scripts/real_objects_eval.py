@@ -17,6 +17,7 @@ import argparse
 import csv
 import json
 import pathlib
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -47,14 +48,23 @@ def run_one(binary, scenario, gravity, tmp, mjcf_dir, sim=(), raw_dir=None):
     s = pathlib.Path(tmp) / f"{scenario.stem}_{gravity}.toml"
     s.write_text(scenario_text(scenario, gravity, sim))
     cmd = [binary, "--json", s.as_posix()]
+    # Each run exports into a folder of its own (grasp-sim locks an output folder for the run
+    # that writes it), moved into MJCF_DIR after.
+    own = pathlib.Path(tmp) / f"mjcf_{scenario.stem}_{gravity}"
     if mjcf_dir is not None:
-        cmd[1:1] = ["--export-mjcf", str(mjcf_dir)]
+        own.mkdir()
+        cmd[1:1] = ["--export-mjcf", str(own)]
     t0 = time.monotonic()
     try:
         p = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT_S)
     except subprocess.TimeoutExpired:
         return {"error": f"timeout: no result within {TIMEOUT_S} s", "wall_s": TIMEOUT_S}
     wall = time.monotonic() - t0
+    if mjcf_dir is not None:
+        for d in own.iterdir():
+            if d.is_dir():
+                shutil.rmtree(mjcf_dir / d.name, ignore_errors=True)
+                shutil.move(str(d), str(mjcf_dir / d.name))
     if p.returncode == 2 or not p.stdout.strip():
         return {"error": p.stderr.strip().splitlines()[-1] if p.stderr.strip() else "no output",
                 "wall_s": wall}

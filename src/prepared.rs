@@ -14,8 +14,8 @@ use std::collections::BTreeMap;
 use std::sync::Mutex;
 use std::time::Instant;
 
-/// A scenario's object, loaded and aligned, with its mass and (made on demand, once per axis)
-/// its colliders.
+/// A scenario's object, loaded and aligned, with its mass and its colliders (made on demand,
+/// once per axis; a decomposition once per object).
 pub struct PreparedObject {
     /// The mesh as loaded (original frame), with what loading found and repaired.
     pub loaded: LoadedMesh,

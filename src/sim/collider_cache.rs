@@ -1,6 +1,6 @@
 //! Convex decompositions kept on disk between runs (issue 57): `--collider-cache DIR`, or the
 //! environment's `GRASP_SIM_COLLIDER_CACHE`, keeps each V-HACD decomposition (0.1–0.4 s of an
-//! object's fixed cost, made anew in each axis's frame) under the digest of the mesh it was
+//! object's fixed cost, made once, in the thesis axis's frame) under the digest of the mesh it was
 //! made of, so that a sweep, a tuning or a labelling run that meets the same object again
 //! skips it. What is kept is the decomposition's parts exactly as V-HACD gave them (each
 //! part's points and triangles): the collider made from them is the one made without the
