@@ -182,6 +182,12 @@ def replay(scene_dir, directions=None, trace=False):
                 out[k] = out[k] or other == phalanx1[k]
         return out
 
+    motor_range = [m.actuator_forcerange[2 * k].copy() for k in range(n)]
+    # `reseat_by_motor`: the reseat drives a joint 1 with its motor's torque (the actuator's own
+    # forcerange), and the lock holds it where it stops (as grasp-sim's).
+    motor_cap = bool(proto.get("reseat_by_motor", False))
+    driving = [False] * n
+
     def lock_joint1():
         for k in range(n):
             a = 2 * k
@@ -220,7 +226,15 @@ def replay(scene_dir, directions=None, trace=False):
                     if not t1 and reseat_at[k] < target[2 * k]:
                         reseat_at[k] = min(reseat_at[k] + reseat_step, target[2 * k])
                         d.ctrl[2 * k] = reseat_at[k]
+                        if motor_cap:
+                            m.actuator_forcerange[2 * k] = motor_range[k]
+                            driving[k] = True
                         moving = True
+                    elif motor_cap and driving[k]:
+                        driving[k] = False
+                        reseat_at[k] = float(d.qpos[joint1_qpos[k]])
+                        d.ctrl[2 * k] = reseat_at[k]
+                        m.actuator_forcerange[2 * k] = [-lock, lock]
             if ramp is not None and ramp < ramp_steps:
                 ramp += 1
                 s = ramp / ramp_steps
