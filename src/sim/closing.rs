@@ -277,7 +277,9 @@ fn reseat(scene: &mut Scene, case: &Case, run: &mut Phases, max_steps: usize) {
             .zip(at.iter_mut().zip(&now.fingers))
             .enumerate()
         {
-            if !t[0] && *a < f.joint1_target {
+            let lifted = !case.params.closing.reseat_only_lifted
+                || run.first_contact.fingers[i][0].is_some();
+            if !t[0] && lifted && *a < f.joint1_target {
                 *a = (*a + step_rad).min(f.joint1_target);
                 let cap = if motor_cap {
                     Some(torques[i] as f32)
