@@ -93,7 +93,9 @@ pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
     let dt = params.solver.timestep_s;
     let close_steps = (params.closing.close_duration_s / dt).round() as usize;
     let (p0, q0) = relative(scene);
+    trace::start(case);
     let mut run = Phases {
+        p0,
         stall: params.closing.close_until_stalled.then_some(&STALL),
         dt,
         steps: 0,
@@ -107,6 +109,7 @@ pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
     };
     // Joint 1 closes for at most half the closing time, joint 2 for the rest.
     run.phase(scene, close_steps / 2);
+    trace::phase_end(scene, case, p0, 0, run.steps);
     if run.together.waiting {
         run.together.release(scene);
     }
@@ -115,8 +118,10 @@ pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
     }
     scene.release_joint2();
     run.phase(scene, close_steps - close_steps / 2);
+    trace::phase_end(scene, case, p0, 1, run.steps);
     if params.closing.reseat {
         reseat(scene, case, &mut run, close_steps / 2);
+        trace::phase_end(scene, case, p0, 2, run.steps);
     }
     closed(scene, case, (p0, q0), &run.first_contact, run.steps)
 }
@@ -124,6 +129,8 @@ pub(super) fn close(scene: &mut Scene, case: &Case) -> Closing {
 /// The closing's running state: its stall rule, the steps taken, the first contacts, and the
 /// approach's state.
 struct Phases<'a> {
+    /// The object's position relative to the palm at the start `[mm]` (for the trace).
+    p0: Vector3<f64>,
     stall: Option<&'a Stall>,
     dt: f64,
     steps: usize,
@@ -142,6 +149,7 @@ impl Phases<'_> {
             }
             scene.world.step();
             self.steps += 1;
+            trace::every_10_ms(scene, self.p0, self.steps, self.dt);
             let now = touching(scene);
             self.first_contact.update(&now, self.steps as f64 * self.dt);
             if self.together.hold_touching(scene, &now) {
@@ -257,19 +265,41 @@ fn reseat(scene: &mut Scene, case: &Case, run: &mut Phases, max_steps: usize) {
         .map(|f| f.joint1.angle(&scene.world).unwrap_or(f.joint1_target))
         .collect();
     let mut quiet_steps = 0;
+    let motor_cap = case.params.closing.reseat_by_motor;
+    let torques = super::scene::finger_torque_limits(case.hand, case.params);
+    let mut driving = vec![false; scene.fingers.len()];
     for _ in 0..max_steps {
         let now = touching(scene);
         let mut moving = false;
-        for (f, (a, t)) in scene.fingers.iter().zip(at.iter_mut().zip(&now.fingers)) {
-            if !t[0] && *a < f.joint1_target {
+        for (i, (f, (a, t))) in scene
+            .fingers
+            .iter()
+            .zip(at.iter_mut().zip(&now.fingers))
+            .enumerate()
+        {
+            let lifted = !case.params.closing.reseat_only_lifted
+                || run.first_contact.fingers[i][0].is_some();
+            if !t[0] && lifted && *a < f.joint1_target {
                 *a = (*a + step_rad).min(f.joint1_target);
-                f.joint1
-                    .set_motor(&mut scene.world, *a, (k * 10.0, d), lock);
+                let cap = if motor_cap {
+                    Some(torques[i] as f32)
+                } else {
+                    lock
+                };
+                f.joint1.set_motor(&mut scene.world, *a, (k * 10.0, d), cap);
+                driving[i] = true;
                 moving = true;
+            } else if motor_cap && driving[i] {
+                driving[i] = false;
+                let here = f.joint1.angle(&scene.world).unwrap_or(*a);
+                *a = here;
+                f.joint1
+                    .set_motor(&mut scene.world, here, (k * 10.0, d), lock);
             }
         }
         scene.world.step();
         run.steps += 1;
+        trace::every_10_ms(scene, run.p0, run.steps, run.dt);
         run.first_contact
             .update(&touching(scene), run.steps as f64 * run.dt);
         let Some(rule) = run.stall else { continue };
@@ -630,6 +660,102 @@ fn joint_errors(scene: &Scene) -> Vec<[f64; 2]> {
             ]
         })
         .collect()
+}
+
+/// `GRASP_SIM_TRACE_CLOSING=1`: rapier's closing on stderr, in the format of
+/// `scripts/mujoco_replay.py --trace` (the object's shift from its start relative to the palm
+/// every 10 ms, each joint's bend minus its plan, the bodies touching the object; at the end of
+/// each phase every contact carrying force, in the palm frame). A diagnostic: the check's
+/// result is the same with or without it.
+pub(super) mod trace {
+    use super::{joint_errors, relative, touching, Case, Scene};
+    use nalgebra::Vector3;
+    use std::sync::OnceLock;
+
+    fn on() -> bool {
+        static ON: OnceLock<bool> = OnceLock::new();
+        *ON.get_or_init(|| std::env::var_os("GRASP_SIM_TRACE_CLOSING").is_some_and(|v| v == "1"))
+    }
+
+    fn line(scene: &Scene, p0: Vector3<f64>, stamp: &str) {
+        let (pc, _) = relative(scene);
+        let d = pc - p0;
+        let errors: Vec<String> = joint_errors(scene)
+            .iter()
+            .flat_map(|e| e.map(|x| format!("{x:+.1}")))
+            .collect();
+        let now = touching(scene);
+        let mut names = Vec::new();
+        if now.palm {
+            names.push("palm".to_string());
+        }
+        for (k, t) in now.fingers.iter().enumerate() {
+            for (j, on) in t.iter().enumerate() {
+                if *on {
+                    names.push(format!("finger_{}_phalanx_{}", k + 1, j + 1));
+                }
+            }
+        }
+        eprintln!(
+            "{stamp}: shift {:.2} mm [{:.2} {:.2} {:.2}], bend - plan [deg] {}, touching {:?}",
+            d.norm(),
+            d.x,
+            d.y,
+            d.z,
+            errors.join(" "),
+            names
+        );
+    }
+
+    /// During the hold: the object's translation from where the closing left it, every 50 ms.
+    pub(in crate::sim) fn hold(scene: &Scene, pc: Vector3<f64>, steps: usize, dt: f64) {
+        if on() && steps.is_multiple_of(((0.05 / dt).round() as usize).max(1)) {
+            line(scene, pc, &format!("hold t={:.3} s", steps as f64 * dt));
+        }
+    }
+
+    pub(super) fn start(case: &Case) {
+        if on() {
+            eprintln!("closing: theta planned {:?} deg", case.pose.theta_deg);
+        }
+    }
+
+    pub(super) fn every_10_ms(scene: &Scene, p0: Vector3<f64>, steps: usize, dt: f64) {
+        if on() && steps.is_multiple_of(((0.01 / dt).round() as usize).max(1)) {
+            line(scene, p0, &format!("t={:.3} s", steps as f64 * dt));
+        }
+    }
+
+    pub(super) fn phase_end(
+        scene: &Scene,
+        case: &Case,
+        p0: Vector3<f64>,
+        phase: usize,
+        steps: usize,
+    ) {
+        if !on() {
+            return;
+        }
+        let dt = case.params.solver.timestep_s;
+        line(
+            scene,
+            p0,
+            &format!("end of phase {phase} (t={:.3} s)", steps as f64 * dt),
+        );
+        let (pc, qc) = relative(scene);
+        for c in super::super::contacts::grip_contacts(scene) {
+            let p = qc * Vector3::from(c.point_mm) + pc;
+            let n = qc * Vector3::from(c.normal);
+            let body = match c.finger {
+                None => "palm".to_string(),
+                Some(k) => format!("finger_{}_phalanx_{}", k + 1, c.phalanx),
+            };
+            eprintln!(
+                "    {body:20} at [{:.1} {:.1} {:.1}] mm, normal (hand on object) [{:.2} {:.2} {:.2}], {:.2} N normal",
+                p.x, p.y, p.z, n.x, n.y, n.z, c.force_n
+            );
+        }
+    }
 }
 
 #[cfg(test)]

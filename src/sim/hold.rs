@@ -98,6 +98,7 @@ pub(super) fn hold(
     while steps < hold_steps && decided.is_none() {
         scene.world.step();
         steps += 1;
+        super::closing::trace::hold(scene, closing.pc, steps, dt);
         if tracing && early.is_none() && steps % fine_every == 0 {
             let (p, q) = relative(scene);
             fine.push((p, q, super::contacts::friction_use(scene)));
