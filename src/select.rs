@@ -454,8 +454,7 @@ fn has_hold(sel: &Selection) -> bool {
 /// bound of its probability of a hold as planned passed); else, when candidates were sampled,
 /// the one ranked highest by its samples ([`crate::sim::Robust::rank`]: the lower bound of a
 /// hold as planned, then of a hold; the first on a tie) if any sample of it held; else the
-/// best by the preference held as planned, held, slip, drop (issue 55), within one preference
-/// the one whose closing kept the plan, then the least closing shift; else the first found.
+/// first by the preference held as planned, held, slip, drop (issue 55), else the first found.
 fn choose(candidates: &[Candidate]) -> Option<usize> {
     if let Some(i) = candidates
         .iter()
@@ -480,21 +479,12 @@ fn choose(candidates: &[Candidate]) -> Option<usize> {
     if let Some((i, _)) = best {
         return Some(i);
     }
-    // Among candidates of the same preference, the one whose closing kept the plan, then the
-    // one whose closing moved the object least: the grasp closest to the one planned, whose
-    // verdict owes least to what the closing did (then the first found).
-    let checked = candidates.iter().enumerate().filter_map(|(i, c)| {
-        let check = c.check.as_ref()?;
-        let f = &check.fidelity;
-        Some((i, (check.preference(), !f.as_planned, f.shift_mm)))
-    });
+    let checked = candidates
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| Some((i, c.check.as_ref()?.preference())));
     checked
-        .min_by(|(i, a), (j, b)| {
-            (a.0, a.1)
-                .cmp(&(b.0, b.1))
-                .then(a.2.total_cmp(&b.2))
-                .then(i.cmp(j))
-        })
+        .min_by_key(|&(i, p)| (p, i))
         .map(|(i, _)| i)
         .or_else(|| (!candidates.is_empty()).then_some(0))
 }
