@@ -39,7 +39,8 @@ pub struct PlannerParams {
     pub candidate_budget: usize,
     /// The significance factor of [`super::order::OrderTerms::centred`] (issue 58). The five
     /// `sf_*` factors reorder each axis's candidates by [`super::order::OrderFactors::score`];
-    /// all 0 is the thesis's order; the defaults are [`DEFAULT_ORDER_FACTORS`].
+    /// all 0 (the default) is the thesis's order. Factors tuned on the real-object set did not
+    /// carry over to a third set (docs/studies/2026-12-05-order-even.md).
     pub sf_centred: f64,
     /// The factor of [`super::order::OrderTerms::opposed`].
     pub sf_opposed: f64,
@@ -49,28 +50,6 @@ pub struct PlannerParams {
     pub sf_margin: f64,
     /// The factor of [`super::order::OrderTerms::even`].
     pub sf_even: f64,
-}
-
-/// The default order factors, in the order of [`super::order::NAMES`]: tuned by `grasp-sim
-/// tune --labels --objective auc` on 724 labelled candidates of 48 real objects (gravity down,
-/// 2026-12-05; docs/studies/2026-12-05-order-even.md). Held out (5 folds over objects) they
-/// raise the first candidate's mean hold probability from 0.797 to 0.841; on 15 objects the
-/// tuning never saw, from 0.942 to 0.975. All 0 is the thesis's order, as the thesis's
-/// scenarios set it.
-pub const DEFAULT_ORDER_FACTORS: [f64; super::order::TERMS] = [-8.0, -1.0, 16.0, 28.0, 24.0];
-
-impl PlannerParams {
-    /// These parameters with every order factor 0: the thesis's order, bit for bit.
-    pub fn in_thesis_order(self) -> PlannerParams {
-        PlannerParams {
-            sf_centred: 0.0,
-            sf_opposed: 0.0,
-            sf_spread: 0.0,
-            sf_margin: 0.0,
-            sf_even: 0.0,
-            ..self
-        }
-    }
 }
 
 /// The default [`PlannerParams::candidate_budget`]: a rule set's candidates over all axes.
@@ -95,11 +74,11 @@ impl Default for PlannerParams {
             pitch_range_deg: 20.0,
             extended_rules: true,
             candidate_budget: DEFAULT_CANDIDATE_BUDGET,
-            sf_centred: DEFAULT_ORDER_FACTORS[0],
-            sf_opposed: DEFAULT_ORDER_FACTORS[1],
-            sf_spread: DEFAULT_ORDER_FACTORS[2],
-            sf_margin: DEFAULT_ORDER_FACTORS[3],
-            sf_even: DEFAULT_ORDER_FACTORS[4],
+            sf_centred: 0.0,
+            sf_opposed: 0.0,
+            sf_spread: 0.0,
+            sf_margin: 0.0,
+            sf_even: 0.0,
         }
     }
 }
