@@ -81,7 +81,7 @@ fn main() {
             t.non_manifold_edges,
             o.volume_mm3(),
             o.mass_kg,
-            ColliderReport::of(&shape),
+            grasp_sim::report::ColliderReport::from(&ColliderReport::of(&shape)),
             c.x, c.y, c.z, i[0], i[1], i[2]
         );
     }
@@ -102,7 +102,7 @@ fn main() {
         println!(
             "{} jitter k={k}: {}; centre of mass ({:.3}, {:.3}, {:.3}) mm, {:.3} mm from k=0's",
             base.name,
-            ColliderReport::of(&shape),
+            grasp_sim::report::ColliderReport::from(&ColliderReport::of(&shape)),
             c.x,
             c.y,
             c.z,

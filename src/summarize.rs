@@ -10,7 +10,7 @@
 use crate::batch::{BatchError, Counts};
 use crate::messages::plural;
 use crate::report::RecordView;
-use crate::sim::Verdict;
+use crate::report::Verdict;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;

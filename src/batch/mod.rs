@@ -28,8 +28,8 @@ pub use isolate::{Interrupted, Worker};
 pub use record::{input_hash, Key, Record, RecordError};
 
 use crate::report::RecordView;
+use crate::report::Verdict;
 use crate::scenario::Scenario;
-use crate::sim::Verdict;
 use crate::{run, RunOptions};
 use rayon::prelude::*;
 use record::BatchInfo;

@@ -14,7 +14,8 @@
 
 use crate::mesh::{AlignedObject, GraspAxis};
 use crate::report::json::round_significant;
-use crate::sim::{Fidelity, Robust, SimHand, SimOutcome, Verdict};
+use crate::report::{Counts, Fidelity, Verdict};
+use crate::sim::{Robust, SimHand, SimOutcome};
 use nalgebra::{Matrix3, Matrix4, Point3};
 use serde::Serialize;
 
@@ -400,7 +401,7 @@ pub struct LabelRecord {
     /// Perturbed checks run.
     pub samples: usize,
     /// Their verdicts.
-    pub counts: crate::sim::robust::Counts,
+    pub counts: Counts,
     /// Samples held in every direction / samples.
     pub hold_probability: f64,
     /// Its 95 % Wilson interval.
@@ -427,7 +428,7 @@ pub struct DirectionLabel {
     /// The nominal check's verdict under it.
     pub verdict: Verdict,
     /// The samples' verdicts under it.
-    pub counts: crate::sim::robust::Counts,
+    pub counts: Counts,
     /// Samples held under it with a closing as planned.
     pub held_as_planned: usize,
     /// Samples held under it / samples.
@@ -465,8 +466,8 @@ impl LabelRecord {
             .zip(&robust.directions)
             .map(|(n, r)| DirectionLabel {
                 gravity: n.gravity,
-                verdict: n.verdict,
-                counts: r.counts,
+                verdict: n.verdict.into(),
+                counts: (&r.counts).into(),
                 held_as_planned: r.held_as_planned,
                 hold_probability: r.hold_probability,
             })
@@ -487,12 +488,12 @@ impl LabelRecord {
             relaxations: line.carried.relaxations.clone(),
             grade: line.carried.grade.clone(),
             planned_contacts_mm: line.planned_contacts_mm.clone(),
-            verdict: nominal.verdict,
-            fidelity: nominal.fidelity.clone(),
+            verdict: nominal.verdict.into(),
+            fidelity: (&nominal.fidelity).into(),
             translation_mm: nominal.translation_mm,
             rotation_deg: nominal.rotation_deg,
             samples: robust.samples,
-            counts: robust.counts,
+            counts: (&robust.counts).into(),
             hold_probability: robust.hold_probability,
             interval: robust.interval,
             held_as_planned: robust.held_as_planned,

@@ -167,25 +167,25 @@ pub(super) fn checked_report(
     options: &RunOptions,
 ) -> SimReport {
     SimReport {
-        verdict: SimVerdict::Ran(out.verdict),
+        verdict: SimVerdict::Ran(out.verdict.into()),
         translation_mm: Some(out.translation_mm),
         rotation_deg: Some(out.rotation_deg),
         simulated_s: Some(out.simulated_s),
         steps: Some(out.steps),
         wall_ms: Some(out.wall_ms),
-        start: Some(sim::scene::start(case)),
-        collider: Some(sim::ColliderReport::of(shape)),
+        start: Some((&sim::scene::start(case)).into()),
+        collider: Some((&sim::ColliderReport::of(shape)).into()),
         mass_kg: Some(case.mass_kg),
         grasp_source: Some(source),
         payload_margin: options
             .payload
             .then(|| payload.map_or(0.0, |(held, _)| held)),
         payload_fails_at: payload.and_then(|(_, failed)| failed),
-        closing: Some(out.closing),
-        fidelity: Some(out.fidelity),
-        directions: out.directions,
-        robust: out.robust,
-        replay: out.replay,
+        closing: Some((&out.closing).into()),
+        fidelity: Some((&out.fidelity).into()),
+        directions: out.directions.iter().map(Into::into).collect(),
+        robust: out.robust.as_ref().map(Into::into),
+        replay: out.replay.as_ref().map(Into::into),
         limits: Some(report::HoldLimits {
             translation_mm: case.params.hold.hold_translation_mm,
             rotation_deg: case.params.hold.hold_rotation_deg,
@@ -319,9 +319,9 @@ fn grasp_report(
                         .to_string(),
                 }
             } else {
-                SimVerdict::Ran(o.verdict)
+                SimVerdict::Ran(o.verdict.into())
             },
-            fidelity: o.fidelity.clone(),
+            fidelity: (&o.fidelity).into(),
             closed_joint_angles_deg: o.closing.fingers.iter().map(|f| f.final_deg).collect(),
             translation_mm: o.translation_mm,
             rotation_deg: o.rotation_deg,

@@ -25,7 +25,7 @@ pub const BISECTION_TOL_RAD: f64 = std::f64::consts::PI / 18_000.0;
 pub const TOUCH_MM: f64 = 0.01;
 
 /// What the refinement did to one finger.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FingerRefinement {
     /// The planned `[θ1, θ2]` it started from `[deg]` (the ALS angles).
     pub als_deg: [f64; 2],

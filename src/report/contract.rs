@@ -8,8 +8,9 @@
 //! [`RecordView`] reads a line back: the one typed view that `batch` (counts, `--resume`,
 //! `--merge`) and `summarize` read.
 
+use super::check::{ClosingOutcome, ColliderReport, DirectionOutcome, Fidelity, Start, Verdict};
+use super::robust::{Perturbation, Robust};
 use crate::scenario::Outcome;
-use crate::sim::Verdict;
 use serde::de::DeserializeOwned;
 use serde::{Deserialize, Deserializer, Serialize};
 
@@ -261,7 +262,7 @@ pub struct CandidateCheck {
     #[serde(flatten)]
     pub verdict: SimVerdict,
     /// Whether the grasp the closing made is the one planned (issue 55).
-    pub fidelity: crate::sim::Fidelity,
+    pub fidelity: Fidelity,
     /// Per finger, `[θ1, θ2]` where the closing left the joints `[deg]`: the grasp to command
     /// when it held but not as planned.
     pub closed_joint_angles_deg: Vec<[f64; 2]>,
@@ -471,12 +472,12 @@ pub struct SimReport {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub wall_ms: Option<f64>,
     /// Where the check started: how far the palm was backed off the object's collider, how far
-    /// each finger started open, and any penetration left (`sim::scene::Start`).
+    /// each finger started open, and any penetration left.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub start: Option<crate::sim::scene::Start>,
+    pub start: Option<Start>,
     /// The object's collider: `convex_hull` or `convex_decomposition`, and its part count.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub collider: Option<crate::sim::ColliderReport>,
+    pub collider: Option<ColliderReport>,
     /// Object mass simulated `[kg]`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mass_kg: Option<f64>,
@@ -494,15 +495,15 @@ pub struct SimReport {
     /// What the closing did (issue 33): the object's shift and turn, each finger's planned and
     /// final joint angles, and the first touch.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub closing: Option<crate::sim::ClosingOutcome>,
+    pub closing: Option<ClosingOutcome>,
     /// Whether the grasp that held is the one planned (issue 55): `as_planned` by
     /// `max_closing_shift_mm`, `min_on_plan_fraction` and `max_penetration_mm`, with the
     /// figures that decided it. The verdict is gravity's alone.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub fidelity: Option<crate::sim::Fidelity>,
+    pub fidelity: Option<Fidelity>,
     /// Per gravity direction.
     #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub directions: Vec<crate::sim::DirectionOutcome>,
+    pub directions: Vec<DirectionOutcome>,
     /// The limits the verdict (`translation_mm`, `rotation_deg`) and the fidelity
     /// (`penetration_mm`, `closing_shift_mm`, `on_plan_fraction`) were judged by.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -510,10 +511,10 @@ pub struct SimReport {
     /// The hold probability under `[sim] samples` perturbed checks (issue 34); absent with one
     /// sample (the default: the main check only).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub robust: Option<crate::sim::Robust>,
+    pub robust: Option<Robust>,
     /// The perturbation the main check ran under (`[sim] replay_sample`); absent otherwise.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub replay: Option<crate::sim::Perturbation>,
+    pub replay: Option<Perturbation>,
 }
 
 /// The limits of a hold: how far the object may move and turn relative to the palm, and how

@@ -71,7 +71,7 @@ impl ExpectReport {
             let verdict = sim.verdict.verdict();
             return ExpectReport {
                 outcome,
-                met: Some(verdict.is_some() && verdict == expect.outcome.verdict()),
+                met: Some(verdict.is_some() && verdict == expect.outcome.verdict().map(Into::into)),
                 details: format!("sim-only ({why}): verdict {}", sim.verdict),
             };
         }
@@ -146,7 +146,7 @@ fn judge_probability(p: f64, sim: &SimReport, q: Question) -> (bool, String) {
         (None, Some(v)) => {
             let as_planned = sim.fidelity.as_ref().is_some_and(|f| f.as_planned);
             let held = usize::from(
-                v == crate::sim::Verdict::Hold
+                v == super::Verdict::Hold
                     && (matches!(q, Question::Hold) || as_planned),
             );
             (held, 1, crate::sim::robust::wilson(held, 1)[0])
@@ -173,7 +173,7 @@ fn judge_check(expected: Outcome, verdict: &SimVerdict) -> (bool, String) {
              not run"
                 .to_string(),
         ),
-        Some(v) if expected.verdict() == Some(v) => {
+        Some(v) if expected.verdict().map(super::Verdict::from) == Some(v) => {
             (true, format!("planning part met; physics check: {v}"))
         }
         Some(v) => (

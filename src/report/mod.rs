@@ -6,15 +6,22 @@
 //! read (`feasible`, `hold`, `not_run`, `override_angles`, ...).
 //!
 //! - [`contract`]: the report's types, as written to JSON, and [`RecordView`], a line read back.
+//! - [`check`] and [`robust`]: the physics check's part of them, converted from `sim`'s types.
 //! - [`expect`]: judging a scenario's `[expect]`.
 //! - [`summary`]: the human summary.
 //! - [`json`]: the JSON text, figures rounded.
 
+pub mod check;
 pub mod contract;
 pub mod expect;
 pub mod json;
+pub mod robust;
 pub mod summary;
 
+pub use check::{
+    ClosingOutcome, ColliderKind, ColliderReport, DecidedBy, DirectionOutcome, Fidelity,
+    FidelityReason, FingerClosing, FingerRefinement, FirstTouch, Start, Verdict,
+};
 pub use contract::{
     AlsReport, AxisReport, BatchView, CandidateCheck, CandidateRobust, DiameterBasis,
     DirectionView, ErrorView, ExpectReport, ExpectView, FingerReport, GradesReport, GraspQuality,
@@ -26,4 +33,5 @@ pub use json::{
     round_significant, to_rounded_json, to_rounded_json_pretty, JSON_SIGNIFICANT_DIGITS,
     JSON_ZERO_BELOW,
 };
+pub use robust::{Counts, DirectionRobust, FirstFailure, Perturbation, Ranges, Robust};
 pub use summary::{closing_line, fmt_signed};

@@ -1,9 +1,10 @@
 //! The human summary of a run: the thesis's "Grasp Parameter Set" style where a plan exists,
 //! the physics check, the closing, the quality and the result in one sentence.
 
+use super::check::{ClosingOutcome, Fidelity, FidelityReason, FingerClosing, Verdict};
+use super::robust::{Perturbation, Robust};
 use super::{GraspReport, PlanReport, RunReport, SimReport, SimVerdict};
 use crate::messages::plural;
-use crate::sim::Verdict;
 use std::fmt::Write;
 
 impl GraspReport {
@@ -219,8 +220,7 @@ impl RunReport {
         }
         if let Some(c) = &self.sim.closing {
             let _ = writeln!(s, "  Closing     {}", closing_line(c));
-            let set = |f: &crate::sim::FingerClosing,
-                       which: fn(&crate::sim::FingerClosing) -> [f64; 2]| {
+            let set = |f: &FingerClosing, which: fn(&FingerClosing) -> [f64; 2]| {
                 let [a, b] = which(f);
                 format!("{a:.1}/{b:.1}")
             };
@@ -342,17 +342,17 @@ impl RunReport {
 
 /// The reasons a closing left the plan, in words: "pushed 6.2 mm", "2 of 6 phalanges on plan",
 /// "a finger 2.40 mm inside".
-fn reasons_words(f: &crate::sim::Fidelity) -> String {
+fn reasons_words(f: &Fidelity) -> String {
     let words: Vec<String> = f
         .reasons
         .iter()
         .map(|r| match r {
-            crate::sim::FidelityReason::Pushed => format!("pushed {:.1} mm", f.shift_mm),
-            crate::sim::FidelityReason::OffPlan => format!(
+            FidelityReason::Pushed => format!("pushed {:.1} mm", f.shift_mm),
+            FidelityReason::OffPlan => format!(
                 "{} of {} phalanges on plan",
                 f.phalanges_on_plan, f.phalanges
             ),
-            crate::sim::FidelityReason::Penetrated => {
+            FidelityReason::Penetrated => {
                 format!("a finger {:.2} mm inside", f.penetration_mm)
             }
         })
@@ -364,8 +364,7 @@ fn reasons_words(f: &crate::sim::Fidelity) -> String {
 /// planned, how far the closing took it from the plan, and each bound it crossed, e.g. "NOT as
 /// planned: the closing took the object 6.2 mm and 1.3 deg from the plan (at most 5 mm);
 /// 2 of 6 phalanges end on plan (at least 3); worst joint 12.0 deg short".
-pub fn fidelity_line(f: &crate::sim::Fidelity, sim: &SimReport) -> String {
-    use crate::sim::FidelityReason;
+pub fn fidelity_line(f: &Fidelity, sim: &SimReport) -> String {
     let has = |r| f.reasons.contains(&r);
     let limits = sim.limits;
     let min_on_plan = sim.closing.as_ref().map(|c| c.min_on_plan);
@@ -414,7 +413,7 @@ pub fn fidelity_line(f: &crate::sim::Fidelity, sim: &SimReport) -> String {
 /// The summary's closing line (issue 33): how far the closing pushed and turned the object,
 /// which body touched first, and the joint furthest from its plan, e.g. "the closing pushed
 /// the object 23.0 mm; finger_2 stopped 27.0 deg short of its plan".
-pub fn closing_line(c: &crate::sim::ClosingOutcome) -> String {
+pub fn closing_line(c: &ClosingOutcome) -> String {
     let mut s = format!(
         "the closing pushed the object {:.1} mm and turned it {:.1} deg{}",
         c.shift_mm,
@@ -461,7 +460,7 @@ pub fn closing_line(c: &crate::sim::ClosingOutcome) -> String {
 
 /// The hold probability in words, per direction, and the first failing sample with how to
 /// replay it.
-pub fn robust_line(r: &crate::sim::Robust) -> String {
+pub fn robust_line(r: &Robust) -> String {
     let dirs: Vec<String> = r
         .directions
         .iter()
@@ -491,7 +490,7 @@ pub fn robust_line(r: &crate::sim::Robust) -> String {
 }
 
 /// A perturbation in words.
-fn replay_line(p: &crate::sim::Perturbation) -> String {
+fn replay_line(p: &Perturbation) -> String {
     let [x, y, z] = p.offset_mm;
     let [a, b, c] = p.rotation_deg;
     format!(

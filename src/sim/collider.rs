@@ -11,8 +11,7 @@ use rapier3d::parry::transformation::vhacd::{VHACDParameters, VHACD};
 use rapier3d::prelude::*;
 
 /// How the object's collider was made.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ColliderKind {
     /// The convex hull of the mesh (the mesh is convex).
     ConvexHull,
@@ -131,10 +130,9 @@ pub fn object_mass_properties(object: &ObjectShape, mass_kg: f64) -> MassPropert
     object.shape.mass_properties(density as f32)
 }
 
-/// The object's collider as the report gives it (`sim.collider`): how it was made and its part
-/// count, and for a hull rebuilt from its face planes, the vertex counts before and after.
-/// Serialised as the sentence its [`Display`](std::fmt::Display) writes, e.g.
-/// `convex_decomposition (12 parts)`.
+/// What the report says of the object's collider (`sim.collider`, written by
+/// `report::check::ColliderReport`): how it was made and its part count, and for a hull rebuilt
+/// from its face planes, the vertex counts before and after.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ColliderReport {
     /// How the collider was made.
@@ -172,35 +170,6 @@ impl ColliderReport {
             }),
             hull_off_mm: shape.hull_off_mm,
         }
-    }
-}
-
-impl std::fmt::Display for ColliderReport {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        if let Some(off) = self.hull_off_mm {
-            return write!(
-                f,
-                "{} ({} parts, for a convex mesh whose hull lies {off:.1} mm outside a planned contact)",
-                self.kind, self.parts
-            );
-        }
-        match self.rebuilt {
-            Some(RebuiltHull {
-                from_vertices,
-                to_vertices,
-            }) => write!(
-                f,
-                "{} ({} parts, rebuilt from its face planes where parry would merge bent faces: {from_vertices} vertices to {to_vertices})",
-                self.kind, self.parts
-            ),
-            None => write!(f, "{} ({} parts)", self.kind, self.parts),
-        }
-    }
-}
-
-impl serde::Serialize for ColliderReport {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_str(self)
     }
 }
 
@@ -1045,9 +1014,7 @@ mod tests {
         assert_eq!(taken.kind, ColliderKind::ConvexDecomposition);
         assert!(taken.parts > 1);
         assert!((taken.hull_off_mm.unwrap() - depth).abs() < 1e-3);
-        assert!(ColliderReport::of(&taken).to_string().ends_with(
-            "parts, for a convex mesh whose hull lies 3.6 mm outside a planned contact)"
-        ));
+        assert_eq!(ColliderReport::of(&taken).hull_off_mm, taken.hull_off_mm);
         // A contact the plan presses 2 mm into the body is as deep in the mesh as in the
         // hull: the hull adds nothing there and stays.
         let pressed = nalgebra::Point3::new(28.0, 0.0, 100.0);
@@ -1247,38 +1214,5 @@ mod tests {
             assert!((0.0299..=0.030_05).contains(&r), "{r} m");
             assert!(c.z >= -1e-6 && c.z <= 0.120 + 1e-6, "{} m", c.z);
         }
-    }
-
-    #[test]
-    fn the_collider_report_is_the_sentence_it_was() {
-        let plain = ColliderReport {
-            kind: ColliderKind::ConvexDecomposition,
-            parts: 12,
-            rebuilt: None,
-            hull_off_mm: None,
-        };
-        assert_eq!(
-            serde_json::to_string(&plain).unwrap(),
-            "\"convex_decomposition (12 parts)\""
-        );
-        let rebuilt = ColliderReport {
-            kind: ColliderKind::ConvexHull,
-            parts: 1,
-            rebuilt: Some(RebuiltHull {
-                from_vertices: 1024,
-                to_vertices: 296,
-            }),
-            hull_off_mm: None,
-        };
-        assert_eq!(
-            rebuilt.to_string(),
-            "convex_hull (1 parts, rebuilt from its face planes where parry would merge bent \
-             faces: 1024 vertices to 296)"
-        );
-        // From a shape: the prism's plain hull.
-        let prism = crate::objects::prism(40.0, 100.0, 80.0);
-        let v = crate::mesh::mass_properties(&prism).volume_mm3;
-        let r = ColliderReport::of(&ObjectShape::from_mesh(&prism, v));
-        assert_eq!(r.to_string(), "convex_hull (1 parts)");
     }
 }

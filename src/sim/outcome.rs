@@ -12,8 +12,7 @@ use nalgebra::Vector3;
 /// The verdict of the hold test: what gravity did to the object in the hand, judged by the hold
 /// thresholds alone (`hold_translation_mm`, `hold_rotation_deg`). Whether the grasp that held
 /// is the one planned is the [`Fidelity`]'s question, not this one's.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Verdict {
     /// The object stayed within the thresholds relative to the palm.
     Hold,
@@ -47,8 +46,9 @@ impl std::fmt::Display for Verdict {
     }
 }
 
-/// The result for one gravity direction (reported as is in the JSON's `sim.directions`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+/// The result for one gravity direction (the JSON's `sim.directions` reports it as
+/// `report::DirectionOutcome`).
+#[derive(Debug, Clone, PartialEq)]
 pub struct DirectionOutcome {
     /// Gravity direction (unit, aligned frame).
     pub gravity: [f64; 3],
@@ -107,8 +107,7 @@ pub struct DirectionOutcome {
 
 /// What decided a direction's verdict (`decided_by` in the JSON's `sim.directions`; docs/SIM.md,
 /// "Deciding early").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum DecidedBy {
     /// The direction ran the whole hold.
     End,
@@ -231,7 +230,7 @@ impl SimOutcome {
 /// What the closing did to the planned grasp (issue 33, docs/SIM.md "What the closing does"):
 /// how far it pushed the object, where each joint stopped against its plan, and which phalanx
 /// touched the object first. Reported as `sim.closing`.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ClosingOutcome {
     /// Object translation relative to the palm from the start of the closing to its end `[mm]`.
     pub shift_mm: f64,
@@ -266,7 +265,7 @@ pub struct ClosingOutcome {
 pub const WITHIN_PLAN_DEG: f64 = 5.0;
 
 /// The first touch of the closing.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FirstTouch {
     /// `palm`, or the finger's name.
     pub body: String,
@@ -277,7 +276,7 @@ pub struct FirstTouch {
 }
 
 /// One finger's closing: planned and final joint angles, in the thesis's interior angles.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FingerClosing {
     /// The finger's name.
     pub name: String,
@@ -321,8 +320,7 @@ impl ClosingOutcome {
 
 /// Why a closing did not keep the planned grasp: one entry of [`Fidelity::reasons`], named in
 /// the JSON by the key that bounds it.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, serde::Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
 pub enum FidelityReason {
     /// The closing pushed the object farther than `max_closing_shift_mm`.
     Pushed,
@@ -353,7 +351,7 @@ impl std::fmt::Display for FidelityReason {
 /// Whether the grasp the closing made is the one planned (issue 55; `sim.fidelity` in the JSON,
 /// also per candidate): the bounds as a yes or no, and the continuous figures that decided it,
 /// for an engine comparison or a tuning to use.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Fidelity {
     /// True if and only if `reasons` is empty: the closing pushed the object no farther than
     /// `max_closing_shift_mm`, left at least `min_on_plan_fraction` of the phalanges on their
@@ -431,16 +429,7 @@ mod tests {
     }
 
     #[test]
-    fn decided_by_serialises_as_its_name() {
-        for d in [
-            DecidedBy::End,
-            DecidedBy::Rest,
-            DecidedBy::OutOfReach,
-            DecidedBy::ClearOfHand,
-        ] {
-            let json = serde_json::to_string(&d).unwrap();
-            assert_eq!(json, format!("\"{}\"", d.as_str()));
-        }
+    fn decided_by_is_named_and_tells_a_drop() {
         assert_eq!(DecidedBy::OutOfReach.as_str(), "out_of_reach");
         assert_eq!(DecidedBy::ClearOfHand.to_string(), "clear_of_hand");
         assert!(DecidedBy::OutOfReach.is_drop() && DecidedBy::ClearOfHand.is_drop());

@@ -28,7 +28,7 @@ use std::time::Instant;
 /// One sample's perturbation: how the object sits relative to the hand, and how friction, the
 /// object's mass and the motors' torque differ from the scenario's. Reported as
 /// `sim.robust.first_failure.perturbation` (and `sim.replay`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Perturbation {
     /// The sample's index (`[sim] replay_sample` replays it).
     pub sample: usize,
@@ -147,7 +147,7 @@ fn object_com_mm(case: &Case) -> Vector3<f64> {
 }
 
 /// Counts of the verdicts.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
 pub struct Counts {
     /// Samples that held.
     pub hold: usize,
@@ -193,7 +193,7 @@ pub fn wilson(k: usize, n: usize) -> [f64; 2] {
 }
 
 /// The hold probability over one gravity direction.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct DirectionRobust {
     /// Gravity direction (unit, aligned frame).
     pub gravity: [f64; 3],
@@ -208,7 +208,7 @@ pub struct DirectionRobust {
 }
 
 /// The first sample that did not hold: enough to replay it (`[sim] replay_sample`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FirstFailure {
     /// Its index.
     pub sample: usize,
@@ -221,7 +221,7 @@ pub struct FirstFailure {
 }
 
 /// The perturbation ranges a run drew from (`[sim]` keys of the same names).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Ranges {
     /// `[mm]`, each coordinate.
     pub pose_offset_mm: f64,
@@ -236,7 +236,7 @@ pub struct Ranges {
 }
 
 /// The hold probability under perturbation (`sim.robust`).
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Robust {
     /// Perturbed checks run.
     pub samples: usize,
@@ -263,7 +263,6 @@ pub struct Robust {
     /// Each sample's fidelity (`true`: its closing kept the planned grasp), in sample order.
     pub as_planned: Vec<bool>,
     /// The first sample that did not hold (`None`: all held).
-    #[serde(skip_serializing_if = "Option::is_none")]
     pub first_failure: Option<FirstFailure>,
     /// Physics steps over all samples.
     pub steps: usize,
@@ -271,36 +270,10 @@ pub struct Robust {
     pub wall_ms: f64,
     /// True if and only if the lower bound of `as_planned_interval` reaches `[sim]
     /// choose_min_lower_bound` (what `choose = "robust"` takes as a success).
-    #[serde(skip)]
     pub passes: bool,
 }
 
 impl Robust {
-    /// The summary's words: "held in 14 of 16 perturbed checks (88 %, 95 % interval 64–97 %)",
-    /// and, when some of those holds were not as planned, "; as planned in 12 (75 %, 95 %
-    /// interval 51–90 %)".
-    pub fn in_words(&self) -> String {
-        let pct = |x: f64| (100.0 * x).round();
-        let mut words = format!(
-            "held in {} of {} perturbed checks ({} %, 95 % interval {}–{} %)",
-            self.counts.hold,
-            self.samples,
-            pct(self.hold_probability),
-            pct(self.interval[0]),
-            pct(self.interval[1])
-        );
-        if self.held_as_planned != self.counts.hold {
-            words += &format!(
-                "; as planned in {} ({} %, 95 % interval {}–{} %)",
-                self.held_as_planned,
-                pct(self.as_planned_probability),
-                pct(self.as_planned_interval[0]),
-                pct(self.as_planned_interval[1])
-            );
-        }
-        words
-    }
-
     /// The candidate search's rank of a sampled candidate, larger better: the lower bound of
     /// the probability of a hold as planned, then of the hold probability, then the two
     /// probabilities.
@@ -488,53 +461,5 @@ mod tests {
         // Uniform angles in [0, 3]: a mean near 1.5 (500 draws: σ of the mean 0.04).
         let mean = angles.iter().sum::<f64>() / 500.0;
         assert!((mean - 1.5).abs() < 0.15, "{mean}");
-    }
-
-    #[test]
-    fn the_words_round_as_the_issue_writes_them() {
-        let r = Robust {
-            samples: 16,
-            seed: 0,
-            ranges: Ranges {
-                pose_offset_mm: 2.0,
-                pose_rotation_deg: 3.0,
-                friction_range_pct: 15.0,
-                mass_range_pct: 15.0,
-                torque_range_pct: 10.0,
-            },
-            counts: Counts {
-                hold: 14,
-                slip: 2,
-                drop: 0,
-            },
-            hold_probability: 14.0 / 16.0,
-            interval: wilson(14, 16),
-            held_as_planned: 14,
-            as_planned_probability: 14.0 / 16.0,
-            as_planned_interval: wilson(14, 16),
-            directions: Vec::new(),
-            verdicts: Vec::new(),
-            as_planned: Vec::new(),
-            first_failure: None,
-            steps: 0,
-            wall_ms: 0.0,
-            passes: false,
-        };
-        assert_eq!(
-            r.in_words(),
-            "held in 14 of 16 perturbed checks (88 %, 95 % interval 64–97 %)"
-        );
-        // 12 of the 14 holds as planned: 75 %, Wilson 51–90 %.
-        let r = Robust {
-            held_as_planned: 12,
-            as_planned_probability: 12.0 / 16.0,
-            as_planned_interval: wilson(12, 16),
-            ..r
-        };
-        assert_eq!(
-            r.in_words(),
-            "held in 14 of 16 perturbed checks (88 %, 95 % interval 64–97 %); as planned in 12 \
-             (75 %, 95 % interval 51–90 %)"
-        );
     }
 }

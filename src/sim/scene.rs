@@ -248,15 +248,13 @@ fn box_shape(b: &HandBox) -> SharedShape {
 /// check on its convex hull or decomposition, whose parts bulge past the mesh by millimetres: a
 /// hand collider starting inside one is thrown out by the solver (MuJoCo's stiff contacts threw
 /// a golf club 3 m), which is a different test from closing on the object.
-#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Start {
     /// The palm's origin `[mm]` (the planned one moved by `palm_backoff_mm` along palm x).
-    #[serde(skip)]
     pub origin_mm: Point3<f64>,
     /// How far the palm was backed off the collider `[mm]` (0 when it starts clear).
     pub palm_backoff_mm: f64,
     /// Per finger, the bends the joints start at `[rad]`.
-    #[serde(skip)]
     pub open_bend_rad: Vec<[f64; 2]>,
     /// Per finger, the margin it starts open by `[deg]`.
     pub open_margin_deg: Vec<f64>,
@@ -265,11 +263,9 @@ pub struct Start {
     pub penetration_mm: f64,
     /// Per finger, the `[θ1, θ2]` the check commands `[deg]` (plus the squeeze): the plan's,
     /// or with `[sim] refine_contacts` the plan refined by the contact.
-    #[serde(skip)]
     pub theta_deg: Vec<[f64; 2]>,
     /// Per finger, what the refinement by the contact did (`sim::refine`); empty when it did not
     /// run (`refine_contacts = false`, or `override_angles`).
-    #[serde(skip_serializing_if = "Vec::is_empty")]
     pub refinement: Vec<crate::plan::refine::FingerRefinement>,
 }
 

@@ -72,7 +72,7 @@ fn parameter_set(report: &RunReport) -> String {
 
 /// One table row per finger: its name, planned joint angles and contact, and with the
 /// `closing` the angles it closed to.
-fn finger_rows(g: &GraspReport, closing: Option<&crate::sim::ClosingOutcome>) -> String {
+fn finger_rows(g: &GraspReport, closing: Option<&crate::report::ClosingOutcome>) -> String {
     let mut s = String::new();
     for (k, f) in g.fingers.iter().enumerate() {
         s.push_str(&format!(

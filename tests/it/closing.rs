@@ -335,19 +335,23 @@ fn a_push_beyond_the_bound_moves_the_search_on() {
     let c = r.sim.closing.as_ref().unwrap();
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(Verdict::Hold)
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold)
     );
     assert!(c.shift_mm <= 5.0, "{c:?}");
     assert!(r.sim.fidelity.as_ref().unwrap().as_planned);
     let first = &r.plan.grasps[0];
     let check = first.check.as_ref().unwrap();
-    assert_eq!(check.ran(), Some(Verdict::Hold), "{first:?}");
+    assert_eq!(
+        check.ran(),
+        Some(grasp_sim::report::Verdict::Hold),
+        "{first:?}"
+    );
     assert!(check.translation_mm < 1.0, "{first:?}");
     let f = &check.fidelity;
     assert!(!f.as_planned, "{f:?}");
     assert_eq!(
         f.reasons[0],
-        grasp_sim::sim::FidelityReason::Pushed,
+        grasp_sim::report::FidelityReason::Pushed,
         "{f:?}"
     );
     assert!(f.shift_mm > 5.0 && f.shift_mm < 8.0, "{f:?}");

@@ -33,9 +33,9 @@
 //! join it after `python3 scripts/real_objects.py`). docs/FRAMES.md gives the rule and what it
 //! measures.
 
+use grasp_sim::report::Verdict;
 use grasp_sim::report::{GraspReport, PlanStatus, RunReport};
 use grasp_sim::scenario::Scenario;
-use grasp_sim::sim::Verdict;
 use grasp_sim::{run, RunOptions};
 use nalgebra::{Isometry3, Point3, Translation3, UnitQuaternion, Vector3};
 

@@ -40,11 +40,11 @@ fn sim_contacts_on_a_convex_decomposition_lie_on_the_object_and_grip_it() {
     let r = run(&s, &with_quality()).unwrap();
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold)
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold)
     );
     assert_eq!(
         r.sim.collider.map(|c| c.kind),
-        Some(grasp_sim::sim::ColliderKind::ConvexDecomposition),
+        Some(grasp_sim::report::ColliderKind::ConvexDecomposition),
         "{:?}",
         r.sim.collider
     );
@@ -186,7 +186,7 @@ fn a_grip_closed_on_nothing_has_no_quality_whatever_the_plan() {
     let r = run(&s, &with_quality()).unwrap();
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Drop)
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Drop)
     );
     let q = r.quality.unwrap();
     assert_eq!(q.source, "sim");

@@ -375,7 +375,7 @@ fn held_beyond_the_thesis<'a>(
     }
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold),
         "{:?} {:?}",
         r.sim.translation_mm,
         check_names(r)
@@ -411,7 +411,7 @@ fn a_flat_disc_is_wrapped_across_its_faces() {
         .all(|a| a.grasps_found == 0));
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold),
         "{:?}",
         r.sim.translation_mm
     );

@@ -4,8 +4,8 @@
 //! Wilson interval's lower bound.
 
 use grasp_sim::report::RunReport;
+use grasp_sim::report::Verdict;
 use grasp_sim::scenario::Scenario;
-use grasp_sim::sim::Verdict;
 use grasp_sim::{run, RunOptions};
 
 /// The closing before the default changed (a straight approach with a 10° squeeze, no
@@ -362,7 +362,7 @@ fn tune_checks_the_chosen_grasp_as_a_run_reports_it() {
     let r = tune(&items, &default_template(), &sweep, 1, 2).unwrap();
     let cup = &r.settings[0].objects[0];
     assert_eq!(cup.translation_mm, ran.sim.translation_mm, "{cup:?}");
-    assert_eq!(cup.verdict, ran.sim.verdict.verdict());
+    assert_eq!(cup.verdict.map(Verdict::from), ran.sim.verdict.verdict());
 }
 
 #[test]

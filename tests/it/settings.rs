@@ -2,8 +2,8 @@
 //! the hold's substeps change the hold and leave the closing alone, and the shorter rest
 //! window decides a still grasp sooner with the same verdict and numbers.
 
+use grasp_sim::report::{DecidedBy, Verdict};
 use grasp_sim::scenario::{GravityMode, Scenario};
-use grasp_sim::sim::{DecidedBy, Verdict};
 use grasp_sim::{run, RunOptions};
 
 fn d40_six() -> Scenario {

@@ -49,7 +49,7 @@ fn the_scene_matches_the_plan() {
     let r = run(&s, &with_sim()).unwrap();
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold),
         "{:?}",
         r.sim
     );
@@ -169,7 +169,7 @@ fn hold_slip_and_drop_are_told_apart() {
     let hold = scenario("cup");
     assert_eq!(
         hold.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold),
         "{:?}",
         hold.sim
     );
@@ -177,7 +177,7 @@ fn hold_slip_and_drop_are_told_apart() {
     let slip = scenario("sim_chapter4_weak_motors");
     assert_eq!(
         slip.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Slip),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Slip),
         "{:?}",
         slip.sim
     );
@@ -188,14 +188,14 @@ fn hold_slip_and_drop_are_told_apart() {
     // It has come to rest on the hand by 0.5 s: the fast protocol decides the slip then rather
     // than holding to the end (`fast_and_full_protocols_agree_on_the_bundled_scenarios`
     // compares its numbers with the full hold's).
-    assert_eq!(d.decided_by, grasp_sim::sim::DecidedBy::Rest);
+    assert_eq!(d.decided_by, grasp_sim::report::DecidedBy::Rest);
     assert!(d.decided_at_s < 1.0, "decided at {} s", d.decided_at_s);
     let mut drops = Vec::new();
     for name in ["sim_cup_weak_motors", "sim_d40_slippery_heavy"] {
         let drop = scenario(name);
         assert_eq!(
             drop.sim.verdict,
-            grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Drop),
+            grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Drop),
             "{name}: {:?}",
             drop.sim
         );
@@ -258,11 +258,11 @@ fn payload_margin_is_found_by_bisection() {
     };
     assert_eq!(
         check(m),
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold)
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold)
     );
     assert_ne!(
         check(failed),
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold)
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold)
     );
 }
 
@@ -585,7 +585,7 @@ fn a_drop_clear_of_the_hand_is_the_full_protocols_drop() {
     let mut clear = 0;
     for (a, b) in full.directions.iter().zip(&fast.directions) {
         assert_eq!(a.verdict, b.verdict, "gravity {:?}", a.gravity);
-        if b.decided_by == grasp_sim::sim::DecidedBy::ClearOfHand {
+        if b.decided_by == grasp_sim::report::DecidedBy::ClearOfHand {
             clear += 1;
             let d = (a.translation_mm - b.translation_mm).abs();
             assert!(
@@ -610,7 +610,7 @@ fn penetration_after_closing_is_reported_and_bounded() {
     let depth = r.sim.directions[0].closing_penetration_mm;
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold),
         "{:?}",
         r.sim
     );
@@ -629,13 +629,13 @@ fn penetration_after_closing_is_reported_and_bounded() {
     assert!(dir.translation_mm < 1.0, "{dir:?}");
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold),
         "{:?}",
         r.sim
     );
     let f = r.sim.fidelity.as_ref().unwrap();
     assert!(!f.as_planned && !dir.as_planned, "{f:?}");
-    assert_eq!(f.reasons, [grasp_sim::sim::FidelityReason::Penetrated]);
+    assert_eq!(f.reasons, [grasp_sim::report::FidelityReason::Penetrated]);
     assert_eq!(f.penetration_mm, dir.closing_penetration_mm);
     // The scenario expects `hold`: met; asking for a hold as planned too is not.
     assert_eq!(r.expect.met, Some(true));
@@ -679,7 +679,7 @@ fn penetration_after_closing_is_reported_and_bounded() {
     let r = run(&s, &with_sim()).unwrap();
     assert_eq!(
         r.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(grasp_sim::sim::Verdict::Hold),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold),
         "{:?}",
         r.sim
     );
@@ -796,7 +796,7 @@ fn a_given_grasp_is_checked_as_given() {
     let planned = run(&s, &with_sim()).unwrap();
     assert_eq!(
         planned.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(Verdict::Hold)
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Hold)
     );
     let shift =
         |r: &grasp_sim::report::RunReport| r.sim.closing.as_ref().map(|c| c.shift_mm).unwrap();
@@ -818,7 +818,7 @@ fn a_given_grasp_is_checked_as_given() {
     let off = run(&s, &o).unwrap();
     assert_eq!(
         off.sim.verdict,
-        grasp_sim::report::SimVerdict::Ran(Verdict::Drop),
+        grasp_sim::report::SimVerdict::Ran(grasp_sim::report::Verdict::Drop),
         "{:?}",
         off.sim
     );
