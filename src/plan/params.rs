@@ -52,6 +52,20 @@ pub struct PlannerParams {
     pub sf_even: f64,
 }
 
+impl PlannerParams {
+    /// These parameters with every order factor 0: the thesis's order, bit for bit.
+    pub fn in_thesis_order(self) -> PlannerParams {
+        PlannerParams {
+            sf_centred: 0.0,
+            sf_opposed: 0.0,
+            sf_spread: 0.0,
+            sf_margin: 0.0,
+            sf_even: 0.0,
+            ..self
+        }
+    }
+}
+
 /// The default [`PlannerParams::candidate_budget`]: a rule set's candidates over all axes.
 pub const DEFAULT_CANDIDATE_BUDGET: usize = 1500;
 
