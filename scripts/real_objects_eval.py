@@ -166,6 +166,8 @@ def main():
     ap.add_argument("--binary", default=str(ROOT / "target" / "release" / "grasp-sim"))
     ap.add_argument("--out", default=str(ROOT / "out" / "real"))
     ap.add_argument("--no-mujoco", action="store_true")
+    ap.add_argument("--down-only", action="store_true",
+                    help="skip the `six` run (what MuJoCo replays is the `down` run's grasp)")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--write-doc", action="store_true")
     ap.add_argument("--sim", action="append", default=[], metavar="KEY=VALUE",
@@ -180,6 +182,8 @@ def main():
                     help="keep each run's JSON as OUT/raw/NAME_GRAVITY.json (for per-phalanx studies)")
     ap.add_argument("names", nargs="*", help="only these objects")
     a = ap.parse_args()
+    if a.down_only and a.write_doc:
+        ap.error("--write-doc needs the `six` run: drop --down-only")
 
     labels = {r["name"]: r for r in csv.DictReader(open(REAL / "manifest.csv"))}
     scenarios = sorted((REAL / "scenarios").glob("*.toml"))
@@ -204,15 +208,15 @@ def main():
             (s.stem, g): pool.submit(run_one, a.binary, s, g, tmp, mjcf if g == "down" else None, a.sim,
                         raw)
             for s in scenarios
-            for g in ("down", "six")
+            for g in (("down",) if a.down_only else ("down", "six"))
         } if not a.mujoco_only else {}
         for s in (scenarios if not a.mujoco_only else []):
             down = jobs[(s.stem, "down")].result()
-            six = jobs[(s.stem, "six")].result()
             results[s.stem] = {
                 "label": labels[s.stem]["label"],
                 "down": summary_of(down),
-                "six": summary_of(six),
+                "six": ({"verdict": "not_run"} if a.down_only
+                        else summary_of(jobs[(s.stem, "six")].result())),
             }
             print(f"{s.stem}: {results[s.stem]['down'].get('verdict')} / "
                   f"{results[s.stem]['six'].get('verdict')}", file=sys.stderr)

@@ -295,10 +295,18 @@ pub struct ClosingParams {
     pub reseat_by_motor: bool,
     /// The reseat moves on only a joint 1 whose phalanx 1 touched the object earlier in the
     /// closing and is off it now (a phalanx lifted off by joint 2's squeeze), not one whose
-    /// phalanx 1 never reached the object (its finger stopped on phalanx 2). Off by default (a
-    /// prototype). Left out of the serialised parameters when off.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    /// phalanx 1 never reached the object (its finger stopped on phalanx 2): driven on under
+    /// its lock, such a joint crushes the object through phalanx 2 (docs/studies/
+    /// 2026-12-05-three-disagreements.md). On by default since the five runs of
+    /// docs/studies/2026-12-05-reseat-only-lifted.md. Left out of the serialised parameters
+    /// when on.
+    #[serde(skip_serializing_if = "is_true")]
     pub reseat_only_lifted: bool,
+}
+
+/// `serde`'s test for a field left out at its default of `true`.
+fn is_true(b: &bool) -> bool {
+    *b
 }
 
 impl Default for ClosingParams {
@@ -311,7 +319,7 @@ impl Default for ClosingParams {
             refine_contacts: false,
             reseat: true,
             reseat_by_motor: false,
-            reseat_only_lifted: false,
+            reseat_only_lifted: true,
         }
     }
 }
@@ -1007,7 +1015,7 @@ mod tests {
         p.closing.refine_contacts = true;
         p.closing.reseat = false;
         p.closing.reseat_by_motor = true;
-        p.closing.reseat_only_lifted = true;
+        p.closing.reseat_only_lifted = false;
         p.closing.approach = Approach::Timed;
         p.hold.closing_decides = true;
         p.early.rest_margin = 0.75;
@@ -1036,7 +1044,7 @@ mod tests {
             finger_density_kg_m3: 1000.0, contact_stiffness_hz: 10000.0, \
             hand_joints: Multibody, hold_solver_iterations: 8, open_margin_deg: 20.0, \
             refine_contacts: false, reseat: true, reseat_by_motor: false, \
-            reseat_only_lifted: false, \
+            reseat_only_lifted: true, \
             override_angles: None, \
             override_index: None, max_checked: 8, max_penetration_mm: 2.0, \
             max_closing_shift_mm: 5.0, min_on_plan_fraction: 0.5, closing_decides: false, \
@@ -1057,7 +1065,7 @@ mod tests {
             finger_density_kg_m3: 1000.0, contact_stiffness_hz: 10000.0, \
             hand_joints: Impulse, hold_solver_iterations: 8, open_margin_deg: 20.0, \
             refine_contacts: true, reseat: false, reseat_by_motor: true, \
-            reseat_only_lifted: true, \
+            reseat_only_lifted: false, \
             override_angles: Some([[90.0, 80.5], \
             [45.0, 30.0]]), override_index: Some(7), max_checked: 4, \
             max_penetration_mm: 2.0, max_closing_shift_mm: 5.0, min_on_plan_fraction: 0.5, \
@@ -1111,7 +1119,7 @@ mod tests {
                 r#""balanced_squeeze":false},"#,
                 r#""closing":{"close_duration_s":0.5,"close_until_stalled":true,"#,
                 r#""open_margin_deg":20.0,"approach":"timed","refine_contacts":true,"#,
-                r#""reseat_by_motor":true,"reseat_only_lifted":true},"#,
+                r#""reseat_by_motor":true,"reseat_only_lifted":false},"#,
                 r#""hold":{"duration_s":2.0,"hold_translation_mm":5.0,"hold_rotation_deg":5.0,"#,
                 r#""max_penetration_mm":2.0,"max_closing_shift_mm":5.0,"#,
                 r#""min_on_plan_fraction":0.5,"#,
