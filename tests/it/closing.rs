@@ -516,3 +516,30 @@ fn real_object_run(name: &str) -> serde_json::Value {
     crate::assert_success(&out);
     serde_json::from_slice(&out.stdout).unwrap()
 }
+
+#[test]
+fn the_reseat_leaves_a_finger_that_stopped_on_phalanx_2() {
+    // The palm 40 mm off the D40: the outer fingers reach the cylinder with phalanx 2 only
+    // (their phalanx 1 never touches it). Reseating every joint 1 whose phalanx 1 is off the
+    // object (`reseat_only_lifted = false`, the reseat before 2026-12-05) drives theirs on under
+    // the lock, through phalanx 2, to the squeeze target, 3° past the plan; the default leaves
+    // them where phalanx 2 stopped them, more than half a degree short of it.
+    let joint1_errors = |only_lifted: bool| -> Vec<(bool, f64)> {
+        let mut params = SimParams::default();
+        params.closing.reseat_only_lifted = only_lifted;
+        let c = d40_backed_off(40.0, &params).closing;
+        c.fingers
+            .iter()
+            .map(|f| (f.first_contact_s[0].is_none(), f.error_deg[0]))
+            .collect()
+    };
+    assert!(SimParams::default().closing.reseat_only_lifted);
+    let every = joint1_errors(false);
+    let lifted = joint1_errors(true);
+    let outer = [0, 2];
+    for i in outer {
+        assert!(every[i].0 && lifted[i].0, "{every:?} {lifted:?}");
+        assert!((every[i].1 - 3.0).abs() < 0.01, "{every:?}");
+        assert!(lifted[i].1 < 2.5, "{lifted:?}");
+    }
+}
