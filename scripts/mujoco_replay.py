@@ -182,11 +182,6 @@ def replay(scene_dir, directions=None, trace=False):
                 out[k] = out[k] or other == phalanx1[k]
         return out
 
-    motor_range = [m.actuator_forcerange[2 * k].copy() for k in range(n)]
-    # `reseat_by_motor`: the reseat drives a joint 1 with its motor's torque (the actuator's own
-    # forcerange), and the lock holds it where it stops (as grasp-sim's).
-    motor_cap = bool(proto.get("reseat_by_motor", False))
-    driving = [False] * n
     # `reseat_only_lifted`: only a joint 1 whose phalanx 1 touched the object earlier in the
     # closing moves on (as grasp-sim's).
     only_lifted = bool(proto.get("reseat_only_lifted", False))
@@ -231,15 +226,7 @@ def replay(scene_dir, directions=None, trace=False):
                     if not t1 and lifted and reseat_at[k] < target[2 * k]:
                         reseat_at[k] = min(reseat_at[k] + reseat_step, target[2 * k])
                         d.ctrl[2 * k] = reseat_at[k]
-                        if motor_cap:
-                            m.actuator_forcerange[2 * k] = motor_range[k]
-                            driving[k] = True
                         moving = True
-                    elif motor_cap and driving[k]:
-                        driving[k] = False
-                        reseat_at[k] = float(d.qpos[joint1_qpos[k]])
-                        d.ctrl[2 * k] = reseat_at[k]
-                        m.actuator_forcerange[2 * k] = [-lock, lock]
             if ramp is not None and ramp < ramp_steps:
                 ramp += 1
                 s = ramp / ramp_steps

@@ -488,7 +488,6 @@ fn protocol(input: &ExportInput, keys: &Keyframes) -> serde_json::Value {
         "max_penetration_mm": sim.hold.max_penetration_mm,
         "approach": sim.closing.approach,
         "reseat": sim.closing.reseat,
-        "reseat_by_motor": sim.closing.reseat_by_motor,
         "reseat_only_lifted": sim.closing.reseat_only_lifted,
         "ramp_s": crate::sim::RAMP_S,
         "reseat_rad_s": crate::sim::RESEAT_RAD_S,

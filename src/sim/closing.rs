@@ -265,9 +265,6 @@ fn reseat(scene: &mut Scene, case: &Case, run: &mut Phases, max_steps: usize) {
         .map(|f| f.joint1.angle(&scene.world).unwrap_or(f.joint1_target))
         .collect();
     let mut quiet_steps = 0;
-    let motor_cap = case.params.closing.reseat_by_motor;
-    let torques = super::scene::finger_torque_limits(case.hand, case.params);
-    let mut driving = vec![false; scene.fingers.len()];
     for _ in 0..max_steps {
         let now = touching(scene);
         let mut moving = false;
@@ -281,20 +278,9 @@ fn reseat(scene: &mut Scene, case: &Case, run: &mut Phases, max_steps: usize) {
                 || run.first_contact.fingers[i][0].is_some();
             if !t[0] && lifted && *a < f.joint1_target {
                 *a = (*a + step_rad).min(f.joint1_target);
-                let cap = if motor_cap {
-                    Some(torques[i] as f32)
-                } else {
-                    lock
-                };
-                f.joint1.set_motor(&mut scene.world, *a, (k * 10.0, d), cap);
-                driving[i] = true;
-                moving = true;
-            } else if motor_cap && driving[i] {
-                driving[i] = false;
-                let here = f.joint1.angle(&scene.world).unwrap_or(*a);
-                *a = here;
                 f.joint1
-                    .set_motor(&mut scene.world, here, (k * 10.0, d), lock);
+                    .set_motor(&mut scene.world, *a, (k * 10.0, d), lock);
+                moving = true;
             }
         }
         scene.world.step();

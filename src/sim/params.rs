@@ -287,12 +287,6 @@ pub struct ClosingParams {
     /// serialised parameters when off.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub reseat: bool,
-    /// The reseat moves joint 1 on with the finger's motor torque (its `torque_limit_nm`, as
-    /// balanced) instead of its lock's `joint1_lock_torque_nm`, and the lock holds it where it
-    /// stops: a TorqueSwitch's worm drive holds with its torque but only the motor drives it.
-    /// Off by default (a prototype). Left out of the serialised parameters when off.
-    #[serde(skip_serializing_if = "std::ops::Not::not")]
-    pub reseat_by_motor: bool,
     /// The reseat moves on only a joint 1 whose phalanx 1 touched the object earlier in the
     /// closing and is off it now (a phalanx lifted off by joint 2's squeeze), not one whose
     /// phalanx 1 never reached the object (its finger stopped on phalanx 2): driven on under
@@ -318,7 +312,6 @@ impl Default for ClosingParams {
             approach: Approach::Together,
             refine_contacts: false,
             reseat: true,
-            reseat_by_motor: false,
             reseat_only_lifted: true,
         }
     }
@@ -547,7 +540,6 @@ sim_table! {
     open_margin_deg: f64 => closing,
     refine_contacts: bool => closing,
     reseat: bool => closing,
-    reseat_by_motor: bool => closing,
     reseat_only_lifted: bool => closing,
     override_angles: Option<Vec<[f64; 2]>> => input,
     override_index: Option<usize> => input,
@@ -1014,7 +1006,6 @@ mod tests {
         p.fingers.balanced_squeeze = false;
         p.closing.refine_contacts = true;
         p.closing.reseat = false;
-        p.closing.reseat_by_motor = true;
         p.closing.reseat_only_lifted = false;
         p.closing.approach = Approach::Timed;
         p.hold.closing_decides = true;
@@ -1043,7 +1034,7 @@ mod tests {
             motor_stiffness_nm_per_rad: 20.0, motor_damping_nms_per_rad: 0.2, \
             finger_density_kg_m3: 1000.0, contact_stiffness_hz: 10000.0, \
             hand_joints: Multibody, hold_solver_iterations: 8, open_margin_deg: 20.0, \
-            refine_contacts: false, reseat: true, reseat_by_motor: false, \
+            refine_contacts: false, reseat: true, \
             reseat_only_lifted: true, \
             override_angles: None, \
             override_index: None, max_checked: 8, max_penetration_mm: 2.0, \
@@ -1064,7 +1055,7 @@ mod tests {
             motor_stiffness_nm_per_rad: 20.0, motor_damping_nms_per_rad: 0.2, \
             finger_density_kg_m3: 1000.0, contact_stiffness_hz: 10000.0, \
             hand_joints: Impulse, hold_solver_iterations: 8, open_margin_deg: 20.0, \
-            refine_contacts: true, reseat: false, reseat_by_motor: true, \
+            refine_contacts: true, reseat: false, \
             reseat_only_lifted: false, \
             override_angles: Some([[90.0, 80.5], \
             [45.0, 30.0]]), override_index: Some(7), max_checked: 4, \
@@ -1119,7 +1110,7 @@ mod tests {
                 r#""balanced_squeeze":false},"#,
                 r#""closing":{"close_duration_s":0.5,"close_until_stalled":true,"#,
                 r#""open_margin_deg":20.0,"approach":"timed","refine_contacts":true,"#,
-                r#""reseat_by_motor":true,"reseat_only_lifted":false},"#,
+                r#""reseat_only_lifted":false},"#,
                 r#""hold":{"duration_s":2.0,"hold_translation_mm":5.0,"hold_rotation_deg":5.0,"#,
                 r#""max_penetration_mm":2.0,"max_closing_shift_mm":5.0,"#,
                 r#""min_on_plan_fraction":0.5,"#,
@@ -1177,7 +1168,7 @@ mod tests {
                 `stabilization_iterations`, `motor_stiffness_nm_per_rad`, \
                 `motor_damping_nms_per_rad`, `finger_density_kg_m3`, `contact_stiffness_hz`, \
                 `hand_joints`, `hold_solver_iterations`, `open_margin_deg`, \
-                `refine_contacts`, `reseat`, `reseat_by_motor`, `reseat_only_lifted`, \
+                `refine_contacts`, `reseat`, `reseat_only_lifted`, \
                 `override_angles`, \
                 `override_index`, \
                 `max_checked`, `max_penetration_mm`, `max_closing_shift_mm`, \
