@@ -183,7 +183,8 @@ def replay(scene_dir, directions=None, trace=False):
         return out
 
     # `reseat_only_lifted`: only a joint 1 whose phalanx 1 touched the object earlier in the
-    # closing moves on (as grasp-sim's).
+    # closing moves on (as grasp-sim's). Every export writes it; a protocol.json without it was
+    # written before the key existed, when every joint 1 was reseated.
     only_lifted = bool(proto.get("reseat_only_lifted", False))
     p1_touched = [False] * n
 
