@@ -140,7 +140,35 @@ def agreement_summary(rows):
         hist = {k: on_plan.count(k) for k in sorted(set(on_plan))}
         words.append("|phalanges on plan difference| " +
                      ", ".join(f"{k}: {v}" for k, v in hist.items()))
-    return "; ".join(words)
+    words.append(disagreements(rows))
+    return "; ".join(w for w in words if w)
+
+
+def disagreements(rows):
+    """What the verdicts' disagreements follow from: a closing that left the plan in one engine
+    or both (a different grasp in each engine), or, with both closings as planned, gravity's
+    motion alone (then the two translations, to tell a disagreement by a hair across the hold
+    threshold from one by centimetres)."""
+    off = {"MuJoCo": 0, "rapier": 0, "both": 0}
+    gravity = []
+    for r in rows:
+        if r["agree"]:
+            continue
+        ra, ma = r["rapier_as_planned"], r["mujoco_as_planned"]
+        if ra and ma:
+            t = r.get("translation_mm")
+            gravity.append(f"{t[0]:.1f}/{t[1]:.1f}" if t else "?")
+        else:
+            off["both" if not ra and not ma else "MuJoCo" if ra else "rapier"] += 1
+    n = sum(off.values()) + len(gravity)
+    if n == 0:
+        return ""
+    text = (f"of the {n} verdict disagreements, {off['MuJoCo']} follow a closing off plan in "
+            f"MuJoCo alone, {off['rapier']} in rapier alone, {off['both']} in both, and "
+            f"{len(gravity)} with both closings as planned")
+    if gravity:
+        text += f" (translation rapier/MuJoCo [mm]: {', '.join(gravity)})"
+    return text
 
 
 def folder_name(name):
@@ -180,6 +208,7 @@ def labels(path, scenes, jsonl):
                "rapier_as_planned": r["fidelity"]["as_planned"],
                "mujoco_as_planned": m["fidelity"]["as_planned"],
                "hold_probability": r["hold_probability"],
+               "translation_mm": (r["translation_mm"], m["translation_mm"]),
                "shift": (r["fidelity"]["shift_mm"], m["fidelity"]["shift_mm"]),
                "on_plan": (r["fidelity"]["phalanges_on_plan"], m["fidelity"]["phalanges_on_plan"])}
         row["agree"] = row["rapier"] == row["mujoco"]
