@@ -25,7 +25,7 @@ per-sample agreement, and over all grasps the mean absolute difference of each, 
 per-sample outcomes, and how often one says >= 0.9 while the other says < 0.5. `--jsonl F`
 writes one line per grasp with both engines' per-sample verdicts.
 
-    python3 scripts/compare_engines.py --labels LABELS.jsonl SCENES_DIR [--jsonl F]
+    python3 scripts/compare_engines.py --labels LABELS.jsonl SCENES_DIR [--jsonl F] [--libccd]
 
 Issue 57: the agreement over a labelled dataset. `grasp-sim label ... --out LABELS.jsonl
 --export-mjcf SCENES_DIR --mujoco-fraction F` writes the scene of a deterministic fraction of
@@ -33,7 +33,9 @@ its grasps into SCENES_DIR/<object>/<grasp_index>/; this replays each (in the re
 directions) and prints how often MuJoCo's verdict and as_planned agree with the nominal check
 `label` recorded, per object and over the dataset, and both engines' rates: rapier's perturbed
 checks a second over the labelled grasps (from the lines' wall times) and MuJoCo's replays a
-second.
+second. `--libccd`: MuJoCo with its libccd collision instead of its native one (see
+scripts/mujoco_replay.py); the rows of two runs, one with it, show which verdicts MuJoCo
+itself cannot decide.
 """
 import json
 import math
@@ -181,7 +183,7 @@ def folder_name(name):
     return b.decode("utf-8", "ignore")
 
 
-def labels(path, scenes, jsonl):
+def labels(path, scenes, jsonl, libccd=False):
     """`--labels`: MuJoCo's replay of the exported grasps of a label file against its records."""
     records = {}
     for line in pathlib.Path(path).read_text().splitlines():
@@ -199,7 +201,7 @@ def labels(path, scenes, jsonl):
             continue
         idx = r["grasp_index"]
         directions = [x["gravity"] for x in r["directions"]] if len(r["directions"]) > 1 else None
-        m = mujoco_replay.replay(d, directions)
+        m = mujoco_replay.replay(d, directions, libccd=libccd)
         mujoco_ms += m["wall_ms"]
         rapier[0] += r["label"]["wall_ms"]
         rapier[1] += r["samples"] + 1
@@ -250,10 +252,12 @@ def main(argv):
             j = args.index("--jsonl")
             jsonl = args[j + 1]
             del args[j:j + 2]
+        libccd = "--libccd" in args
+        args = [a for a in args if a != "--libccd"]
         if len(args) != 2:
             print(__doc__, file=sys.stderr)
             return 2
-        return labels(args[0], args[1], jsonl)
+        return labels(args[0], args[1], jsonl, libccd)
     if len(argv) < 4:
         print(__doc__, file=sys.stderr)
         return 2

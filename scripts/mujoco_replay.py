@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Replay a grasp exported by `grasp-sim --export-mjcf DIR` in MuJoCo, with grasp-sim's protocol.
 
-    python3 scripts/mujoco_replay.py [--six] [--trace] DIR/<scenario> [DIR/<scenario> ...]
+    python3 scripts/mujoco_replay.py [--six] [--trace] [--libccd] DIR/<scenario> [DIR/<scenario> ...]
 
 Prints one JSON object per scene: the verdict (hold / slip / drop: what gravity did, by the same
 hold thresholds as grasp-sim's rapier check), the object's translation and rotation relative to
@@ -23,6 +23,9 @@ each body first touches the object; every 10 ms the object's shift from its star
 the palm, each joint's bend minus its plan and the bodies touching the object; at the end of
 each phase, every contact with the object (point in the palm frame [mm], normal, normal and
 tangential force, depth). The result is the same with or without it.
+`--libccd`: MuJoCo's older convex collision (libccd) instead of its native one, a change to
+the collision algorithm alone: the verdicts it changes are those MuJoCo itself cannot decide
+(docs/studies/2026-12-05-engine-chaos.md).
 Needs `pip install mujoco`.
 """
 import json
@@ -92,16 +95,18 @@ def trace_line(m, d, stamp, p0, palm, obj, planned, n, contacts=False):
         print(line, file=sys.stderr)
 
 
-def replay(scene_dir, directions=None, trace=False):
+def replay(scene_dir, directions=None, trace=False, libccd=False):
     """The replay of one exported scene. `directions`: None, the scene's gravity (the check as
     it has always been replayed); or a list of unit vectors (aligned object frame, as `[sim]
     gravity = "six"` gives them, e.g. `SIX`): the closing runs once and each direction holds
     from a copy of the closed state, as grasp-sim's `fast` protocol does; the result then has
     `directions` (one verdict each) and the worst verdict. `trace`: the closing on stderr
-    (`--trace`)."""
+    (`--trace`). `libccd`: MuJoCo's libccd collision instead of its native one (`--libccd`)."""
     scene_dir = pathlib.Path(scene_dir)
     proto = json.loads((scene_dir / "protocol.json").read_text())
     m = mujoco.MjModel.from_xml_path(str(scene_dir / "scene.xml"))
+    if libccd:
+        m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_NATIVECCD
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, m.key("open").id)
     n = len(proto["fingers"])
@@ -428,8 +433,9 @@ def main(argv):
         return 2
     six = "--six" in argv
     trace = "--trace" in argv
-    for scene_dir in [a for a in argv[1:] if a not in ("--six", "--trace")]:
-        print(json.dumps(replay(scene_dir, SIX if six else None, trace)))
+    libccd = "--libccd" in argv
+    for scene_dir in [a for a in argv[1:] if a not in ("--six", "--trace", "--libccd")]:
+        print(json.dumps(replay(scene_dir, SIX if six else None, trace, libccd)))
     return 0
 
 
