@@ -156,7 +156,7 @@ def disagreements(rows):
     for r in rows:
         if r["agree"]:
             continue
-        ra, ma = r["rapier_as_planned"], r["mujoco_as_planned"]
+        ra, ma = r.get("rapier_as_planned"), r.get("mujoco_as_planned")
         if ra and ma:
             t = r.get("translation_mm")
             gravity.append(f"{t[0]:.1f}/{t[1]:.1f}" if t else "?")
@@ -165,9 +165,9 @@ def disagreements(rows):
     n = sum(off.values()) + len(gravity)
     if n == 0:
         return ""
-    text = (f"of the {n} verdict disagreements, {off['MuJoCo']} follow a closing off plan in "
-            f"MuJoCo alone, {off['rapier']} in rapier alone, {off['both']} in both, and "
-            f"{len(gravity)} with both closings as planned")
+    text = (f"verdict disagreements {n}: after a closing off plan in MuJoCo alone "
+            f"{off['MuJoCo']}, in rapier alone {off['rapier']}, in both {off['both']}; with both "
+            f"closings as planned {len(gravity)}")
     if gravity:
         text += f" (translation rapier/MuJoCo [mm]: {', '.join(gravity)})"
     return text
@@ -325,6 +325,9 @@ def main(argv):
         fr, fm = sim.get("fidelity") or {}, m["fidelity"]
         agree_ap = fr.get("as_planned") == fm["as_planned"]
         rows.append({"agree": agree, "agree_ap": agree_ap,
+                     "rapier_as_planned": fr.get("as_planned"),
+                     "mujoco_as_planned": fm["as_planned"],
+                     "translation_mm": (sim["translation_mm"], m["translation_mm"]),
                      "shift": (fr.get("shift_mm"), fm["shift_mm"]),
                      "on_plan": (fr.get("phalanges_on_plan"), fm["phalanges_on_plan"])})
         # Wall times of the same check, in the same run: rapier's whole check (closing and every
