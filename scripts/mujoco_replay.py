@@ -106,6 +106,8 @@ def replay(scene_dir, directions=None, trace=False, libccd=False):
     proto = json.loads((scene_dir / "protocol.json").read_text())
     m = mujoco.MjModel.from_xml_path(str(scene_dir / "scene.xml"))
     if libccd:
+        if not hasattr(mujoco.mjtDisableBit, "mjDSBL_NATIVECCD"):
+            sys.exit(f"--libccd: MuJoCo {mujoco.__version__} has no native collision to turn off")
         m.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_NATIVECCD
     d = mujoco.MjData(m)
     mujoco.mj_resetDataKeyframe(m, d, m.key("open").id)
