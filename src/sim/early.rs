@@ -26,10 +26,6 @@ pub struct EarlyDecision {
     /// A rest decision keeps the object within this fraction of the hold thresholds, motion to
     /// come included: an object near a threshold runs to the end of the hold.
     pub margin: f64,
-    /// Decide only when the numbers reported are within `report_mm`, `report_deg` and
-    /// `report_fraction` of the full protocol's (`[sim] rest_report`); otherwise as soon as the
-    /// verdict can no longer change.
-    pub report: bool,
 }
 
 impl EarlyDecision {
@@ -42,7 +38,6 @@ impl EarlyDecision {
             report_deg: 0.5,
             report_fraction: 0.1,
             margin: params.early.rest_margin,
-            report: params.early.rest_report,
         }
     }
 }
@@ -132,8 +127,8 @@ impl EarlyDecision {
     /// The rest rules (docs/SIM.md, "Deciding early"): what the motion of the last `window_s`
     /// of `samples` (the poses relative to the palm so far, one every `frame.sample_dt`), its
     /// mean drift and its spread at `safety` times their size continued for `remaining_s`,
-    /// decides now, provided (with `report`) it keeps the numbers reported now within what they
-    /// may differ from the full protocol's:
+    /// decides now, provided it keeps the numbers reported now within what they may differ from
+    /// the full protocol's:
     /// - `Hold` when the object stays within `margin` of the hold thresholds;
     /// - `Slip` when it cannot come back within `1 / margin` of a threshold (the distance to the
     ///   pose after closing moves by no more than the object does, and so does the judged
@@ -151,7 +146,7 @@ impl EarlyDecision {
         params: &SimParams,
     ) -> Option<Verdict> {
         let s = self.settling(samples, frame, remaining_s)?;
-        if self.report && !self.reportable(&s) {
+        if !self.reportable(&s) {
             return None;
         }
         if s.now_mm + s.more_mm <= self.margin * params.hold.hold_translation_mm

@@ -381,15 +381,6 @@ pub struct EarlyParams {
     /// fraction of `hold_translation_mm` and `hold_rotation_deg`, the projected motion included;
     /// a `slip` only if it stays beyond one of them divided by this.
     pub rest_margin: f64,
-    /// `fast` protocol: a direction is decided at rest only when the numbers it reports
-    /// (translation, rotation) are within the rule's tolerance of the full protocol's (true,
-    /// the default); false: as soon as its verdict can no longer change by the rule's
-    /// projection, the numbers reported being those at the decision.
-    pub rest_report: bool,
-    /// `rest_report` for the perturbed samples of the hold probability (and the check that
-    /// `replay_sample` replays): false by default, since a sample reports its verdict and
-    /// fidelity, not its numbers. A sample then costs about what the nominal check does.
-    pub samples_rest_report: bool,
 }
 
 impl Default for EarlyParams {
@@ -398,8 +389,6 @@ impl Default for EarlyParams {
             rest_window_s: 0.05,
             rest_safety: 2.0,
             rest_margin: 0.8,
-            rest_report: true,
-            samples_rest_report: false,
         }
     }
 }
@@ -571,8 +560,6 @@ sim_table! {
     replay_sample: Option<usize> => robust,
     choose: Choose => robust,
     choose_min_lower_bound: f64 => robust,
-    rest_report: bool => early,
-    samples_rest_report: bool => early,
 }
 
 /// `[("sim.<field>", s.<group>.<field>), ...]`: each grouped value with its `[sim]` key.

@@ -114,8 +114,6 @@ impl Perturbed {
         params.fingers.torque_limit_nm *= p.torque_scale;
         // A sample is checked in full: its verdict is reported (`verdicts`, `first_failure`).
         params.hold.closing_decides = false;
-        // It reports its verdict and fidelity, not its numbers (`[sim] samples_rest_report`).
-        params.early.rest_report = params.early.samples_rest_report;
         Perturbed {
             pose: SimHand {
                 origin_mm: moved.into(),
