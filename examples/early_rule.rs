@@ -59,6 +59,9 @@ fn decide(
         if remaining <= 1e-9 {
             return None;
         }
+        if !rule.joints_settled(&t.joints[..=i], t.frame.sample_dt, remaining) {
+            continue;
+        }
         let Some(verdict) = rule.decide(&t.samples[..=i], &t.frame, remaining, params) else {
             continue;
         };

@@ -627,7 +627,7 @@ fn penetration_mm(scene: &Scene) -> f64 {
 }
 
 /// Per finger, each joint's bend minus its planned bend `[deg]`.
-fn joint_errors(scene: &Scene) -> Vec<[f64; 2]> {
+pub(super) fn joint_errors(scene: &Scene) -> Vec<[f64; 2]> {
     let bodies = &scene.world.bodies;
     let rp = *bodies[scene.palm].rotation();
     scene

@@ -26,6 +26,9 @@ pub struct EarlyDecision {
     /// A rest decision keeps the object within this fraction of the hold thresholds, motion to
     /// come included: an object near a threshold runs to the end of the hold.
     pub margin: f64,
+    /// Every finger joint's further motion, bounded as the object's, must stay within this
+    /// `[deg]` (`[sim] rest_joint_deg`).
+    pub joint_deg: f64,
 }
 
 impl EarlyDecision {
@@ -38,6 +41,7 @@ impl EarlyDecision {
             report_deg: 0.5,
             report_fraction: 0.1,
             margin: params.early.rest_margin,
+            joint_deg: params.early.rest_joint_deg,
         }
     }
 }
@@ -84,6 +88,31 @@ struct Settling {
 }
 
 impl EarlyDecision {
+    /// True when the hand's joints have settled: over the last window of `joints` (each
+    /// sample's joint angles `[deg]`, one every `sample_dt`), every joint's drift continued
+    /// for `remaining_s` plus its spread, at `safety` times their size, stays within
+    /// `joint_deg`. A finger whose motor has reached its torque limit creeps while the object
+    /// it presses still looks at rest, and the object then slips (stick-slip): the object's
+    /// rest alone does not show it.
+    pub fn joints_settled(&self, joints: &[Vec<f64>], sample_dt: f64, remaining_s: f64) -> bool {
+        let window = ((self.window_s / sample_dt).round() as usize).max(1);
+        if joints.len() <= window {
+            return false;
+        }
+        let recent = &joints[joints.len() - window - 1..];
+        let window_s = window as f64 * sample_dt;
+        let (first, last) = (&recent[0], &recent[window]);
+        (0..last.len()).all(|k| {
+            let (lo, hi) = recent
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), j| {
+                    (lo.min(j[k]), hi.max(j[k]))
+                });
+            let drift = (last[k] - first[k]).abs() / window_s;
+            self.safety * (drift * remaining_s + (hi - lo)) <= self.joint_deg
+        })
+    }
+
     /// The last `window_s` of `samples` measured: `None` while the hold is shorter than the
     /// window.
     fn settling(
@@ -249,6 +278,29 @@ mod tests {
         // left, the spread alone, 2 × 0.2083 = 0.417 mm, is within it.
         assert!(!r.reportable(&r.settling(&samples, &f, 0.05).unwrap()));
         assert!(r.reportable(&r.settling(&samples, &f, 0.0).unwrap()));
+    }
+
+    #[test]
+    fn a_creeping_finger_joint_keeps_the_direction_open() {
+        let (r, _) = rule();
+        // Six joints still; then joint 4 creeping at 1°/s, as a motor that gave way does
+        // while the object it presses has not yet moved.
+        let still: Vec<Vec<f64>> = vec![vec![1.0, -2.0, 0.5, 3.0, 1.4, 2.6]; 20];
+        assert!(r.joints_settled(&still, SAMPLE_S, 1.5));
+        let creep: Vec<Vec<f64>> = (0..20)
+            .map(|i| vec![1.0, -2.0, 0.5, 3.0 + i as f64 * SAMPLE_S, 1.4, 2.6])
+            .collect();
+        // Over the 10-sample window (0.2083 s) it moves 0.2083°: with 1.5 s left the bound is
+        // 2 × (1°/s × 1.5 s + 0.2083°) = 3.42°, beyond 1°; with none left, 0.417°, within.
+        assert!(!r.joints_settled(&creep, SAMPLE_S, 1.5));
+        assert!(r.joints_settled(&creep, SAMPLE_S, 0.0));
+        let wide = EarlyDecision {
+            joint_deg: 3.5,
+            ..r
+        };
+        assert!(wide.joints_settled(&creep, SAMPLE_S, 1.5));
+        // Fewer samples than a window: not settled.
+        assert!(!r.joints_settled(&still[..10], SAMPLE_S, 1.5));
     }
 
     #[test]

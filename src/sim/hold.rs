@@ -24,6 +24,8 @@ pub struct HoldTrace {
     pub frame: RestFrame,
     /// The object's pose relative to the palm, one per sample.
     pub samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)>,
+    /// The finger joints' angles `[deg]`, one list per sample.
+    pub joints: Vec<Vec<f64>>,
     /// Four times finer ([`HoldTrace::fine_dt`]): the pose relative to the palm and how near
     /// the hand's contacts were to sliding, for the study of other rules.
     pub fine: Vec<(
@@ -79,6 +81,8 @@ pub(super) fn hold(
     };
     // Samples of the object's pose relative to the palm, for the rest rule.
     let mut samples: Vec<(Vector3<f64>, UnitQuaternion<f64>)> = Vec::new();
+    // The finger joints' angles at the same samples `[deg]`, for the rest rule's joint test.
+    let mut joints: Vec<Vec<f64>> = Vec::new();
     let mut fine = Vec::new();
     let fine_every = (sample_every / 4).max(1);
     let mut decided: Option<Decision> = None;
@@ -107,8 +111,9 @@ pub(super) fn hold(
             continue;
         }
         samples.push(relative(scene));
+        joints.push(joint_angles_deg(scene));
         let Some(w) = watch.as_mut() else { continue };
-        decided = w.decide(scene, params, closing, &samples, steps);
+        decided = w.decide(scene, params, closing, &samples, &joints, steps);
         if decided.is_some() {
             break;
         }
@@ -120,6 +125,7 @@ pub(super) fn hold(
                 v.push(HoldTrace {
                     frame,
                     samples,
+                    joints,
                     fine,
                     fine_dt: fine_every as f64 * dt,
                     duration_s: hold_steps as f64 * dt,
@@ -157,6 +163,7 @@ impl EarlyWatch<'_> {
         params: &SimParams,
         closing: &Closing,
         samples: &[(Vector3<f64>, UnitQuaternion<f64>)],
+        joints: &[Vec<f64>],
         steps: usize,
     ) -> Option<Decision> {
         let (rule, g, hold_steps) = (self.rule, self.g, self.hold_steps);
@@ -178,6 +185,9 @@ impl EarlyWatch<'_> {
         }
         self.hand_was_still = hand_still;
         let remaining_s = (hold_steps - steps) as f64 * params.solver.timestep_s;
+        if !rule.joints_settled(joints, self.frame.sample_dt, remaining_s) {
+            return None;
+        }
         match rule.decide(samples, &self.frame, remaining_s, params) {
             Some(Verdict::Hold) => {}
             Some(_) if touches_hand(scene) => {}
@@ -340,4 +350,10 @@ fn hand_holds_itself(scene: &Scene, params: &SimParams) -> bool {
         params.fingers.torque_limit_nm >= 4.0 * m2 * G * l2
             && params.fingers.joint1_lock_torque_nm >= 4.0 * (m1 + m2) * G * (l1 + l2)
     })
+}
+
+/// Every finger joint's angle `[deg]`, finger by finger (joint 1, joint 2), as the closing
+/// measures it against the plan: the differences between samples are the joints' motion.
+fn joint_angles_deg(scene: &Scene) -> Vec<f64> {
+    super::closing::joint_errors(scene).concat()
 }

@@ -381,6 +381,11 @@ pub struct EarlyParams {
     /// fraction of `hold_translation_mm` and `hold_rotation_deg`, the projected motion included;
     /// a `slip` only if it stays beyond one of them divided by this.
     pub rest_margin: f64,
+    /// `fast` protocol: a direction is decided at rest only when every finger joint has
+    /// settled too: its drift over the window continued to the end of the hold plus its
+    /// spread, at `rest_safety` times their size, within this `[deg]`. A finger whose motor
+    /// gives way creeps while the object it presses still looks at rest, before a slip.
+    pub rest_joint_deg: f64,
 }
 
 impl Default for EarlyParams {
@@ -389,6 +394,7 @@ impl Default for EarlyParams {
             rest_window_s: 0.05,
             rest_safety: 2.0,
             rest_margin: 0.8,
+            rest_joint_deg: 1.0,
         }
     }
 }
@@ -560,6 +566,7 @@ sim_table! {
     replay_sample: Option<usize> => robust,
     choose: Choose => robust,
     choose_min_lower_bound: f64 => robust,
+    rest_joint_deg: f64 => early,
 }
 
 /// `[("sim.<field>", s.<group>.<field>), ...]`: each grouped value with its `[sim]` key.
@@ -613,7 +620,7 @@ impl SimParams {
     /// (0: the value must be positive) or inclusive where zero means "none".
     fn validate_positive(&self) -> Result<(), Invalid> {
         let s = self;
-        let ranges: [NumberRange; 16] = [
+        let ranges: [NumberRange; 17] = [
             positive("sim.duration_s", s.hold.duration_s, 3600.0, " s"),
             positive("sim.timestep_s", s.solver.timestep_s, 0.05, " s"),
             positive(
@@ -668,6 +675,7 @@ impl SimParams {
             ),
             positive("sim.open_margin_deg", s.closing.open_margin_deg, 90.0, "°"),
             positive("sim.rest_window_s", s.early.rest_window_s, 10.0, " s"),
+            positive("sim.rest_joint_deg", s.early.rest_joint_deg, 360.0, "°"),
             positive("sim.rest_safety", s.early.rest_safety, 100.0, ""),
             positive("sim.rest_margin", s.early.rest_margin, 1.0, ""),
             positive(
@@ -1042,7 +1050,8 @@ mod tests {
             balanced_squeeze: true, approach: Together, samples: 1, seed: 0, \
             pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
             mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: None, \
-            choose: First, choose_min_lower_bound: 0.8 }"
+            choose: First, choose_min_lower_bound: 0.8, \
+            rest_joint_deg: 1.0 }"
         );
         assert_eq!(
             format!("{:?}", non_default()),
@@ -1063,7 +1072,8 @@ mod tests {
             closing_decides: true, balanced_squeeze: false, approach: Timed, samples: 8, \
             seed: 0, pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
             mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: Some(3), \
-            choose: Robust, choose_min_lower_bound: 0.8 }"
+            choose: Robust, choose_min_lower_bound: 0.8, \
+            rest_joint_deg: 1.0 }"
         );
     }
 
@@ -1090,7 +1100,8 @@ mod tests {
                 r#""max_penetration_mm":2.0,"max_closing_shift_mm":5.0,"#,
                 r#""min_on_plan_fraction":0.5,"#,
                 r#""closing_decides":false},"#,
-                r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.8},"#,
+                r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.8,"#,
+                r#""rest_joint_deg":1.0},"#,
                 r#""selection":{"max_checked":8},"#,
                 r#""input":{"override_angles":null,"override_index":null}}"#,
             )
@@ -1115,7 +1126,8 @@ mod tests {
                 r#""max_penetration_mm":2.0,"max_closing_shift_mm":5.0,"#,
                 r#""min_on_plan_fraction":0.5,"#,
                 r#""closing_decides":true},"#,
-                r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.75},"#,
+                r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.75,"#,
+                r#""rest_joint_deg":1.0},"#,
                 r#""selection":{"max_checked":4},"#,
                 r#""input":{"override_angles":[[90.0,80.5],[45.0,30.0]],"override_index":7},"#,
                 r#""robust":{"samples":8,"seed":0,"pose_offset_mm":2.0,"pose_rotation_deg":3.0,"#,
@@ -1175,7 +1187,7 @@ mod tests {
                 `min_on_plan_fraction`, `closing_decides`, `balanced_squeeze`, `approach`, \
                 `samples`, `seed`, `pose_offset_mm`, `pose_rotation_deg`, \
                 `friction_range_pct`, `mass_range_pct`, `torque_range_pct`, `replay_sample`, \
-                `choose`, `choose_min_lower_bound`\n"
+                `choose`, `choose_min_lower_bound`, `rest_joint_deg`\n"
             ),
             "{err}"
         );
