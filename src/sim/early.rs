@@ -95,13 +95,10 @@ impl EarlyDecision {
     /// it presses still looks at rest, and the object then slips (stick-slip): the object's
     /// rest alone does not show it.
     pub fn joints_settled(&self, joints: &[Vec<f64>], sample_dt: f64, remaining_s: f64) -> bool {
-        let window = ((self.window_s / sample_dt).round() as usize).max(1);
-        if joints.len() <= window {
+        let Some((recent, window_s)) = self.last_window(joints, sample_dt) else {
             return false;
-        }
-        let recent = &joints[joints.len() - window - 1..];
-        let window_s = window as f64 * sample_dt;
-        let (first, last) = (&recent[0], &recent[window]);
+        };
+        let (first, last) = (&recent[0], &recent[recent.len() - 1]);
         (0..last.len()).all(|k| {
             let (lo, hi) = recent
                 .iter()
@@ -113,6 +110,19 @@ impl EarlyDecision {
         })
     }
 
+    /// The samples of the last `window_s` (sampled every `sample_dt`), the one before the window
+    /// included, and the window's length `[s]`; `None` while fewer samples than that were taken.
+    fn last_window<'a, T>(&self, samples: &'a [T], sample_dt: f64) -> Option<(&'a [T], f64)> {
+        let window = ((self.window_s / sample_dt).round() as usize).max(1);
+        if samples.len() <= window {
+            return None;
+        }
+        Some((
+            &samples[samples.len() - window - 1..],
+            window as f64 * sample_dt,
+        ))
+    }
+
     /// The last `window_s` of `samples` measured: `None` while the hold is shorter than the
     /// window.
     fn settling(
@@ -121,13 +131,8 @@ impl EarlyDecision {
         frame: &RestFrame,
         remaining_s: f64,
     ) -> Option<Settling> {
-        let window = ((self.window_s / frame.sample_dt).round() as usize).max(1);
-        if samples.len() <= window {
-            return None;
-        }
-        let recent = &samples[samples.len() - window - 1..];
-        let window_s = window as f64 * frame.sample_dt;
-        let (first, last) = (recent[0], recent[window]);
+        let (recent, window_s) = self.last_window(samples, frame.sample_dt)?;
+        let (first, last) = (recent[0], recent[recent.len() - 1]);
         let mut spread_mm = 0.0f64;
         let mut spread_deg = 0.0f64;
         for (i, a) in recent.iter().enumerate() {

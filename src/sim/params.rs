@@ -1018,6 +1018,7 @@ mod tests {
         p.closing.approach = Approach::Timed;
         p.hold.closing_decides = true;
         p.early.rest_margin = 0.75;
+        p.early.rest_joint_deg = 2.5;
         p.selection.max_checked = 4;
         p.input.override_angles = Some(vec![[90.0, 80.5], [45.0, 30.0]]);
         p.input.override_index = Some(7);
@@ -1073,7 +1074,7 @@ mod tests {
             seed: 0, pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
             mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: Some(3), \
             choose: Robust, choose_min_lower_bound: 0.8, \
-            rest_joint_deg: 1.0 }"
+            rest_joint_deg: 2.5 }"
         );
     }
 
@@ -1127,7 +1128,7 @@ mod tests {
                 r#""min_on_plan_fraction":0.5,"#,
                 r#""closing_decides":true},"#,
                 r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.75,"#,
-                r#""rest_joint_deg":1.0},"#,
+                r#""rest_joint_deg":2.5},"#,
                 r#""selection":{"max_checked":4},"#,
                 r#""input":{"override_angles":[[90.0,80.5],[45.0,30.0]],"override_index":7},"#,
                 r#""robust":{"samples":8,"seed":0,"pose_offset_mm":2.0,"pose_rotation_deg":3.0,"#,
