@@ -111,6 +111,7 @@ fn bench_plan(c: &mut Criterion) {
                         recheck: None,
                         domains: None,
                         frame: grasp_sim::mesh::FrameRule::File,
+                        order_by_closing: None,
                     },
                     &mut t,
                 )

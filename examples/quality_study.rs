@@ -100,6 +100,7 @@ fn plan_one(path: &Path, collect: usize) -> Result<Planned, String> {
             recheck: None,
             domains: None,
             frame: sc.object.frame,
+            order_by_closing: None,
         },
         &mut grasp_sim::report::StageTimings::default(),
     );

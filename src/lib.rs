@@ -33,6 +33,7 @@ pub mod label;
 pub mod mesh;
 mod messages;
 pub mod objects;
+pub mod pick;
 pub mod pipeline;
 pub mod plan;
 pub mod prepared;

@@ -983,6 +983,7 @@ mod tests {
                     recheck: None,
                     domains: None,
                     frame: sc.object.frame,
+                    order_by_closing: None,
                 },
                 &mut crate::report::StageTimings::default(),
             );

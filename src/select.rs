@@ -65,7 +65,23 @@ pub struct Candidate {
     /// Its place in its axis plan's thesis order (0: the thesis's first), whatever order the
     /// `[planner] sf_*` factors searched it in: what `grasp-sim tune --labels` reorders.
     pub thesis_place: usize,
+    /// Under `[sim] order_by_closing`, what its closing did with gravity off, for a candidate
+    /// it closed.
+    pub preclosed: Option<Preclosed>,
 }
+
+/// What a candidate's closing did, gravity off (`[sim] order_by_closing`): the closing's own
+/// fidelity figures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Preclosed {
+    /// The closing kept the plan ([`crate::sim::Fidelity`]'s `as_planned`).
+    pub as_planned: bool,
+    /// How far it pushed the object `[mm]`.
+    pub shift_mm: f64,
+}
+
+/// A closing with gravity off of a grasp about an axis (`[sim] order_by_closing`).
+pub type CloseFn<'a> = &'a (dyn Fn(&AlignedObject, &Grasp) -> Preclosed + Sync);
 
 /// Everything the selection did.
 #[derive(Debug, Clone)]
@@ -149,6 +165,10 @@ pub struct SelectParams<'a> {
     pub domains: Option<&'a DomainCache>,
     /// How the object's own frame is chosen (`[object] frame`).
     pub frame: FrameRule,
+    /// `[sim] order_by_closing` and the closing it runs: with the physics check, that many
+    /// candidates picked for diversity are closed first and checked in the order their closings
+    /// give ([`select`]). `None` or 0: the search order.
+    pub order_by_closing: Option<(usize, CloseFn<'a>)>,
 }
 
 /// Stage-1 domains by (axis, rule set, AngularStep bits, HeightStep bits).
@@ -164,6 +184,13 @@ pub fn select(
     p: &SelectParams,
     timings: &mut StageTimings,
 ) -> Selection {
+    if let (Some(max), Some((n, close))) = (p.max_checked, p.order_by_closing) {
+        if n > 0 {
+            if let Some(sel) = select_by_closing(mesh, props, p, (max, n, close), timings) {
+                return sel;
+            }
+        }
+    }
     let mut sel = Selection {
         axes: Vec::new(),
         candidates: Vec::new(),
@@ -217,6 +244,134 @@ pub fn select(
         recheck_if_closing_decided(&mut sel, i, recheck);
     }
     sel
+}
+
+/// `[sim] order_by_closing = n` (issue 58). The first candidate in search order is closed with
+/// gravity off; if its closing keeps the plan, `None`: the caller searches as without the
+/// setting (the same selection, bit for bit). Otherwise every candidate is planned as `label`
+/// plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), `n` of them are
+/// picked for diversity as `label` picks them (the first always among them) and closed, and
+/// they are checked in the order their closings give (as planned first, then the shift in
+/// whole millimetres, then the search order) until one succeeds or `max` have been checked.
+/// The selection lists the picks in that order, then the other candidates collected
+/// (`collect`) in search order. `None` too when none of them succeeded before the checks ran
+/// out of candidates: the caller then searches as without the setting (the rules beyond the
+/// thesis among it).
+fn select_by_closing(
+    mesh: &Mesh,
+    props: &MassProperties,
+    p: &SelectParams,
+    (max, n, close): (usize, usize, CloseFn<'_>),
+    timings: &mut StageTimings,
+) -> Option<Selection> {
+    let unchecked = |collect: usize| SelectParams {
+        hand: p.hand,
+        planner: p.planner,
+        friction: p.friction,
+        collect,
+        max_checked: None,
+        check: p.check,
+        recheck: None,
+        domains: p.domains,
+        frame: p.frame,
+        order_by_closing: None,
+    };
+    let first = {
+        let mut t = StageTimings::default();
+        let sel = select(mesh, props, &unchecked(1), &mut t);
+        let c = sel.candidates.first()?;
+        close(&sel.axes[c.axis_plan].aligned, &c.grasp)
+    };
+    if first.as_planned {
+        return None;
+    }
+    let mut sel = select(
+        mesh,
+        props,
+        &unchecked(crate::pick::DEFAULT_CANDIDATES.max(p.collect)),
+        timings,
+    );
+    if sel.candidates.is_empty() {
+        return None;
+    }
+    let ranked = ranked_by_closing(&sel, p.hand, (n, close), first);
+    put_first(&mut sel, &ranked, p.collect);
+    for k in 0..sel.candidates.len() {
+        if sel.checked() >= max || has_hold(&sel) {
+            break;
+        }
+        let c = &sel.candidates[k];
+        let out = (p.check)(&sel.axes[c.axis_plan].aligned, &c.grasp);
+        sel.candidates[k].check = Some(out);
+    }
+    if !has_hold(&sel) && sel.checked() < max {
+        return None;
+    }
+    if let Some(recheck) = p.recheck {
+        recheck_failed_closings(&mut sel, recheck);
+    }
+    sel.chosen = choose(&sel.candidates);
+    if let (Some(recheck), Some(i)) = (p.recheck, sel.chosen) {
+        recheck_if_closing_decided(&mut sel, i, recheck);
+    }
+    Some(sel)
+}
+
+/// `n` of `sel`'s candidates picked for diversity ([`crate::pick::farthest_points`]), each
+/// with its closing by `close` (the first candidate's is `first`, closed already), in the
+/// order their closings give: as planned first, then the shift in whole millimetres, then the
+/// search order. The closings run in parallel; the order does not depend on the threads.
+fn ranked_by_closing(
+    sel: &Selection,
+    hand: &Hand,
+    (n, close): (usize, CloseFn<'_>),
+    first: Preclosed,
+) -> Vec<(usize, Preclosed)> {
+    use rayon::prelude::*;
+    let features: Vec<_> = sel
+        .candidates
+        .iter()
+        .map(|c| crate::pick::feature_of(&c.grasp, &sel.axes[c.axis_plan].aligned, hand))
+        .collect();
+    let picks = crate::pick::farthest_points(&features, n);
+    // The first is among the picks (`farthest_points` starts from it).
+    let closed: Vec<Preclosed> = picks
+        .par_iter()
+        .map(|&i| {
+            let c = &sel.candidates[i];
+            if i == 0 {
+                first
+            } else {
+                close(&sel.axes[c.axis_plan].aligned, &c.grasp)
+            }
+        })
+        .collect();
+    let mut ranked: Vec<(usize, Preclosed)> = picks.into_iter().zip(closed).collect();
+    ranked.sort_by(|(i, a), (j, b)| {
+        b.as_planned
+            .cmp(&a.as_planned)
+            .then(a.shift_mm.floor().total_cmp(&b.shift_mm.floor()))
+            .then(i.cmp(j))
+    });
+    ranked
+}
+
+/// Puts the `ranked` candidates of `sel` first, in that order and with their closings, then
+/// the others in search order up to `collect` in all.
+fn put_first(sel: &mut Selection, ranked: &[(usize, Preclosed)], collect: usize) {
+    let mut slots: Vec<Option<Candidate>> = std::mem::take(&mut sel.candidates)
+        .into_iter()
+        .map(Some)
+        .collect();
+    for (i, figures) in ranked {
+        if let Some(mut c) = slots[*i].take() {
+            c.preclosed = Some(*figures);
+            sel.candidates.push(c);
+        }
+    }
+    let rest = collect.saturating_sub(sel.candidates.len());
+    sel.candidates
+        .extend(slots.into_iter().flatten().take(rest));
 }
 
 /// Checks candidate `i` again with `recheck` if a failed closing decided its check.
@@ -349,6 +504,7 @@ fn search_axis(
             grasp: g,
             check,
             thesis_place,
+            preclosed: None,
         });
         !is_done(sel, p, collect)
     };

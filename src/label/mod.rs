@@ -19,7 +19,7 @@ pub mod command;
 pub mod line;
 pub mod npz;
 pub mod object;
-pub mod pick;
+pub use crate::pick;
 
 pub use line::{GraspLine, LabelInfo, LabelRecord};
 pub use object::{check_lines, label_object, LabelParams, Line, ObjectSummary};

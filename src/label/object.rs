@@ -9,8 +9,8 @@
 //! thesis axis's frame, and moved into the others') and shared by every check of the object.
 
 use super::line::{Carried, ErrorRecord, GraspLine, LabelInfo, LabelRecord, UngraspableRecord};
-use super::pick::{self, Feature};
 use crate::mesh::{self, AlignedObject, GraspAxis};
+use crate::pick::{self, feature_of, Feature};
 use crate::pipeline::Error;
 use crate::plan::search::Grasp;
 use crate::plan::StageTimings;
@@ -19,7 +19,6 @@ use crate::report::to_rounded_json;
 use crate::scenario::Scenario;
 use crate::select::{self, AxisPlan, Selection};
 use crate::sim::{self, Perturbation, SimHand, SimOutcome};
-use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeSet;
@@ -62,9 +61,7 @@ impl MjcfExport {
     }
 }
 
-/// The default `--candidates`: more than the planner's candidate budget finds on any object of
-/// the real-object set, so that the picks cover the whole search.
-pub const DEFAULT_CANDIDATES: usize = 4000;
+pub use crate::pick::DEFAULT_CANDIDATES;
 
 /// One finished line of an object: its grasp index (`None` for an object-level line) and its
 /// JSON text.
@@ -400,37 +397,6 @@ pub fn error_line(object: &str, index: Option<usize>, error: &str, label: LabelI
     }
 }
 
-/// The feature of a planned grasp for [`pick::farthest_points`], in the file's frame.
-fn feature_of(g: &Grasp, aligned: &AlignedObject, hand: &crate::hand::Hand) -> Feature {
-    let back = aligned.to_aligned.rotation.inverse().to_rotation_matrix();
-    let contacts = crate::quality::planned_contacts(g, hand);
-    let fingers_mm = hand
-        .finger_list
-        .iter()
-        .map(|f| {
-            let pts: Vec<Vector3<f64>> = contacts
-                .iter()
-                .filter(|c| c.finger == f.name)
-                .map(|c| {
-                    aligned
-                        .to_original(&nalgebra::Point3::from(c.point_mm))
-                        .coords
-                })
-                .collect();
-            if pts.is_empty() {
-                aligned.to_original(&g.palm.origin).coords
-            } else {
-                pts.iter().sum::<Vector3<f64>>() / pts.len() as f64
-            }
-        })
-        .collect();
-    Feature {
-        palm_mm: aligned.to_original(&g.palm.origin).coords,
-        palm_rotation: back.matrix() * Matrix3::from_columns(&g.palm.axes),
-        fingers_mm,
-    }
-}
-
 /// Plans `object`'s candidates as a run does, without checking any: every feasible grasp in
 /// search order, up to `candidates`.
 fn plan_candidates(
@@ -455,6 +421,7 @@ fn plan_candidates(
             recheck: None,
             domains: None,
             frame: scenario.object.frame,
+            order_by_closing: None,
         },
         timings,
     )

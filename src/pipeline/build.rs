@@ -76,14 +76,7 @@ pub(super) fn plan_report(
         .candidates
         .iter()
         .zip(qualities)
-        .map(|(c, q)| report::GraspReport {
-            quality: q.as_ref().map(report::GraspQuality::of),
-            ..grasp_report(
-                &c.grasp,
-                &selection.axes[c.axis_plan].aligned,
-                c.check.as_ref(),
-            )
-        })
+        .map(|(c, q)| candidate_report(c, &selection.axes[c.axis_plan].aligned, q.as_ref()))
         .collect();
     let chosen_report = selection.chosen.map(|i| all_grasps[i].clone());
     let (status, reason) = if chosen_report.is_some() {
@@ -273,6 +266,23 @@ fn axis_report(a: &select::AxisPlan) -> report::AxisReport {
     }
 }
 
+/// A candidate's report: its grasp, its check, its brief quality and, under `[sim]
+/// order_by_closing`, the closing that ordered it.
+fn candidate_report(
+    c: &select::Candidate,
+    aligned: &mesh::AlignedObject,
+    q: Option<&quality::Quality>,
+) -> report::GraspReport {
+    report::GraspReport {
+        quality: q.map(report::GraspQuality::of),
+        closing_order: c.preclosed.map(|f| report::ClosingOrder {
+            as_planned: f.as_planned,
+            shift_mm: f.shift_mm,
+        }),
+        ..grasp_report(&c.grasp, aligned, c.check.as_ref())
+    }
+}
+
 fn grasp_report(
     g: &plan::search::Grasp,
     aligned: &mesh::AlignedObject,
@@ -335,5 +345,6 @@ fn grasp_report(
             }),
         }),
         quality: None,
+        closing_order: None,
     }
 }

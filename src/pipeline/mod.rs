@@ -533,6 +533,16 @@ fn select_grasps(
     let recheck = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
         check_grasp(scenario, object, a, g, sim::entry::search_in_full)
     };
+    // `[sim] order_by_closing`: the closing alone, gravity off.
+    let close = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> select::Preclosed {
+        let pose = sim::SimHand::from_grasp(g, &scenario.hand);
+        let shape = object.shape(a, &pose, &scenario.hand);
+        let f = sim::entry::closing_fidelity(&object.case(scenario, &pose, &shape));
+        select::Preclosed {
+            as_planned: f.as_planned,
+            shift_mm: f.shift_mm,
+        }
+    };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
     let checks_candidates =
         !options.no_sim && scenario.sim.input.override_angles.is_none() && options.given.is_none();
@@ -552,6 +562,7 @@ fn select_grasps(
             recheck: Some(&recheck),
             domains: None,
             frame: scenario.object.frame,
+            order_by_closing: Some((scenario.sim.selection.order_by_closing, &close)),
         },
         timings,
     )

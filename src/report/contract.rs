@@ -220,6 +220,19 @@ pub struct GraspReport {
     /// report's `quality`).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub quality: Option<GraspQuality>,
+    /// Under `[sim] order_by_closing`, what this candidate's closing did with gravity off, for
+    /// a candidate it closed: the order the search checked it in.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub closing_order: Option<ClosingOrder>,
+}
+
+/// A candidate's closing with gravity off (`[sim] order_by_closing`).
+#[derive(Debug, Clone, Serialize)]
+pub struct ClosingOrder {
+    /// The closing kept the plan (`sim.fidelity.as_planned`'s rules).
+    pub as_planned: bool,
+    /// How far it pushed the object `[mm]`.
+    pub shift_mm: f64,
 }
 
 /// A candidate grasp's analytic quality in brief.

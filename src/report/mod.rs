@@ -23,7 +23,7 @@ pub use check::{
     FidelityReason, FingerClosing, FingerRefinement, FirstTouch, Start, Verdict,
 };
 pub use contract::{
-    AlsReport, AxisReport, BatchView, CandidateCheck, CandidateRobust, DiameterBasis,
+    AlsReport, AxisReport, BatchView, CandidateCheck, CandidateRobust, ClosingOrder, DiameterBasis,
     DirectionView, ErrorView, ExpectReport, ExpectView, FingerReport, GradesReport, GraspQuality,
     GraspReport, GraspSource, HoldLimits, IndexScale, ObjectReport, PlanReport, PlanStatus,
     PlanView, PoseReport, RecordView, RobustView, RunReport, SimReport, SimVerdict, SimView,

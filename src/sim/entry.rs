@@ -35,6 +35,12 @@ pub fn search_in_full(case: &Case) -> SimOutcome {
     in_full(case, search)
 }
 
+/// The closing alone, gravity off, as every check of `case` starts (`[sim] order_by_closing`):
+/// its fidelity.
+pub fn closing_fidelity(case: &Case) -> super::outcome::Fidelity {
+    super::protocol::Closed::new(case).fidelity().clone()
+}
+
 /// The check of a chosen grasp as reported.
 #[derive(Debug, Clone)]
 pub struct Reported {

@@ -405,12 +405,32 @@ pub struct SelectionParams {
     /// A run checks the planner's candidates in search order until one holds or this many have
     /// been checked (1: only the first grasp, as the thesis would give it).
     pub max_checked: usize,
+    /// Before the candidate search, up to this many candidates, picked for diversity as `label`
+    /// picks them (the first always among them), are closed with gravity off, and the search
+    /// checks them first, in the order their closings give: as planned, then the closing
+    /// shift in whole millimetres, then the search order (issue 58: the closing predicts the
+    /// hold where the plan's geometry does not); only when the first candidate's own closing
+    /// leaves its plan. 0: the search order alone.
+    #[serde(skip_serializing_if = "is_default_order_by_closing")]
+    pub order_by_closing: usize,
 }
+
+/// True at the default (a field serialised only when set otherwise).
+fn is_default_order_by_closing(n: &usize) -> bool {
+    *n == DEFAULT_ORDER_BY_CLOSING
+}
+
+/// `order_by_closing`'s default: the 16 diverse candidates `label` labels by default.
+pub const DEFAULT_ORDER_BY_CLOSING: usize = 16;
+
+/// The most candidates `order_by_closing` may close.
+pub const MAX_ORDER_BY_CLOSING: usize = 256;
 
 impl Default for SelectionParams {
     fn default() -> Self {
         SelectionParams {
             max_checked: crate::DEFAULT_MAX_CHECKED,
+            order_by_closing: DEFAULT_ORDER_BY_CLOSING,
         }
     }
 }
@@ -567,6 +587,7 @@ sim_table! {
     choose: Choose => robust,
     choose_min_lower_bound: f64 => robust,
     rest_joint_deg: f64 => early,
+    order_by_closing: usize => selection,
 }
 
 /// `[("sim.<field>", s.<group>.<field>), ...]`: each grouped value with its `[sim]` key.
@@ -707,6 +728,13 @@ impl SimParams {
             if !(1..=100).contains(&v) {
                 return Err((key, format!("must be in 1..=100, got {v}")));
             }
+        }
+        let n = s.selection.order_by_closing;
+        if n > MAX_ORDER_BY_CLOSING {
+            return Err((
+                "sim.order_by_closing",
+                format!("must be in 0..={MAX_ORDER_BY_CLOSING}, got {n}"),
+            ));
         }
         Ok(())
     }
@@ -967,6 +995,8 @@ mod tests {
             check("hold_solver_iterations = 0"),
             Err("sim.hold_solver_iterations")
         );
+        assert_eq!(check("order_by_closing = 256"), Ok(()));
+        assert_eq!(check("order_by_closing = 257"), Err("sim.order_by_closing"));
         let mut p = SimParams::default();
         p.solver.timestep_s = 0.5;
         assert_eq!(
@@ -1019,6 +1049,7 @@ mod tests {
         p.hold.closing_decides = true;
         p.early.rest_margin = 0.75;
         p.early.rest_joint_deg = 2.5;
+        p.selection.order_by_closing = 0;
         p.selection.max_checked = 4;
         p.input.override_angles = Some(vec![[90.0, 80.5], [45.0, 30.0]]);
         p.input.override_index = Some(7);
@@ -1052,7 +1083,7 @@ mod tests {
             pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
             mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: None, \
             choose: First, choose_min_lower_bound: 0.8, \
-            rest_joint_deg: 1.0 }"
+            rest_joint_deg: 1.0, order_by_closing: 16 }"
         );
         assert_eq!(
             format!("{:?}", non_default()),
@@ -1074,7 +1105,7 @@ mod tests {
             seed: 0, pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
             mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: Some(3), \
             choose: Robust, choose_min_lower_bound: 0.8, \
-            rest_joint_deg: 2.5 }"
+            rest_joint_deg: 2.5, order_by_closing: 0 }"
         );
     }
 
@@ -1129,7 +1160,7 @@ mod tests {
                 r#""closing_decides":true},"#,
                 r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.75,"#,
                 r#""rest_joint_deg":2.5},"#,
-                r#""selection":{"max_checked":4},"#,
+                r#""selection":{"max_checked":4,"order_by_closing":0},"#,
                 r#""input":{"override_angles":[[90.0,80.5],[45.0,30.0]],"override_index":7},"#,
                 r#""robust":{"samples":8,"seed":0,"pose_offset_mm":2.0,"pose_rotation_deg":3.0,"#,
                 r#""friction_range_pct":15.0,"mass_range_pct":15.0,"torque_range_pct":10.0,"#,
@@ -1188,7 +1219,7 @@ mod tests {
                 `min_on_plan_fraction`, `closing_decides`, `balanced_squeeze`, `approach`, \
                 `samples`, `seed`, `pose_offset_mm`, `pose_rotation_deg`, \
                 `friction_range_pct`, `mass_range_pct`, `torque_range_pct`, `replay_sample`, \
-                `choose`, `choose_min_lower_bound`, `rest_joint_deg`\n"
+                `choose`, `choose_min_lower_bound`, `rest_joint_deg`, `order_by_closing`\n"
             ),
             "{err}"
         );

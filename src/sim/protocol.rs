@@ -60,6 +60,11 @@ impl Closed {
     pub fn steps(&self) -> usize {
         self.closing.steps
     }
+
+    /// What the closing did to the plan.
+    pub fn fidelity(&self) -> &super::outcome::Fidelity {
+        &self.closing.fidelity
+    }
 }
 
 /// Runs the hold test for every gravity direction of `params.gravity`, by `params.protocol`.

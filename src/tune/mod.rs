@@ -736,6 +736,7 @@ fn run_planned(
             recheck: None,
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,
+            order_by_closing: None,
         },
         &mut t,
     );

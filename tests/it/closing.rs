@@ -220,6 +220,8 @@ fn with_closing_decides_the_grasp_reported_is_checked_in_full() {
             .replace("\"../", &format!("\"{}/", crate::root().display()));
     let sim = |keys: &str| -> serde_json::Value {
         let path = dir.path().join("c4.toml");
+        // The search order: the closing order would check another candidate first.
+        let keys = format!("order_by_closing = 0\n{keys}");
         std::fs::write(&path, text.replace("[sim]\n", &format!("[sim]\n{keys}\n"))).unwrap();
         let out = crate::succeed(crate::grasp_sim().arg("--json").arg(&path));
         let mut v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
@@ -331,6 +333,8 @@ fn a_push_beyond_the_bound_moves_the_search_on() {
     s.sim.closing.reseat = old.closing.reseat;
     s.sim.fingers.squeeze_deg = old.fingers.squeeze_deg;
     s.sim.fingers.squeeze2_deg = old.fingers.squeeze2_deg;
+    // The search order (the closing order would start elsewhere).
+    s.sim.selection.order_by_closing = 0;
     let r = grasp_sim::run(&s, &grasp_sim::RunOptions::default()).unwrap();
     let c = r.sim.closing.as_ref().unwrap();
     assert_eq!(

@@ -129,3 +129,80 @@ fn a_large_factor_puts_the_grasp_its_term_prefers_first() {
         .iter()
         .any(|l| l["grade"]["terms"]["even"].as_f64().unwrap() < -0.01));
 }
+
+/// The JSON report of LIBERO's akita bowl, checked on its first candidate only
+/// (`max_checked = 1`), with `extra` in its `[sim]` table.
+fn akita_bowl(dir: &std::path::Path, extra: &str) -> Value {
+    let text =
+        std::fs::read_to_string(root().join("assets/real/scenarios/libero_akita_black_bowl.toml"))
+            .unwrap()
+            .replace(
+                "\"../meshes/",
+                &format!("\"{}/", root().join("assets/real/meshes").display()),
+            )
+            .replace(
+                "\"../../hands/",
+                &format!("\"{}/", root().join("assets/hands").display()),
+            );
+    let p = dir.join(format!("akita_{}.toml", extra.len()));
+    std::fs::write(&p, format!("{text}\n[sim]\nmax_checked = 1\n{extra}\n")).unwrap();
+    let o = grasp_sim()
+        .args(["--json", "--candidates", "16"])
+        .arg(&p)
+        .output()
+        .unwrap();
+    crate::assert_success(&o);
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+#[test]
+fn the_closing_order_checks_first_a_grasp_whose_closing_stays_near_its_plan() {
+    // The thesis's first candidate on the akita bowl: its closing throws the bowl 102 mm and
+    // it drops. `order_by_closing = 16` (the default) closes 16 diverse candidates with gravity
+    // off and checks first the one whose closing kept nearest its plan (none of the 16 as
+    // planned: the least shift, 5.7 mm): it holds, with one check, as the thesis's first does
+    // not.
+    let dir = tempfile::tempdir().unwrap();
+    let thesis = akita_bowl(dir.path(), "order_by_closing = 0");
+    assert_eq!(thesis["sim"]["verdict"], "drop", "{}", thesis["sim"]);
+    let shift = thesis["sim"]["fidelity"]["shift_mm"].as_f64().unwrap();
+    assert!(shift > 50.0, "{shift}");
+    assert!(thesis["plan"]["grasp"].get("closing_order").is_none());
+
+    // The default.
+    let ordered = akita_bowl(dir.path(), "");
+    assert_eq!(ordered["sim"]["verdict"], "hold", "{}", ordered["sim"]);
+    assert_eq!(ordered["plan"]["candidates_checked"], 1);
+    let grasps = ordered["plan"]["grasps"].as_array().unwrap();
+    assert_eq!(grasps.len(), 16);
+    // In the order their closings give: as planned first, then the shift in whole mm.
+    let key = |g: &Value| {
+        let c = &g["closing_order"];
+        (
+            !c["as_planned"].as_bool().unwrap(),
+            c["shift_mm"].as_f64().unwrap().floor(),
+        )
+    };
+    for w in grasps.windows(2) {
+        assert!(
+            key(&w[0]) <= key(&w[1]),
+            "{} then {}",
+            w[0]["closing_order"],
+            w[1]["closing_order"]
+        );
+    }
+    // The chosen grasp is the first of them, checked once, and not the thesis's first; the
+    // thesis's first is among the 16 (`label`'s picks always hold it).
+    assert_eq!(ordered["plan"]["grasp"], grasps[0]);
+    assert!(grasps[0]["check"].is_object());
+    assert!(grasps[1..].iter().all(|g| g.get("check").is_none()));
+    let pose = |g: &Value| g["palm_pose"].clone();
+    assert_ne!(pose(&grasps[0]), pose(&thesis["plan"]["grasp"]));
+    assert!(grasps
+        .iter()
+        .any(|g| pose(g) == pose(&thesis["plan"]["grasp"])));
+    let fidelity_shift = ordered["sim"]["fidelity"]["shift_mm"].as_f64().unwrap();
+    let closed_shift = grasps[0]["closing_order"]["shift_mm"].as_f64().unwrap();
+    // The check closes the same way as the closing that ordered it.
+    assert_eq!(fidelity_shift, closed_shift);
+}

@@ -150,7 +150,15 @@ fn the_json_keys_are_the_ones_output_md_lists() {
         d,
         "decides",
         "[object]\nmesh = \"ROOT/assets/objects/cup.stl\"\n[hand]\nurdf = \"ROOT/assets/hands/sdh2.urdf\"\n\
-         [planner]\nheight_step_mm = 3.0\n[sim]\nclosing_decides = true\n",
+         [planner]\nheight_step_mm = 3.0\n[sim]\nclosing_decides = true\norder_by_closing = 0\n",
+    );
+    // The same, searched in the order its closings give (`order_by_closing`, the default): the
+    // first candidate's closing leaves its plan, so the picks carry `closing_order`.
+    let ordered = scenario(
+        d,
+        "ordered",
+        "[object]\nmesh = \"ROOT/assets/objects/cup.stl\"\n[hand]\nurdf = \"ROOT/assets/hands/sdh2.urdf\"\n\
+         [planner]\nheight_step_mm = 3.0\n[sim]\nmax_checked = 1\n",
     );
     let missing = d.join("missing.stl").display().to_string();
     let runs: Vec<(Vec<&str>, i32)> = vec![
@@ -191,6 +199,7 @@ fn the_json_keys_are_the_ones_output_md_lists() {
             2,
         ),
         (vec!["--json", &robust, &decides], 0),
+        (vec!["--json", &ordered], 0),
     ];
     let mut written = BTreeSet::new();
     for (args, status) in &runs {

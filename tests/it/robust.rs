@@ -234,11 +234,16 @@ fn robust_choice_passes_over_a_marginal_hold_for_a_later_robust_grasp() {
     // the probability of a hold as planned of at least 0.6, which only 8 of 8 (0.676) reaches:
     // the search goes on past it and takes the 7th candidate, the first whose samples all held
     // as planned.
-    let (_d, first) = variant("chapter4", &format!("samples = 8\n{SQUEEZE_CLOSING}"), "");
+    // The search order (`order_by_closing = 0`): the closing order would start elsewhere.
+    let (_d, first) = variant(
+        "chapter4",
+        &format!("samples = 8\norder_by_closing = 0\n{SQUEEZE_CLOSING}"),
+        "",
+    );
     let (_e, robust) = variant(
         "chapter4",
         &format!(
-            "samples = 8\nchoose = \"robust\"\nchoose_min_lower_bound = 0.6\n{SQUEEZE_CLOSING}"
+            "samples = 8\nchoose = \"robust\"\nchoose_min_lower_bound = 0.6\norder_by_closing = 0\n{SQUEEZE_CLOSING}"
         ),
         "",
     );
@@ -404,8 +409,9 @@ fn a_replayed_sample_is_of_the_grasp_chosen_without_it() {
     // chosen grasp fails, and the search would go on to another candidate that holds under it).
     const BOX: &str = "assets/objects/train/tapered_box.toml";
     let (_d, mut s) = variant_of(BOX, "samples = 8", "");
-    // The thesis's order, where the first candidate does not hold.
+    // The thesis's order, where the first candidate does not hold, searched in that order.
     s.planner = s.planner.clone().in_thesis_order();
+    s.sim.selection.order_by_closing = 0;
     let r = run_on(2, &s);
     let first = r
         .sim
@@ -418,6 +424,7 @@ fn a_replayed_sample_is_of_the_grasp_chosen_without_it() {
     assert!(r.plan.candidates_checked > 1);
     let (_e, mut replay) = variant_of(BOX, &format!("replay_sample = {}", first.sample), "");
     replay.planner = replay.planner.clone().in_thesis_order();
+    replay.sim.selection.order_by_closing = 0;
     let replayed = run_on(2, &replay);
     assert_eq!(replayed.plan.candidates_checked, r.plan.candidates_checked);
     assert!(replayed

@@ -1,4 +1,5 @@
-//! Picking diverse grasps among the planner's candidates (issue 57): farthest-point sampling over
+//! Picking diverse grasps among the planner's candidates (issues 57 and 58: `label`'s picks and
+//! `[sim] order_by_closing`'s): farthest-point sampling over
 //! the palm pose and the finger contacts, so that near-copies (the cup's first twelve candidates
 //! differ only in the approach angle) are not labelled twice.
 //!
@@ -9,7 +10,13 @@
 //! candidate; each next pick is the candidate farthest from every pick so far (ties to the
 //! earlier in search order). Deterministic: the same candidates give the same picks.
 
+use crate::mesh::AlignedObject;
+use crate::plan::search::Grasp;
 use nalgebra::{Matrix3, Vector3};
+
+/// The default `--candidates`: more than the planner's candidate budget finds on any object of
+/// the real-object set, so that the picks cover the whole search.
+pub const DEFAULT_CANDIDATES: usize = 4000;
 
 /// The length that makes a palm turn comparable with a palm shift `[mm]`: a turn by 1 rad moves
 /// the scaled axes as far as a shift by about this times √2 (50 mm, a palm's half width).
@@ -46,6 +53,37 @@ impl Feature {
             (self.palm_mm - other.palm_mm).norm(),
             cos.acos().to_degrees(),
         )
+    }
+}
+
+/// The feature of a planned grasp for [`farthest_points`], in the file's frame.
+pub fn feature_of(g: &Grasp, aligned: &AlignedObject, hand: &crate::hand::Hand) -> Feature {
+    let back = aligned.to_aligned.rotation.inverse().to_rotation_matrix();
+    let contacts = crate::plan::contacts::planned_contacts(g, hand);
+    let fingers_mm = hand
+        .finger_list
+        .iter()
+        .map(|f| {
+            let pts: Vec<Vector3<f64>> = contacts
+                .iter()
+                .filter(|c| c.finger == f.name)
+                .map(|c| {
+                    aligned
+                        .to_original(&nalgebra::Point3::from(c.point_mm))
+                        .coords
+                })
+                .collect();
+            if pts.is_empty() {
+                aligned.to_original(&g.palm.origin).coords
+            } else {
+                pts.iter().sum::<Vector3<f64>>() / pts.len() as f64
+            }
+        })
+        .collect();
+    Feature {
+        palm_mm: aligned.to_original(&g.palm.origin).coords,
+        palm_rotation: back.matrix() * Matrix3::from_columns(&g.palm.axes),
+        fingers_mm,
     }
 }
 
