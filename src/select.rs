@@ -186,8 +186,10 @@ pub fn select(
 ) -> Selection {
     if let (Some(max), Some((n, close))) = (p.max_checked, p.order_by_closing) {
         if n > 0 {
-            if let Some(sel) = select_by_closing(mesh, props, p, (max, n, close), timings) {
-                return sel;
+            match select_by_closing(mesh, props, p, (max, n, close), timings) {
+                Ok(sel) => return sel,
+                Err(Some(first)) => return select_reusing(mesh, props, p, *first, timings),
+                Err(None) => {}
             }
         }
     }
@@ -246,24 +248,53 @@ pub fn select(
     sel
 }
 
-/// `[sim] order_by_closing = n` (issue 58). The first candidate in search order is closed with
-/// gravity off; if its closing keeps the plan, `None`: the caller searches as without the
-/// setting (the same selection, bit for bit). Otherwise every candidate is planned as `label`
-/// plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), `n` of them are
-/// picked for diversity as `label` picks them (the first always among them) and closed, and
-/// they are checked in the order their closings give (as planned first, then the shift in
-/// whole millimetres, then the search order) until one succeeds or `max` have been checked.
-/// The selection lists the picks in that order, then the other candidates collected
-/// (`collect`) in search order. `None` too when none of them succeeded before the checks ran
-/// out of candidates: the caller then searches as without the setting (the rules beyond the
-/// thesis among it).
+/// [`select`] without `order_by_closing`, its first check `first` (the first candidate's,
+/// already run) reused rather than run again.
+fn select_reusing(
+    mesh: &Mesh,
+    props: &MassProperties,
+    p: &SelectParams,
+    first: SimOutcome,
+    timings: &mut StageTimings,
+) -> Selection {
+    let kept = std::cell::RefCell::new(Some(first));
+    let check = |a: &AlignedObject, g: &Grasp| -> SimOutcome {
+        let first = kept.borrow_mut().take();
+        first.unwrap_or_else(|| (p.check)(a, g))
+    };
+    let q = SelectParams {
+        hand: p.hand,
+        planner: p.planner,
+        friction: p.friction,
+        collect: p.collect,
+        max_checked: p.max_checked,
+        check: &check,
+        recheck: p.recheck,
+        domains: p.domains,
+        frame: p.frame,
+        order_by_closing: None,
+    };
+    select(mesh, props, &q, timings)
+}
+
+/// `[sim] order_by_closing = n` (issue 58). The first candidate in search order is checked;
+/// if its closing keeps the plan, `Err` with that check: the caller searches as without the
+/// setting, reusing it (the same selection, bit for bit). Otherwise every candidate is planned
+/// as `label` plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), `n` of them
+/// are picked for diversity as `label` picks them (the first always among them) and closed with
+/// gravity off, and they are checked in the order their closings give (as planned first, then
+/// the shift in whole millimetres, then the search order) until one succeeds or `max` have been
+/// checked; the first's check is the one already run. The selection lists the picks in that
+/// order, then the other candidates collected (`collect`) in search order. `Err(None)` when
+/// none of them succeeded before the checks ran out of candidates, or nothing was found: the
+/// caller then searches as without the setting (the rules beyond the thesis among it).
 fn select_by_closing(
     mesh: &Mesh,
     props: &MassProperties,
     p: &SelectParams,
     (max, n, close): (usize, usize, CloseFn<'_>),
     timings: &mut StageTimings,
-) -> Option<Selection> {
+) -> Result<Selection, Option<Box<SimOutcome>>> {
     let unchecked = |collect: usize| SelectParams {
         hand: p.hand,
         planner: p.planner,
@@ -276,36 +307,43 @@ fn select_by_closing(
         frame: p.frame,
         order_by_closing: None,
     };
-    let first = {
+    let first_check = {
         let mut t = StageTimings::default();
         let sel = select(mesh, props, &unchecked(1), &mut t);
-        let c = sel.candidates.first()?;
-        close(&sel.axes[c.axis_plan].aligned, &c.grasp)
+        let c = sel.candidates.first().ok_or(None)?;
+        (p.check)(&sel.axes[c.axis_plan].aligned, &c.grasp)
     };
-    if first.as_planned {
-        return None;
+    if first_check.fidelity.as_planned {
+        return Err(Some(Box::new(first_check)));
     }
+    let first = Preclosed {
+        as_planned: false,
+        shift_mm: first_check.fidelity.shift_mm,
+    };
     let mut sel = select(
         mesh,
         props,
         &unchecked(crate::pick::DEFAULT_CANDIDATES.max(p.collect)),
         timings,
     );
-    if sel.candidates.is_empty() {
-        return None;
-    }
     let ranked = ranked_by_closing(&sel, p.hand, (n, close), first);
-    put_first(&mut sel, &ranked, p.collect);
-    for k in 0..sel.candidates.len() {
+    let places = put_first(&mut sel, &ranked, p.collect);
+    let mut first_check = Some(first_check);
+    for (k, place) in places.into_iter().enumerate() {
         if sel.checked() >= max || has_hold(&sel) {
             break;
         }
-        let c = &sel.candidates[k];
-        let out = (p.check)(&sel.axes[c.axis_plan].aligned, &c.grasp);
+        let out = match first_check.take_if(|_| place == 0) {
+            Some(out) => out,
+            None => {
+                let c = &sel.candidates[k];
+                (p.check)(&sel.axes[c.axis_plan].aligned, &c.grasp)
+            }
+        };
         sel.candidates[k].check = Some(out);
     }
     if !has_hold(&sel) && sel.checked() < max {
-        return None;
+        return Err(None);
     }
     if let Some(recheck) = p.recheck {
         recheck_failed_closings(&mut sel, recheck);
@@ -314,7 +352,7 @@ fn select_by_closing(
     if let (Some(recheck), Some(i)) = (p.recheck, sel.chosen) {
         recheck_if_closing_decided(&mut sel, i, recheck);
     }
-    Some(sel)
+    Ok(sel)
 }
 
 /// `n` of `sel`'s candidates picked for diversity ([`crate::pick::farthest_points`]), each
@@ -357,21 +395,30 @@ fn ranked_by_closing(
 }
 
 /// Puts the `ranked` candidates of `sel` first, in that order and with their closings, then
-/// the others in search order up to `collect` in all.
-fn put_first(sel: &mut Selection, ranked: &[(usize, Preclosed)], collect: usize) {
+/// the others in search order up to `collect` in all; returns each one's place in search order.
+fn put_first(sel: &mut Selection, ranked: &[(usize, Preclosed)], collect: usize) -> Vec<usize> {
     let mut slots: Vec<Option<Candidate>> = std::mem::take(&mut sel.candidates)
         .into_iter()
         .map(Some)
         .collect();
+    let mut places = Vec::new();
     for (i, figures) in ranked {
         if let Some(mut c) = slots[*i].take() {
             c.preclosed = Some(*figures);
             sel.candidates.push(c);
+            places.push(*i);
         }
     }
     let rest = collect.saturating_sub(sel.candidates.len());
-    sel.candidates
-        .extend(slots.into_iter().flatten().take(rest));
+    let others = slots
+        .into_iter()
+        .enumerate()
+        .filter_map(|(i, c)| Some((i, c?)));
+    for (i, c) in others.take(rest) {
+        sel.candidates.push(c);
+        places.push(i);
+    }
+    places
 }
 
 /// Checks candidate `i` again with `recheck` if a failed closing decided its check.
