@@ -284,7 +284,8 @@ fn select_reusing(
 /// are picked for diversity as `label` picks them (the first always among them) and closed with
 /// gravity off, and they are checked in the order their closings give (as planned first, then
 /// the shift in whole millimetres, then the search order) until one succeeds or `max` have been
-/// checked; the first's check is the one already run. The selection lists the picks in that
+/// checked, or one held and none left can hold as planned (their closings left the plan); the
+/// first's check is the one already run. The selection lists the picks in that
 /// order, then the other candidates collected (`collect`) in search order. `Err(None)` when
 /// none of them succeeded before the checks ran out of candidates, or nothing was found: the
 /// caller then searches as without the setting (the rules beyond the thesis among it).
@@ -329,8 +330,15 @@ fn select_by_closing(
     let ranked = ranked_by_closing(&sel, p.hand, (n, close), first);
     let places = put_first(&mut sel, &ranked, p.collect);
     let mut first_check = Some(first_check);
+    let mut settled = false;
     for (k, place) in places.into_iter().enumerate() {
         if sel.checked() >= max || has_hold(&sel) {
+            break;
+        }
+        // With fewer candidates than checks the search goes on as without the setting when
+        // none succeeds (below), the rules beyond the thesis among it: no early end then.
+        if sel.candidates.len() >= max && held_and_none_left_can_succeed(&sel, k) {
+            settled = true;
             break;
         }
         let out = match first_check.take_if(|_| place == 0) {
@@ -342,7 +350,7 @@ fn select_by_closing(
         };
         sel.candidates[k].check = Some(out);
     }
-    if !has_hold(&sel) && sel.checked() < max {
+    if !has_hold(&sel) && !settled && sel.checked() < max {
         return Err(None);
     }
     if let Some(recheck) = p.recheck {
@@ -353,6 +361,20 @@ fn select_by_closing(
         recheck_if_closing_decided(&mut sel, i, recheck);
     }
     Ok(sel)
+}
+
+/// True when a checked candidate of `sel` held and none from the `k`-th on can succeed: each
+/// was closed and its closing left the plan, which its check's closing does again (the same
+/// closing), so none can hold as planned; [`choose`] then takes the first that held, whatever
+/// the rest would do. Not under `choose = "robust"` (a check with samples), whose success is
+/// the samples', not the closing's.
+fn held_and_none_left_can_succeed(sel: &Selection, k: usize) -> bool {
+    let checked = || sel.candidates.iter().filter_map(|c| c.check.as_ref());
+    checked().all(|o| o.robust.is_none())
+        && checked().any(|o| o.verdict == Verdict::Hold)
+        && sel.candidates[k..]
+            .iter()
+            .all(|c| c.preclosed.is_some_and(|f| !f.as_planned))
 }
 
 /// `n` of `sel`'s candidates picked for diversity ([`crate::pick::farthest_points`]), each

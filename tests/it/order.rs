@@ -130,9 +130,8 @@ fn a_large_factor_puts_the_grasp_its_term_prefers_first() {
         .any(|l| l["grade"]["terms"]["even"].as_f64().unwrap() < -0.01));
 }
 
-/// The JSON report of LIBERO's akita bowl, checked on its first candidate only
-/// (`max_checked = 1`), with `extra` in its `[sim]` table.
-fn akita_bowl(dir: &std::path::Path, extra: &str) -> Value {
+/// The JSON report of LIBERO's akita bowl with `sim` as its `[sim]` table.
+fn akita_bowl(dir: &std::path::Path, sim: &str) -> Value {
     let text =
         std::fs::read_to_string(root().join("assets/real/scenarios/libero_akita_black_bowl.toml"))
             .unwrap()
@@ -144,8 +143,8 @@ fn akita_bowl(dir: &std::path::Path, extra: &str) -> Value {
                 "\"../../hands/",
                 &format!("\"{}/", root().join("assets/hands").display()),
             );
-    let p = dir.join(format!("akita_{}.toml", extra.len()));
-    std::fs::write(&p, format!("{text}\n[sim]\nmax_checked = 1\n{extra}\n")).unwrap();
+    let p = dir.join(format!("akita_{}.toml", sim.len()));
+    std::fs::write(&p, format!("{text}\n[sim]\n{sim}\n")).unwrap();
     let o = grasp_sim()
         .args(["--json", "--candidates", "16"])
         .arg(&p)
@@ -163,14 +162,14 @@ fn the_closing_order_checks_first_a_grasp_whose_closing_stays_near_its_plan() {
     // planned: the least shift, 5.7 mm): it holds, with one check, as the thesis's first does
     // not.
     let dir = tempfile::tempdir().unwrap();
-    let thesis = akita_bowl(dir.path(), "order_by_closing = 0");
+    let thesis = akita_bowl(dir.path(), "max_checked = 1\norder_by_closing = 0");
     assert_eq!(thesis["sim"]["verdict"], "drop", "{}", thesis["sim"]);
     let shift = thesis["sim"]["fidelity"]["shift_mm"].as_f64().unwrap();
     assert!(shift > 50.0, "{shift}");
     assert!(thesis["plan"]["grasp"].get("closing_order").is_none());
 
-    // The default.
-    let ordered = akita_bowl(dir.path(), "");
+    // The default order, one check.
+    let ordered = akita_bowl(dir.path(), "max_checked = 1");
     assert_eq!(ordered["sim"]["verdict"], "hold", "{}", ordered["sim"]);
     assert_eq!(ordered["plan"]["candidates_checked"], 1);
     let grasps = ordered["plan"]["grasps"].as_array().unwrap();
@@ -205,4 +204,10 @@ fn the_closing_order_checks_first_a_grasp_whose_closing_stays_near_its_plan() {
     let closed_shift = grasps[0]["closing_order"]["shift_mm"].as_f64().unwrap();
     // The check closes the same way as the closing that ordered it.
     assert_eq!(fidelity_shift, closed_shift);
+    // With the default 8 checks the search ends there too: it held, and no pick closes as
+    // planned, so none after it can hold as planned; the same grasp, the same check.
+    let default = akita_bowl(dir.path(), "");
+    assert_eq!(default["plan"]["candidates_checked"], 1);
+    assert_eq!(default["plan"]["grasp"], ordered["plan"]["grasp"]);
+    assert_eq!(default["sim"]["fidelity"], ordered["sim"]["fidelity"]);
 }
