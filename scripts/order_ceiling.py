@@ -28,6 +28,8 @@ import math
 import sys
 from collections import defaultdict
 
+from order_study import term_auc
+
 RELAXATIONS = [
     "outer_finger_beyond_elevation",
     "curvature_graded",
@@ -82,16 +84,7 @@ def measures(by, key):
                 e += none_yet
                 none_yet *= 1 - c["hold_probability"]
             checks.append(e)
-    pairs, wins = 0, 0.0
-    for cands in by.values():
-        s = [(key(c), c["as_planned_probability"] >= 0.5) for c in cands]
-        for sa, pa in s:
-            for sb, pb in s:
-                if pa and not pb:
-                    pairs += 1
-                    wins += 1 if sa > sb else 0.5 if sa == sb else 0
-    auc = wins / pairs if pairs else math.nan
-    return sum(first) / len(first), sum(checks) / max(len(checks), 1), auc
+    return sum(first) / len(first), sum(checks) / max(len(checks), 1), term_auc(by, key)
 
 
 # The thesis hand (assets/hands/thesis.toml): joint 1 at (setback, ±lateral) in the palm's
