@@ -396,16 +396,7 @@ fn a_finger_that_still_creeps_keeps_a_direction_open_until_the_slip() {
     // the fast protocol waits for the fingers to settle (`rest_joint_deg`) and says `slip`
     // too; without that test it would decide `hold` at once.
     let dir = tempfile::tempdir().unwrap();
-    let scenario = std::fs::read_to_string(root().join("assets/real/scenarios/mw_mug.toml"))
-        .unwrap()
-        .replace(
-            "\"../meshes/",
-            &format!("\"{}/", root().join("assets/real/meshes").display()),
-        )
-        .replace(
-            "\"../../hands/",
-            &format!("\"{}/", root().join("assets/hands").display()),
-        );
+    let scenario = crate::real_scenario_text("mw_mug");
     let verdicts = |name: &str, sim: &str| -> (String, Vec<String>) {
         let path = dir.path().join(format!("{name}.toml"));
         std::fs::write(&path, format!("{scenario}\n[sim]\n{sim}\n")).unwrap();

@@ -73,6 +73,21 @@ pub fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
+/// The text of the real-object scenario `name`, its mesh and hand paths made absolute so that
+/// it can be written anywhere.
+pub fn real_scenario_text(name: &str) -> String {
+    std::fs::read_to_string(root().join(format!("assets/real/scenarios/{name}.toml")))
+        .unwrap()
+        .replace(
+            "\"../meshes/",
+            &format!("\"{}/", root().join("assets/real/meshes").display()),
+        )
+        .replace(
+            "\"../../hands/",
+            &format!("\"{}/", root().join("assets/hands").display()),
+        )
+}
+
 /// Runs `cmd` and returns its output, failing the test (with its stderr) unless it exits 0.
 pub fn succeed(cmd: &mut std::process::Command) -> std::process::Output {
     let out = cmd.output().unwrap();

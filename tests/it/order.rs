@@ -132,17 +132,7 @@ fn a_large_factor_puts_the_grasp_its_term_prefers_first() {
 
 /// The JSON report of LIBERO's akita bowl with `sim` as its `[sim]` table.
 fn akita_bowl(dir: &std::path::Path, sim: &str) -> Value {
-    let text =
-        std::fs::read_to_string(root().join("assets/real/scenarios/libero_akita_black_bowl.toml"))
-            .unwrap()
-            .replace(
-                "\"../meshes/",
-                &format!("\"{}/", root().join("assets/real/meshes").display()),
-            )
-            .replace(
-                "\"../../hands/",
-                &format!("\"{}/", root().join("assets/hands").display()),
-            );
+    let text = crate::real_scenario_text("libero_akita_black_bowl");
     let p = dir.join(format!("akita_{}.toml", sim.len()));
     std::fs::write(&p, format!("{text}\n[sim]\n{sim}\n")).unwrap();
     let o = grasp_sim()
