@@ -140,6 +140,7 @@ impl Selection {
 }
 
 /// What the selection needs besides the object.
+#[derive(Clone, Copy)]
 pub struct SelectParams<'a> {
     /// The hand.
     pub hand: &'a Hand,
@@ -184,15 +185,46 @@ pub fn select(
     p: &SelectParams,
     timings: &mut StageTimings,
 ) -> Selection {
-    if let (Some(max), Some((n, close))) = (p.max_checked, p.order_by_closing) {
-        if n > 0 {
-            match select_by_closing(mesh, props, p, (max, n, close), timings) {
-                Ok(sel) => return sel,
-                Err(Some(first)) => return select_reusing(mesh, props, p, *first, timings),
-                Err(None) => {}
-            }
-        }
+    let (Some(max), Some((n, close))) = (p.max_checked, p.order_by_closing) else {
+        return select_in(mesh, props, p, None, timings);
+    };
+    if n == 0 {
+        return select_in(mesh, props, p, None, timings);
     }
+    // `[sim] order_by_closing`: the search as without it, stopped at its first check if that
+    // check's closing left the plan.
+    let left = std::cell::Cell::new(false);
+    let first_call = std::cell::Cell::new(true);
+    let check = |a: &AlignedObject, g: &Grasp| -> SimOutcome {
+        let out = (p.check)(a, g);
+        if first_call.replace(false) && !out.fidelity.as_planned {
+            left.set(true);
+        }
+        out
+    };
+    let q = SelectParams {
+        check: &check,
+        ..*p
+    };
+    let sel = select_in(mesh, props, &q, Some(&left), timings);
+    if !left.get() {
+        return sel;
+    }
+    let first = sel.candidates.into_iter().find_map(|c| c.check);
+    first
+        .and_then(|first| select_by_closing(mesh, props, p, (max, n, close), first, timings))
+        .unwrap_or_else(|| select_in(mesh, props, p, None, timings))
+}
+
+/// [`select`] without `order_by_closing`; the search ends as soon as `stop` is set (what it
+/// found is returned as it stands, nothing chosen).
+fn select_in(
+    mesh: &Mesh,
+    props: &MassProperties,
+    p: &SelectParams,
+    stop: Option<&std::cell::Cell<bool>>,
+    timings: &mut StageTimings,
+) -> Selection {
     let mut sel = Selection {
         axes: Vec::new(),
         candidates: Vec::new(),
@@ -207,7 +239,7 @@ pub fn select(
         // The candidates this rule set has tried over its axes (the budget is per rule set).
         let mut spent = 0usize;
         for (k, axis) in GraspAxis::SEARCH_ORDER.iter().enumerate() {
-            if is_done(&sel, p, collect) {
+            if is_done(&sel, p, collect) || stop.is_some_and(std::cell::Cell::get) {
                 break;
             }
             let aligned = aligned_cache[k]
@@ -228,13 +260,16 @@ pub fn select(
                 p,
                 (aligned, rules, graded),
                 budget,
-                collect,
+                (collect, stop),
                 &mut t,
             );
             timings.add(&t);
             spent += plan.candidates_tried;
             sel.axes.push(plan);
         }
+    }
+    if stop.is_some_and(std::cell::Cell::get) {
+        return sel;
     }
     if let Some(recheck) = p.recheck {
         recheck_failed_closings(&mut sel, recheck);
@@ -248,85 +283,37 @@ pub fn select(
     sel
 }
 
-/// [`select`] without `order_by_closing`, its first check `first` (the first candidate's,
-/// already run) reused rather than run again.
-fn select_reusing(
-    mesh: &Mesh,
-    props: &MassProperties,
-    p: &SelectParams,
-    first: SimOutcome,
-    timings: &mut StageTimings,
-) -> Selection {
-    let kept = std::cell::RefCell::new(Some(first));
-    let check = |a: &AlignedObject, g: &Grasp| -> SimOutcome {
-        let first = kept.borrow_mut().take();
-        first.unwrap_or_else(|| (p.check)(a, g))
-    };
-    let q = SelectParams {
-        hand: p.hand,
-        planner: p.planner,
-        friction: p.friction,
-        collect: p.collect,
-        max_checked: p.max_checked,
-        check: &check,
-        recheck: p.recheck,
-        domains: p.domains,
-        frame: p.frame,
-        order_by_closing: None,
-    };
-    select(mesh, props, &q, timings)
-}
-
-/// `[sim] order_by_closing = n` (issue 58). The first candidate in search order is checked;
-/// if its closing keeps the plan, `Err` with that check: the caller searches as without the
-/// setting, reusing it (the same selection, bit for bit). Otherwise every candidate is planned
-/// as `label` plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), `n` of them
-/// are picked for diversity as `label` picks them (the first always among them) and closed with
-/// gravity off, and they are checked in the order their closings give (as planned first, then
-/// the shift in whole millimetres, then the search order) until one succeeds or `max` have been
+/// `[sim] order_by_closing = n` (issue 58), once the search's first check, `first_check`, found
+/// that the first candidate's closing left the plan: every candidate is planned as `label`
+/// plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), `n` of them are picked
+/// for diversity as `label` picks them (the first always among them) and closed with gravity
+/// off, and they are checked in the order their closings give (as planned first, then the
+/// shift in whole millimetres, then the search order) until one succeeds, `max` have been
 /// checked, or one held and none left can hold as planned (their closings left the plan); the
-/// first's check is the one already run. The selection lists the picks in that
-/// order, then the other candidates collected (`collect`) in search order. `Err(None)` when
-/// none of them succeeded before the checks ran out of candidates, or nothing was found: the
-/// caller then searches as without the setting (the rules beyond the thesis among it).
+/// first's check is `first_check`. The selection lists the picks in that order, then the other
+/// candidates collected (`collect`) in search order. `None` when none of them succeeded
+/// before the checks ran out of candidates: the caller then searches as without the setting
+/// (the rules beyond the thesis among it).
 fn select_by_closing(
     mesh: &Mesh,
     props: &MassProperties,
     p: &SelectParams,
     (max, n, close): (usize, usize, CloseFn<'_>),
+    first_check: SimOutcome,
     timings: &mut StageTimings,
-) -> Result<Selection, Option<Box<SimOutcome>>> {
-    let unchecked = |collect: usize| SelectParams {
-        hand: p.hand,
-        planner: p.planner,
-        friction: p.friction,
-        collect,
+) -> Option<Selection> {
+    let plan_all = SelectParams {
+        collect: crate::pick::DEFAULT_CANDIDATES.max(p.collect),
         max_checked: None,
-        check: p.check,
         recheck: None,
-        domains: p.domains,
-        frame: p.frame,
         order_by_closing: None,
+        ..*p
     };
-    let first_check = {
-        let mut t = StageTimings::default();
-        let sel = select(mesh, props, &unchecked(1), &mut t);
-        let c = sel.candidates.first().ok_or(None)?;
-        (p.check)(&sel.axes[c.axis_plan].aligned, &c.grasp)
-    };
-    if first_check.fidelity.as_planned {
-        return Err(Some(Box::new(first_check)));
-    }
     let first = Preclosed {
         as_planned: false,
         shift_mm: first_check.fidelity.shift_mm,
     };
-    let mut sel = select(
-        mesh,
-        props,
-        &unchecked(crate::pick::DEFAULT_CANDIDATES.max(p.collect)),
-        timings,
-    );
+    let mut sel = select_in(mesh, props, &plan_all, None, timings);
     let ranked = ranked_by_closing(&sel, p.hand, (n, close), first);
     let places = put_first(&mut sel, &ranked, p.collect);
     let mut first_check = Some(first_check);
@@ -351,7 +338,7 @@ fn select_by_closing(
         sel.candidates[k].check = Some(out);
     }
     if !has_hold(&sel) && !settled && sel.checked() < max {
-        return Err(None);
+        return None;
     }
     if let Some(recheck) = p.recheck {
         recheck_failed_closings(&mut sel, recheck);
@@ -360,7 +347,7 @@ fn select_by_closing(
     if let (Some(recheck), Some(i)) = (p.recheck, sel.chosen) {
         recheck_if_closing_decided(&mut sel, i, recheck);
     }
-    Ok(sel)
+    Some(sel)
 }
 
 /// True when a checked candidate of `sel` held and none from the `k`-th on can succeed: each
@@ -553,7 +540,7 @@ fn search_axis(
     p: &SelectParams,
     (aligned, rules, graded): (AlignedObject, RuleSet, plan::GradedDomain),
     budget: usize,
-    collect: usize,
+    (collect, stop): (usize, Option<&std::cell::Cell<bool>>),
     t: &mut StageTimings,
 ) -> AxisPlan {
     let slot = sel.axes.len();
@@ -575,7 +562,7 @@ fn search_axis(
             thesis_place,
             preclosed: None,
         });
-        !is_done(sel, p, collect)
+        !is_done(sel, p, collect) && !stop.is_some_and(std::cell::Cell::get)
     };
     let factors = OrderFactors::of(p.planner);
     let (tried, rejections) = if factors.is_thesis() {
