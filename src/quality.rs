@@ -984,6 +984,7 @@ mod tests {
                     domains: None,
                     frame: sc.object.frame,
                     order_by_closing: None,
+                    plan_reach: 0,
                 },
                 &mut crate::report::StageTimings::default(),
             );

@@ -170,6 +170,11 @@ pub struct SelectParams<'a> {
     /// candidates picked for diversity are closed first and checked in the order their closings
     /// give ([`select`]). `None` or 0: the search order.
     pub order_by_closing: Option<(usize, CloseFn<'a>)>,
+    /// Without the check (`max_checked` `None`), the rule sets beyond the thesis's are planned
+    /// while fewer than this many candidates have been found: the candidates a search that
+    /// checks this many could reach (it goes on to the next rule set when none of them held).
+    /// 0 or 1: only when the thesis's rules found none.
+    pub plan_reach: usize,
 }
 
 /// Stage-1 domains by (axis, rule set, AngularStep bits, HeightStep bits).
@@ -285,9 +290,11 @@ fn select_in(
 
 /// `[sim] order_by_closing = n` (issue 58), once the search's first check, `first_check`, found
 /// that the first candidate's closing left the plan: every candidate is planned as `label`
-/// plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), `n` of them are picked
-/// for diversity as `label` picks them (the first always among them) and closed with gravity
-/// off, and they are checked in the order their closings give (as planned first, then the
+/// plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), and the rule sets after
+/// the first too while fewer than `max` were found (what the search could reach); `n` of the
+/// first rule set's are picked for diversity as `label` picks them (the first always among
+/// them), and `n` of the later rule sets' ([`picks_by_rule_set`]); the picks are closed with
+/// gravity off, and they are checked in the order their closings give (as planned first, then the
 /// shift in whole millimetres, then the search order) until one succeeds, `max` have been
 /// checked, or one held and none left can hold as planned (their closings left the plan); the
 /// first's check is `first_check`. The selection lists the picks in that order, then the other
@@ -307,6 +314,7 @@ fn select_by_closing(
         max_checked: None,
         recheck: None,
         order_by_closing: None,
+        plan_reach: max,
         ..*p
     };
     let first = Preclosed {
@@ -364,7 +372,7 @@ fn held_and_none_left_can_succeed(sel: &Selection, k: usize) -> bool {
             .all(|c| c.preclosed.is_some_and(|f| !f.as_planned))
 }
 
-/// `n` of `sel`'s candidates picked for diversity ([`crate::pick::farthest_points`]), each
+/// Up to `2n` of `sel`'s candidates picked for diversity ([`picks_by_rule_set`]), each
 /// with its closing by `close` (the first candidate's is `first`, closed already), in the
 /// order their closings give: as planned first, then the shift in whole millimetres, then the
 /// search order. The closings run in parallel; the order does not depend on the threads.
@@ -380,7 +388,7 @@ fn ranked_by_closing(
         .iter()
         .map(|c| crate::pick::feature_of(&c.grasp, &sel.axes[c.axis_plan].aligned, hand))
         .collect();
-    let picks = crate::pick::farthest_points(&features, n);
+    let picks = picks_by_rule_set(sel, &features, n);
     // The first is among the picks (`farthest_points` starts from it).
     let closed: Vec<Preclosed> = picks
         .par_iter()
@@ -401,6 +409,28 @@ fn ranked_by_closing(
             .then(i.cmp(j))
     });
     ranked
+}
+
+/// `n` candidates of `sel` picked for diversity ([`crate::pick::farthest_points`] over
+/// `features`) among those of the first candidate's rule set (the first always among them),
+/// and `n` more among those of the rule sets planned after it: a search that checks more
+/// candidates than the first rule set gave goes on to the next, so the picks cover what it
+/// could reach without the first rule set's being crowded out (a pinch can give hundreds of
+/// candidates where the rules before it gave four).
+fn picks_by_rule_set(sel: &Selection, features: &[crate::pick::Feature], n: usize) -> Vec<usize> {
+    let first = sel.candidates.first().map(|c| c.grasp.rules);
+    let (own, later): (Vec<usize>, Vec<usize>) =
+        (0..features.len()).partition(|&i| Some(sel.candidates[i].grasp.rules) == first);
+    let pick = |among: &[usize]| -> Vec<usize> {
+        let f: Vec<_> = among.iter().map(|&i| features[i].clone()).collect();
+        crate::pick::farthest_points(&f, n)
+            .into_iter()
+            .map(|k| among[k])
+            .collect()
+    };
+    let mut picks = pick(&own);
+    picks.extend(pick(&later));
+    picks
 }
 
 /// Puts the `ranked` candidates of `sel` first, in that order and with their closings, then
@@ -642,13 +672,14 @@ fn is_done(sel: &Selection, p: &SelectParams, collect: usize) -> bool {
 }
 
 /// The extended rules are tried when the thesis's rules found nothing on any axis, or, with the
-/// physics check, when nothing they found held and checks remain.
+/// physics check, when nothing they found held and checks remain; without it, while fewer than
+/// [`SelectParams::plan_reach`] candidates have been found.
 fn wants_extended(sel: &Selection, p: &SelectParams) -> bool {
     if sel.candidates.is_empty() {
         return true;
     }
     match p.max_checked {
-        None => false,
+        None => sel.candidates.len() < p.plan_reach,
         Some(max) => !has_hold(sel) && sel.checked() < max,
     }
 }
@@ -740,4 +771,66 @@ pub fn override_pose(
         theta_deg: angles.to_vec(),
         planned_contacts_mm: Vec::new(),
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The D40's candidates planned without a check, `plan_reach` as given.
+    fn planned(reach: usize) -> (Selection, Vec<RuleSet>) {
+        let mesh = crate::mesh::primitives::cylinder(40.0, 124.0);
+        let props = crate::mesh::mass_properties(&mesh);
+        let hand = crate::hand::thesis_for_tests();
+        let planner = PlannerParams::default();
+        let no_check = |_: &AlignedObject, _: &Grasp| -> SimOutcome {
+            unreachable!("planned without a check")
+        };
+        let sel = select(
+            &mesh,
+            &props,
+            &SelectParams {
+                hand: &hand,
+                planner: &planner,
+                friction: 0.5,
+                collect: 100_000,
+                max_checked: None,
+                check: &no_check,
+                recheck: None,
+                domains: None,
+                frame: FrameRule::default(),
+                order_by_closing: None,
+                plan_reach: reach,
+            },
+            &mut StageTimings::default(),
+        );
+        let rules = sel.candidates.iter().map(|c| c.grasp.rules).collect();
+        (sel, rules)
+    }
+
+    #[test]
+    fn a_plan_without_checks_goes_past_the_thesis_rules_only_below_its_reach() {
+        let (thesis, rules) = planned(0);
+        let n = thesis.candidates.len();
+        assert!(n > 8, "the D40 has {n} candidates under the thesis's rules");
+        assert!(rules.iter().all(|r| *r == RuleSet::Thesis));
+        // A reach the thesis's candidates meet: the same plan.
+        let (same, _) = planned(n);
+        assert_eq!(same.candidates.len(), n);
+        // One more than they give: the extended rules' candidates follow the thesis's, which
+        // stay first and the same.
+        let (more, rules) = planned(n + 1);
+        assert!(
+            more.candidates.len() > n,
+            "{} candidates",
+            more.candidates.len()
+        );
+        assert!(rules[..n].iter().all(|r| *r == RuleSet::Thesis));
+        assert!(rules[n..].iter().all(|r| r.is_extended()));
+        for (a, b) in thesis.candidates.iter().zip(&more.candidates) {
+            assert_eq!(a.grasp.elevation_index, b.grasp.elevation_index);
+            assert_eq!(a.grasp.approach_angle_deg, b.grasp.approach_angle_deg);
+            assert_eq!(a.thesis_place, b.thesis_place);
+        }
+    }
 }

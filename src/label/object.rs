@@ -422,6 +422,7 @@ fn plan_candidates(
             domains: None,
             frame: scenario.object.frame,
             order_by_closing: None,
+            plan_reach: 0,
         },
         timings,
     )

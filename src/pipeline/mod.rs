@@ -563,6 +563,7 @@ fn select_grasps(
             domains: None,
             frame: scenario.object.frame,
             order_by_closing: Some((scenario.sim.selection.order_by_closing, &close)),
+            plan_reach: 0,
         },
         timings,
     )

@@ -737,6 +737,7 @@ fn run_planned(
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,
             order_by_closing: None,
+            plan_reach: 0,
         },
         &mut t,
     );
