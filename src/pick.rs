@@ -128,6 +128,16 @@ pub fn farthest_points(features: &[Feature], k: usize) -> Vec<usize> {
     picked
 }
 
+/// [`farthest_points`] among the candidates `among` (indices into `features`, in search order):
+/// the indices of `k` of them, the first of `among` always included, in search order.
+pub fn farthest_among(features: &[Feature], among: &[usize], k: usize) -> Vec<usize> {
+    let f: Vec<Feature> = among.iter().map(|&i| features[i].clone()).collect();
+    farthest_points(&f, k)
+        .into_iter()
+        .map(|j| among[j])
+        .collect()
+}
+
 /// How spread a set of candidates is: the mean over its pairs of the palm poses' distance, as
 /// (translation `[mm]`, rotation `[deg]`); `(0, 0)` for fewer than two.
 pub fn mean_pairwise(features: &[&Feature]) -> (f64, f64) {

@@ -411,26 +411,24 @@ fn ranked_by_closing(
     ranked
 }
 
-/// `n` candidates of `sel` picked for diversity ([`crate::pick::farthest_points`] over
+/// `n` candidates of `sel` picked for diversity ([`crate::pick::farthest_among`] over
 /// `features`) among those of the first candidate's rule set (the first always among them),
 /// and `n` more among those of the rule sets planned after it: a search that checks more
 /// candidates than the first rule set gave goes on to the next, so the picks cover what it
 /// could reach without the first rule set's being crowded out (a pinch can give hundreds of
 /// candidates where the rules before it gave four).
 fn picks_by_rule_set(sel: &Selection, features: &[crate::pick::Feature], n: usize) -> Vec<usize> {
-    let first = sel.candidates.first().map(|c| c.grasp.rules);
-    let (own, later): (Vec<usize>, Vec<usize>) =
-        (0..features.len()).partition(|&i| Some(sel.candidates[i].grasp.rules) == first);
-    let pick = |among: &[usize]| -> Vec<usize> {
-        let f: Vec<_> = among.iter().map(|&i| features[i].clone()).collect();
-        crate::pick::farthest_points(&f, n)
-            .into_iter()
-            .map(|k| among[k])
-            .collect()
-    };
-    let mut picks = pick(&own);
-    picks.extend(pick(&later));
+    let (own, later) = by_first_rule_set(sel);
+    let mut picks = crate::pick::farthest_among(features, &own, n);
+    picks.extend(crate::pick::farthest_among(features, &later, n));
     picks
+}
+
+/// The indices of `sel`'s candidates of the first candidate's rule set, and of the rule sets
+/// planned after it (which follow them in search order).
+pub fn by_first_rule_set(sel: &Selection) -> (Vec<usize>, Vec<usize>) {
+    let first = sel.candidates.first().map(|c| c.grasp.rules);
+    (0..sel.candidates.len()).partition(|&i| Some(sel.candidates[i].grasp.rules) == first)
 }
 
 /// Puts the `ranked` candidates of `sel` first, in that order and with their closings, then

@@ -398,7 +398,8 @@ pub fn error_line(object: &str, index: Option<usize>, error: &str, label: LabelI
 }
 
 /// Plans `object`'s candidates as a run does, without checking any: every feasible grasp in
-/// search order, up to `candidates`.
+/// search order, up to `candidates`, the rule sets after the first that finds grasps included
+/// while fewer than the scenario's `max_checked` were found (what its search could reach).
 fn plan_candidates(
     scenario: &Scenario,
     object: &PreparedObject,
@@ -422,7 +423,7 @@ fn plan_candidates(
             domains: None,
             frame: scenario.object.frame,
             order_by_closing: None,
-            plan_reach: 0,
+            plan_reach: scenario.sim.selection.max_checked,
         },
         timings,
     )
@@ -455,7 +456,15 @@ pub fn label_object(
         .iter()
         .map(|c| feature_of(&c.grasp, &selection.axes[c.axis_plan].aligned, hand))
         .collect();
-    let picks = pick::farthest_points(&features, params.grasps);
+    // The first rule set's candidates first; the later rule sets' (planned when the first
+    // gave fewer than the search checks) fill what they leave of the K.
+    let (own, later) = crate::select::by_first_rule_set(&selection);
+    let mut picks = pick::farthest_among(&features, &own, params.grasps);
+    picks.extend(pick::farthest_among(
+        &features,
+        &later,
+        params.grasps - picks.len(),
+    ));
     let first: Vec<&Feature> = features.iter().take(picks.len()).collect();
     let picked: Vec<&Feature> = picks.iter().map(|&i| &features[i]).collect();
     let mut summary = ObjectSummary {

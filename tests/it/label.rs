@@ -425,3 +425,34 @@ fn a_finger_that_still_creeps_keeps_a_direction_open_until_the_slip() {
     assert_eq!(fast, full);
     assert_eq!(without.0, "hold", "{without:?}");
 }
+
+/// The kettle's first rule set that finds grasps finds three. A search that checks 8 goes on to
+/// the later rule sets, so `label` plans those too and fills its K from them; with
+/// `max_checked = 1` it labels the three alone. The three are labelled alike either way.
+#[test]
+fn label_covers_the_rule_sets_its_search_would_reach() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = crate::real_scenario_text("kitchen_kettle");
+    let run = |max_checked: usize| -> Vec<Value> {
+        let path = dir.path().join(format!("kettle_{max_checked}.toml"));
+        let text = format!("{base}\n[sim]\nmax_checked = {max_checked}\n");
+        std::fs::write(&path, text).unwrap();
+        let out = dir.path().join(format!("kettle_{max_checked}.jsonl"));
+        let (code, err) = label(
+            &[&path],
+            &["--grasps", "6", "--samples", "1", "--in-process"],
+            &out,
+        );
+        assert_eq!(code, Some(0), "{err}");
+        lines(&out)
+    };
+    let alone = run(1);
+    let covered = run(8);
+    let index = |v: &Value| v["grasp_index"].as_u64().unwrap();
+    assert_eq!(alone.iter().map(index).collect::<Vec<_>>(), [0, 1, 2]);
+    assert_eq!(covered.len(), 6);
+    assert!(covered[3..].iter().all(|v| index(v) >= 3));
+    for (a, c) in alone.iter().zip(&covered) {
+        assert_eq!(without_label(a), without_label(c));
+    }
+}
