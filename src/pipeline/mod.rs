@@ -535,13 +535,7 @@ fn select_grasps(
     };
     // `[sim] order_by_closing`: the closing alone, gravity off.
     let close = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> select::Preclosed {
-        let pose = sim::SimHand::from_grasp(g, &scenario.hand);
-        let shape = object.shape(a, &pose, &scenario.hand);
-        let f = sim::entry::closing_fidelity(&object.case(scenario, &pose, &shape));
-        select::Preclosed {
-            as_planned: f.as_planned,
-            shift_mm: f.shift_mm,
-        }
+        preclosed(scenario, object, a, g)
     };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
     let checks_candidates =
@@ -567,6 +561,23 @@ fn select_grasps(
         },
         timings,
     )
+}
+
+/// What grasp `g`'s closing on `a` does with gravity off (`[sim] order_by_closing`), as a run
+/// and a `tune` sweep rank it.
+pub(crate) fn preclosed(
+    scenario: &Scenario,
+    object: &PreparedObject,
+    a: &mesh::AlignedObject,
+    g: &plan::search::Grasp,
+) -> select::Preclosed {
+    let pose = sim::SimHand::from_grasp(g, &scenario.hand);
+    let shape = object.shape(a, &pose, &scenario.hand);
+    let f = sim::entry::closing_fidelity(&object.case(scenario, &pose, &shape));
+    select::Preclosed {
+        as_planned: f.as_planned,
+        shift_mm: f.shift_mm,
+    }
 }
 
 /// The analytic quality of every candidate when `--quality` asks for it.

@@ -702,8 +702,8 @@ fn run_override(
 }
 
 /// A planned object at one setting, planned and chosen as a run does (every axis, the extended
-/// rules when the thesis's find nothing, candidates checked until one holds). A grasp two
-/// settings share is simulated once.
+/// rules when the thesis's find nothing, candidates checked until one holds, in the order the
+/// closings give under `[sim] order_by_closing`). A grasp two settings share is simulated once.
 fn run_planned(
     p: &Prepared,
     params: &PlannerParams,
@@ -722,6 +722,10 @@ fn run_planned(
         let o = simulate(p, &pose, &shape, key, sims, counters);
         o.outcome
     };
+    // `[sim] order_by_closing`, as a run orders its search.
+    let close = |a: &AlignedObject, g: &plan::search::Grasp| -> crate::select::Preclosed {
+        crate::pipeline::preclosed(&p.scenario, &p.object, a, g)
+    };
     let mut t = StageTimings::default();
     let selection = crate::select::select(
         p.object.mesh(),
@@ -736,7 +740,7 @@ fn run_planned(
             recheck: None,
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,
-            order_by_closing: None,
+            order_by_closing: Some((p.scenario.sim.selection.order_by_closing, &close)),
             plan_reach: 0,
         },
         &mut t,

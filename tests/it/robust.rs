@@ -307,10 +307,15 @@ fn tune_ranks_settings_by_the_mean_hold_probability_first() {
     // 0.3 finds one that holds as planned in 6 of 8 samples while 0.5 and 0.7 find ones that
     // do in 7 of 8. By the payload margin and the translation alone 0.3 would come before 0.7
     // (the same margin, less translation); ranked by the probability of a hold as planned
-    // first it comes last.
+    // first it comes last. In the search order (`order_by_closing = 0`), as the ranking is
+    // what this tests.
     use grasp_sim::batch::{default_template, expand};
     use grasp_sim::tune::{parse_sweep, rank, tune};
-    let (dir, _s) = variant("chapter4", &format!("samples = 8\n{SQUEEZE_CLOSING}"), "");
+    let (dir, _s) = variant(
+        "chapter4",
+        &format!("samples = 8\norder_by_closing = 0\n{SQUEEZE_CLOSING}"),
+        "",
+    );
     let items = expand(&[dir.path().join("chapter4.toml")]).unwrap();
     let r = tune(
         &items,
