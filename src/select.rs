@@ -276,16 +276,22 @@ fn select_in(
     if stop.is_some_and(std::cell::Cell::get) {
         return sel;
     }
+    choose_rechecked(&mut sel, p);
+    sel
+}
+
+/// Chooses among `sel`'s checked candidates ([`choose`]), the candidates a failed closing
+/// decided checked again with `p.recheck` first when none succeeded; under `choose =
+/// "robust"` a candidate whose own closing failed can still be chosen by its samples, and its
+/// check is then made a full one.
+fn choose_rechecked(sel: &mut Selection, p: &SelectParams) {
     if let Some(recheck) = p.recheck {
-        recheck_failed_closings(&mut sel, recheck);
+        recheck_failed_closings(sel, recheck);
     }
     sel.chosen = choose(&sel.candidates);
-    // Under `choose = "robust"` a candidate whose own closing failed can still be chosen by its
-    // samples: the check reported is a full one.
     if let (Some(recheck), Some(i)) = (p.recheck, sel.chosen) {
-        recheck_if_closing_decided(&mut sel, i, recheck);
+        recheck_if_closing_decided(sel, i, recheck);
     }
-    sel
 }
 
 /// `[sim] order_by_closing = n` (issue 58), once the search's first check, `first_check`, found
@@ -294,8 +300,8 @@ fn select_in(
 /// the first too while fewer than `max` were found (what the search could reach); `n` of the
 /// first rule set's are picked for diversity as `label` picks them (the first always among
 /// them), and `n` of the later rule sets' ([`picks_by_rule_set`]); the picks are closed with
-/// gravity off, and they are checked in the order their closings give (as planned first, then the
-/// shift in whole millimetres, then the search order) until one succeeds, `max` have been
+/// gravity off, and they are checked in the order their closings give (as planned first, then
+/// the shift in whole millimetres, then the search order) until one succeeds, `max` have been
 /// checked, or one held and none left can hold as planned (their closings left the plan); the
 /// first's check is `first_check`. The selection lists the picks in that order, then the other
 /// candidates collected (`collect`) in search order. `None` when none of them succeeded
@@ -348,13 +354,7 @@ fn select_by_closing(
     if !has_hold(&sel) && !settled && sel.checked() < max {
         return None;
     }
-    if let Some(recheck) = p.recheck {
-        recheck_failed_closings(&mut sel, recheck);
-    }
-    sel.chosen = choose(&sel.candidates);
-    if let (Some(recheck), Some(i)) = (p.recheck, sel.chosen) {
-        recheck_if_closing_decided(&mut sel, i, recheck);
-    }
+    choose_rechecked(&mut sel, p);
     Some(sel)
 }
 

@@ -407,8 +407,8 @@ pub struct SelectionParams {
     pub max_checked: usize,
     /// Before the candidate search, up to this many candidates, picked for diversity as `label`
     /// picks them (the first always among them), and as many of the later rule sets' when the
-    /// first rule set gave fewer than `max_checked` (what the search would go on to), are closed with gravity off, and the search
-    /// checks them first, in the order their closings give: as planned, then the closing
+    /// first rule set gave fewer than `max_checked` (what the search would go on to), are
+    /// closed with gravity off, and the search checks them first, in the order their closings give: as planned, then the closing
     /// shift in whole millimetres, then the search order (issue 58: the closing predicts the
     /// hold where the plan's geometry does not); only when the first candidate's own closing
     /// leaves its plan. 0: the search order alone.
