@@ -197,12 +197,12 @@ pub fn select(
         return select_in(mesh, props, p, None, timings);
     }
     // `[sim] order_by_closing`: the search as without it, stopped at its first check if that
-    // check's closing left the plan.
+    // check did not succeed (its closing left the plan, or the grasp did not hold).
     let left = std::cell::Cell::new(false);
     let first_call = std::cell::Cell::new(true);
     let check = |a: &AlignedObject, g: &Grasp| -> SimOutcome {
         let out = (p.check)(a, g);
-        if first_call.replace(false) && !out.fidelity.as_planned {
+        if first_call.replace(false) && !out.succeeded() {
             left.set(true);
         }
         out
@@ -294,8 +294,8 @@ fn choose_rechecked(sel: &mut Selection, p: &SelectParams) {
     }
 }
 
-/// `[sim] order_by_closing = n` (issue 58), once the search's first check, `first_check`, found
-/// that the first candidate's closing left the plan: every candidate is planned as `label`
+/// `[sim] order_by_closing = n` (issue 58), once the search's first check, `first_check`, did
+/// not succeed (its closing left the plan, or the grasp it kept did not hold): every candidate is planned as `label`
 /// plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), and the rule sets after
 /// the first too while fewer than `max` were found (what the search could reach); `n` of the
 /// first rule set's are picked for diversity as `label` picks them (the first always among
@@ -324,7 +324,7 @@ fn select_by_closing(
         ..*p
     };
     let first = Preclosed {
-        as_planned: false,
+        as_planned: first_check.fidelity.as_planned,
         shift_mm: first_check.fidelity.shift_mm,
     };
     let mut sel = select_in(mesh, props, &plan_all, None, timings);
@@ -332,13 +332,13 @@ fn select_by_closing(
     let places = put_first(&mut sel, &ranked, p.collect);
     let mut first_check = Some(first_check);
     let mut settled = false;
-    for (k, place) in places.into_iter().enumerate() {
+    for (k, &place) in places.iter().enumerate() {
         if sel.checked() >= max || has_hold(&sel) {
             break;
         }
         // With fewer candidates than checks the search goes on as without the setting when
         // none succeeds (below), the rules beyond the thesis among it: no early end then.
-        if sel.candidates.len() >= max && held_and_none_left_can_succeed(&sel, k) {
+        if sel.candidates.len() >= max && held_and_none_left_can_succeed(&sel, k, &places) {
             settled = true;
             break;
         }
@@ -360,22 +360,25 @@ fn select_by_closing(
 
 /// True when a checked candidate of `sel` held and none from the `k`-th on can succeed: each
 /// was closed and its closing left the plan, which its check's closing does again (the same
-/// closing), so none can hold as planned; [`choose`] then takes the first that held, whatever
+/// closing), so none can hold as planned, or it is the search's first candidate (`places`: each
+/// one's place in search order), whose check did not succeed; [`choose`] then takes the first that held, whatever
 /// the rest would do. Not under `choose = "robust"` (a check with samples), whose success is
 /// the samples', not the closing's.
-fn held_and_none_left_can_succeed(sel: &Selection, k: usize) -> bool {
+fn held_and_none_left_can_succeed(sel: &Selection, k: usize, places: &[usize]) -> bool {
     let checked = || sel.candidates.iter().filter_map(|c| c.check.as_ref());
     checked().all(|o| o.robust.is_none())
         && checked().any(|o| o.verdict == Verdict::Hold)
         && sel.candidates[k..]
             .iter()
-            .all(|c| c.preclosed.is_some_and(|f| !f.as_planned))
+            .zip(&places[k..])
+            .all(|(c, &place)| place == 0 || c.preclosed.is_some_and(|f| !f.as_planned))
 }
 
 /// Up to `2n` of `sel`'s candidates picked for diversity ([`picks_by_rule_set`]), each
 /// with its closing by `close` (the first candidate's is `first`, closed already), in the
-/// order their closings give: as planned first, then the shift in whole millimetres, then the
-/// search order. The closings run in parallel; the order does not depend on the threads.
+/// order their closings give: as planned first (the first, whose check did not succeed, as
+/// one that left the plan), then the shift in whole millimetres, then the search order. The
+/// closings run in parallel; the order does not depend on the threads.
 fn ranked_by_closing(
     sel: &Selection,
     hand: &Hand,
@@ -402,9 +405,11 @@ fn ranked_by_closing(
         })
         .collect();
     let mut ranked: Vec<(usize, Preclosed)> = picks.into_iter().zip(closed).collect();
+    // The first was checked and did not succeed: it goes as one that left the plan.
+    let kept = |i: usize, f: &Preclosed| f.as_planned && i != 0;
     ranked.sort_by(|(i, a), (j, b)| {
-        b.as_planned
-            .cmp(&a.as_planned)
+        kept(*j, b)
+            .cmp(&kept(*i, a))
             .then(a.shift_mm.floor().total_cmp(&b.shift_mm.floor()))
             .then(i.cmp(j))
     });

@@ -71,8 +71,20 @@ impl GraspReport {
             Some(q) => format!("; epsilon {:.3} ({} contacts)", q.epsilon, q.source),
             None => String::new(),
         };
+        let closing = match &self.closing_order {
+            Some(c) => format!(
+                "; closed {}, {:.1} mm",
+                if c.as_planned {
+                    "as planned"
+                } else {
+                    "off plan"
+                },
+                c.shift_mm
+            ),
+            None => String::new(),
+        };
         format!(
-            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{check}{quality}",
+            "axis {} ({rules}), approach {:.0} deg, index {} (Z {:.1} mm), pitch {} deg, theta1/theta2 {}{closing}{check}{quality}",
             self.axis_name,
             self.approach_angle_deg,
             self.elevation_index,
@@ -191,9 +203,15 @@ impl RunReport {
             plural(p.candidates_tried, "candidate")
         );
         if p.grasps.len() > 1 {
+            // Under `[sim] order_by_closing` the closed picks come first, in the order checked.
+            let order = if p.grasps.iter().any(|g| g.closing_order.is_some()) {
+                "the closed ones first, in the order their closings gave"
+            } else {
+                "in search order"
+            };
             let _ = writeln!(
                 s,
-                "  Candidates  {} collected, in search order (* the one reported below):",
+                "  Candidates  {} collected, {order} (* the one reported below):",
                 p.grasps.len()
             );
             for (k, g) in p.grasps.iter().enumerate() {

@@ -782,8 +782,16 @@ fn the_summary_lists_every_candidate_collected_or_checked() {
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.contains("8 candidates tried, 8 checked"), "{text}");
+    // Its first candidate drops, so the search closes 16 picks and checks them in the order
+    // their closings gave (`[sim] order_by_closing`): 8 checked, every one a drop, each with
+    // its closing.
+    assert!(text.contains("667 candidates tried, 8 checked"), "{text}");
+    assert!(
+        text.contains("16 collected, the closed ones first, in the order their closings gave"),
+        "{text}"
+    );
     assert_eq!(text.matches("; check: drop (").count(), 8, "{text}");
+    assert_eq!(text.matches("; closed as planned, ").count(), 16, "{text}");
     // A single grasp is not listed twice.
     let out = crate::succeed(crate::grasp_sim().args(["scenarios/cup.toml", "--no-sim"]));
     let text = String::from_utf8_lossy(&out.stdout);

@@ -253,10 +253,12 @@ fn payload_margin_is_found_by_bisection() {
         "bracket {m} .. {failed}"
     );
     // The bracket is real: at the margin the grasp holds, at the failing multiplier it does not
-    // (the same grasp: a run would otherwise go on to the next candidate).
+    // (the same grasp: a run would otherwise go on to the next candidate, or to the one
+    // whose closing orders first).
     let check = |k: f64| {
         let mut heavier = s.clone();
         heavier.object.mass = grasp_sim::scenario::MassSpec::Mass(r.object.mass_kg * k);
+        heavier.sim.selection.order_by_closing = 0;
         let first_only = RunOptions {
             max_checked: Some(1),
             ..RunOptions::default()
