@@ -7,14 +7,17 @@ LABELS.jsonl is a `grasp-sim label` file made with the thesis's order (every `sf
 TUNE_DIR the output of `grasp-sim tune --labels LABELS.jsonl --out TUNE_DIR` (its tune.json
 gives each fold's factors and the objects it held out). Prints, for the thesis's order and for
 the tuned one on the folds it did not tune on: the first candidate's mean hold probability,
-the expected candidates checked before a hold, the AUC of the score against a hold as planned
-(within objects), each term's own AUC, and the ceiling (the best labelled candidate of the
+the expected candidates checked before a hold, the AUC of the order against a hold as planned
+(within objects), in the order tune.json measured (`search`: the first by the grade, then by the
+nominal closings, as a run's search checks them; `grade`: the grade alone, the AUC by its
+score), the same for the grade alone, each term's own AUC, and the ceiling (the best labelled candidate of the
 first axis plan, and of any). Writes FIGURE.svg: each labelled candidate's hold probability
 against its score's rank within its object (0: first), thesis beside tuned (held out).
 With --other, also the same measures on OTHER.jsonl, labels of objects the tuning never saw,
 under the factors tuned on every object of LABELS.jsonl.
 """
 import json
+import math
 import statistics
 import sys
 from collections import defaultdict
@@ -27,24 +30,43 @@ def score(c, f):
     return -g["place"] / max(g["found"], 1) + sum(f.get("sf_" + t, 0.0) * g["terms"][t] for t in TERMS)
 
 
-def ranked(cands, f):
+def by_grade(cands, f):
     """The candidates in the order the factors give: axis plans in search order, by score."""
     return sorted(cands, key=lambda c: (c["grade"]["axis_plan"], -score(c, f), c["grade"]["place"]))
 
 
-def measures(by, factors_of):
+def ranked(cands, f, order="grade"):
+    """The candidates in `order`: by the grade, or as a run's search checks them (`search`):
+    the first by the grade first if its nominal check held as planned; the others, and the
+    first if it did not as one off plan, as planned first, then by the closing's shift in whole
+    millimetres, then by the grade (`grasp-sim tune --order search`)."""
+    g = by_grade(cands, f)
+    if order != "search" or any("fidelity" not in c for c in g):
+        return g
+    first_held = g[0]["fidelity"]["as_planned"] and g[0]["verdict"] == "hold"
+
+    def key(i):
+        fid = g[i]["fidelity"]
+        return (not (i == 0 and first_held), not (fid["as_planned"] and i > 0), math.floor(fid["shift_mm"]), i)
+    return [g[i] for i in sorted(range(len(g)), key=key)]
+
+
+def measures(by, factors_of, order="grade"):
     first, checks, pairs, wins = [], [], 0, 0.0
     for name, cands in by.items():
         f = factors_of(name)
-        order = ranked(cands, f)
-        first.append(order[0]["hold_probability"])
+        order_ = ranked(cands, f, order)
+        first.append(order_[0]["hold_probability"])
         if any(c["hold_probability"] > 0 for c in cands):
             e, none_yet = 0.0, 1.0
-            for c in order[:8]:
+            for c in order_[:8]:
                 e += none_yet
                 none_yet *= 1 - c["hold_probability"]
             checks.append(e)
-        s = [(score(c, f), c["as_planned_probability"] >= 0.5) for c in cands]
+        if order == "search":
+            s = [(-k, c["as_planned_probability"] >= 0.5) for k, c in enumerate(order_)]
+        else:
+            s = [(score(c, f), c["as_planned_probability"] >= 0.5) for c in cands]
         for sa, pa in s:
             for sb, pb in s:
                 if pa and not pb:
@@ -64,9 +86,9 @@ def term_auc(by, key):
     return wins / pairs if pairs else float("nan")
 
 
-def figure(by, factors_of, path):
+def figure(by, factors_of, path, order="grade"):
     w, h, pad = 720, 300, 40
-    panels = [("thesis's order", lambda n: {}), ("tuned, held out", factors_of)]
+    panels = [(f"thesis's factors, the {order} order", lambda n: {}), (f"tuned, held out, the {order} order", factors_of)]
     out = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" font-family="sans-serif" font-size="11">',
            f'<rect width="{w}" height="{h}" fill="white"/>']
     pw = (w - 3 * pad) / 2
@@ -77,9 +99,9 @@ def figure(by, factors_of, path):
         out.append(f'<rect x="{x0}" y="{y0}" width="{pw}" height="{ph}" fill="none" stroke="#888"/>')
         means = defaultdict(list)
         for name, cands in by.items():
-            order = ranked(cands, fo(name))
-            n = len(order)
-            for i, c in enumerate(order):
+            ranks = ranked(cands, fo(name), order)
+            n = len(ranks)
+            for i, c in enumerate(ranks):
                 r = i / max(n - 1, 1)
                 means[min(int(r * 4), 3)].append(c["hold_probability"])
                 x = x0 + r * pw
@@ -125,9 +147,14 @@ def main(argv):
             fold_of[name] = fold["factors"]
     held = lambda name: fold_of.get(name, {})  # noqa: E731
     n = sum(len(c) for c in by.values())
-    print(f"{len(by)} objects, {n} labelled candidates, objective {tune['objective']}, {len(tune['folds'])} folds")
-    for label, fo in [("thesis's order", lambda _: {}), ("tuned, held out", held)]:
-        first, checks, auc = measures(by, fo)
+    order = tune.get("order", "grade")
+    print(f"{len(by)} objects, {n} labelled candidates, objective {tune['objective']}, {len(tune['folds'])} folds, "
+          f"the {order} order")
+    rows = [("thesis's factors", lambda _: {}, order), ("tuned, held out", held, order)]
+    if order == "search":
+        rows.append(("the grade alone, thesis's factors", lambda _: {}, "grade"))
+    for label, fo, o in rows:
+        first, checks, auc = measures(by, fo, o)
         print(f"{label}: first candidate's mean hold probability {first:.3f}, expected checks to a hold "
               f"{checks:.2f}, AUC against a hold as planned {auc:.3f}")
     for t in TERMS:
@@ -143,9 +170,9 @@ def main(argv):
         by2 = load(other)
         print(f"{other}: {len(by2)} objects the tuning never saw, {sum(len(c) for c in by2.values())} candidates")
         for label, fo in [("thesis's order", lambda _: {}), ("tuned on every object", lambda _: tune["factors"])]:
-            first, checks, auc = measures(by2, fo)
+            first, checks, auc = measures(by2, fo, order)
             print(f"  {label}: first candidate {first:.3f}, expected checks {checks:.2f}, AUC {auc:.3f}")
-    figure(by, held, argv[3])
+    figure(by, held, argv[3], order)
     print(f"wrote {argv[3]}")
     return 0
 

@@ -531,6 +531,12 @@ pub struct TuneArgs {
     #[arg(long, value_name = "OBJECTIVE", default_value = "first", requires = "labels",
           value_parser = grasp_sim::tune::order::Objective::parse)]
     pub objective: grasp_sim::tune::order::Objective,
+    /// With --labels: the order measured and tuned: `search` (the order a run's search checks
+    /// the candidates in: the first by the grade, then by their closings, `[sim]
+    /// order_by_closing`) or `grade` (the planner's grade alone).
+    #[arg(long, value_name = "ORDER", default_value = "search", requires = "labels",
+          value_parser = grasp_sim::tune::order::Order::parse)]
+    pub order: grasp_sim::tune::order::Order,
     /// With --labels: folds of the cross-validation over objects.
     #[arg(long, value_name = "K", default_value_t = 5, requires = "labels",
           value_parser = clap::value_parser!(u32).range(2..=100))]

@@ -77,9 +77,12 @@ fn dispatch(cli: cli::Cli) -> anyhow::Result<u8> {
             action: cli::HandCommand::Show { file, svg },
         }) => grasp_sim::hand_show::run(&file, svg.as_deref()),
         Some(Command::Tune(args)) => match &args.labels {
-            Some(labels) => {
-                grasp_sim::tune::order::run(labels, args.objective, args.folds as usize, &args.out)
-            }
+            Some(labels) => grasp_sim::tune::order::run(
+                labels,
+                (args.objective, args.order),
+                args.folds as usize,
+                &args.out,
+            ),
             None => grasp_sim::tune::command::run(&args.request(), &Bar::tune()),
         },
         Some(Command::Label(args)) => {

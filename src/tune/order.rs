@@ -16,6 +16,15 @@
 //! - `auc`: the probability that a candidate that holds as planned (`as_planned_probability`
 //!   at least 0.5) scores above one that does not, over the candidates of each object, pooled.
 //!
+//! Two orders can be measured ([`Order`]). `grade`: the planner's grade alone, the order of a
+//! search without `[sim] order_by_closing`; its AUC is the score's. `search` (the default): the
+//! order a run's search checks them in, read off each label's nominal check (its closing is
+//! the one the search runs). The first by the grade is checked; when that check does not hold
+//! as planned, the candidates are checked in the order their closings give (as planned first,
+//! then the shift in whole millimetres, then the grade), the first among them as not planned.
+//! Its AUC is by place in that order, the first first where it held as planned. The factors
+//! then decide the first candidate and the ties among the closings.
+//!
 //! The search is coordinate descent over the five factors with a shrinking step (8, 4, ..., 1/8),
 //! from the thesis's order (every factor 0). It is chosen over a grid, which grows as the
 //! step count to the fourth power, and over CMA-ES or a Bayesian search, which need random
@@ -76,6 +85,41 @@ pub struct Labelled {
     pub hold: f64,
     /// Its probability of a hold as planned.
     pub as_planned: f64,
+    /// What its nominal check's closing did (`fidelity`); `None` in a file without it.
+    pub closing: Option<LabelledClosing>,
+}
+
+/// What a labelled candidate's nominal closing did, gravity off: what `[sim]
+/// order_by_closing` ranks by.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LabelledClosing {
+    /// The closing kept the plan (`fidelity.as_planned`).
+    pub as_planned: bool,
+    /// The object's shift over the closing `[mm]` (`fidelity.shift_mm`).
+    pub shift_mm: f64,
+    /// The nominal check held as planned (`verdict` `hold` and `as_planned`).
+    pub held_as_planned: bool,
+}
+
+/// The order measured and tuned (see the module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Order {
+    /// The planner's grade alone.
+    Grade,
+    /// The order a run's search checks the candidates in (`[sim] order_by_closing`).
+    Search,
+}
+
+impl Order {
+    /// The order named `s`.
+    pub fn parse(s: &str) -> Result<Order, String> {
+        match s {
+            "grade" => Ok(Order::Grade),
+            "search" => Ok(Order::Search),
+            _ => Err(format!("`{s}` is not an order (grade, search)")),
+        }
+    }
 }
 
 /// Every object's labelled candidates, by object name.
@@ -116,6 +160,14 @@ pub fn read_labels(path: &Path) -> anyhow::Result<Labels> {
                 ]),
                 hold: v["hold_probability"].as_f64()?,
                 as_planned: v["as_planned_probability"].as_f64()?,
+                closing: (|| {
+                    Some(LabelledClosing {
+                        as_planned: v["fidelity"]["as_planned"].as_bool()?,
+                        shift_mm: v["fidelity"]["shift_mm"].as_f64()?,
+                        held_as_planned: v["fidelity"]["as_planned"].as_bool()?
+                            && v["verdict"].as_str()? == "hold",
+                    })
+                })(),
             })
         })();
         let l = parsed.ok_or_else(|| {
@@ -147,6 +199,39 @@ fn ordered<'a>(cands: &'a [Labelled], f: &OrderFactors) -> Vec<&'a Labelled> {
     v.into_iter().map(|(c, _)| c).collect()
 }
 
+/// The candidates of one object in the order `order` gives them with the factors `f`: under
+/// [`Order::Search`] as `select::select_by_closing` checks them (the first by the grade first
+/// if it held as planned; the others, and the first if it did not as not planned, by their
+/// closings: as planned first, then the shift in whole millimetres, then the grade's order);
+/// by the grade alone where a label has no closing.
+fn ordered_as<'a>(cands: &'a [Labelled], f: &OrderFactors, order: Order) -> Vec<&'a Labelled> {
+    let by_grade = ordered(cands, f);
+    let closings: Option<Vec<LabelledClosing>> = by_grade.iter().map(|c| c.closing).collect();
+    let (Order::Search, Some(closings)) = (order, closings) else {
+        return by_grade;
+    };
+    let first_held = closings.first().is_some_and(|k| k.held_as_planned);
+    // (comes first, as planned, whole millimetres); the first, checked, is not as planned
+    // unless it held so.
+    let key = |i: usize| {
+        let k = closings[i];
+        (
+            i == 0 && first_held,
+            k.as_planned && i > 0,
+            k.shift_mm.floor(),
+        )
+    };
+    let mut places: Vec<usize> = (0..by_grade.len()).collect();
+    places.sort_by(|&i, &j| {
+        let (a, b) = (key(i), key(j));
+        b.0.cmp(&a.0)
+            .then(b.1.cmp(&a.1))
+            .then(a.2.total_cmp(&b.2))
+            .then(i.cmp(&j))
+    });
+    places.into_iter().map(|i| by_grade[i]).collect()
+}
+
 /// The three measures of the order `f` gives the objects `names` of `labels`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Measures {
@@ -161,16 +246,17 @@ pub struct Measures {
     pub auc: f64,
 }
 
-/// The measures of `f` on `names`.
-pub fn measure(labels: &Labels, names: &[&str], f: &OrderFactors) -> Measures {
-    measure_with(labels, names, &|_| *f)
+/// The measures of `f` on `names` in `order`.
+pub fn measure(labels: &Labels, names: &[&str], f: &OrderFactors, order: Order) -> Measures {
+    measure_with(labels, names, &|_| *f, order)
 }
 
-/// The measures on `names`, each object ordered by its own factors `f(name)`.
+/// The measures on `names`, each object ordered by its own factors `f(name)` in `order`.
 pub fn measure_with(
     labels: &Labels,
     names: &[&str],
     factors: &dyn Fn(&str) -> OrderFactors,
+    order: Order,
 ) -> Measures {
     let (mut first, mut checks, mut holding) = (0.0, 0.0, 0usize);
     let (mut pairs, mut wins) = (0.0f64, 0.0f64);
@@ -179,23 +265,31 @@ pub fn measure_with(
             continue;
         };
         let f = &factors(name);
-        let order = ordered(cands, f);
-        first += order.first().map_or(0.0, |c| c.hold);
+        let ranked = ordered_as(cands, f, order);
+        first += ranked.first().map_or(0.0, |c| c.hold);
         if cands.iter().any(|c| c.hold > 0.0) {
             // E[checks] = Σ_k P(the first k − 1 failed), at most MAX_CHECKED checks.
             let (mut e, mut none_yet) = (0.0, 1.0);
-            for c in order.iter().take(MAX_CHECKED) {
+            for c in ranked.iter().take(MAX_CHECKED) {
                 e += none_yet;
                 none_yet *= 1.0 - c.hold;
             }
             checks += e;
             holding += 1;
         }
-        // Within the object: every (holds as planned, does not) pair, by score.
-        let scores: Vec<(f64, bool)> = cands
-            .iter()
-            .map(|c| (f.score(c.place, c.found, &c.terms), c.as_planned >= 0.5))
-            .collect();
+        // Within the object: every (holds as planned, does not) pair, by score (the grade's;
+        // in the search's order, the place in it, earlier higher).
+        let scores: Vec<(f64, bool)> = match order {
+            Order::Grade => cands
+                .iter()
+                .map(|c| (f.score(c.place, c.found, &c.terms), c.as_planned >= 0.5))
+                .collect(),
+            Order::Search => ranked
+                .iter()
+                .enumerate()
+                .map(|(k, c)| (-(k as f64), c.as_planned >= 0.5))
+                .collect(),
+        };
         for (sa, pa) in &scores {
             for (sb, pb) in &scores {
                 if *pa && !*pb {
@@ -236,10 +330,15 @@ fn value(m: &Measures, objective: Objective) -> f64 {
 }
 
 /// The factors coordinate descent finds on `names` (see the module docs).
-pub fn descend(labels: &Labels, names: &[&str], objective: Objective) -> OrderFactors {
+pub fn descend(
+    labels: &Labels,
+    names: &[&str],
+    objective: Objective,
+    order: Order,
+) -> OrderFactors {
     let mut x = [0.0f64; TERMS];
     let mut best = value(
-        &measure(labels, names, &OrderFactors::from_array(x)),
+        &measure(labels, names, &OrderFactors::from_array(x), order),
         objective,
     );
     let mut step = 8.0;
@@ -257,7 +356,7 @@ pub fn descend(labels: &Labels, names: &[&str], objective: Objective) -> OrderFa
                         crate::plan::order::MAX_FACTOR,
                     );
                     let v = value(
-                        &measure(labels, names, &OrderFactors::from_array(y)),
+                        &measure(labels, names, &OrderFactors::from_array(y), order),
                         objective,
                     );
                     // A strict gain, beyond float noise, or no move.
@@ -306,6 +405,8 @@ pub struct FoldResult {
 pub struct OrderTuning {
     /// The objective.
     pub objective: Objective,
+    /// The order measured.
+    pub order: Order,
     /// The folds.
     pub folds: Vec<FoldResult>,
     /// Every object scored by the factors tuned without its fold: the cross-validated estimate.
@@ -329,7 +430,7 @@ fn named(f: &OrderFactors) -> BTreeMap<String, f64> {
 }
 
 /// Tunes the factors on `labels` against `objective` with `folds`-fold cross-validation.
-pub fn tune(labels: &Labels, objective: Objective, folds: usize) -> OrderTuning {
+pub fn tune(labels: &Labels, objective: Objective, folds: usize, order: Order) -> OrderTuning {
     let folds = folds.max(2);
     let names: Vec<&str> = labels.keys().map(String::as_str).collect();
     let thesis = OrderFactors::default();
@@ -339,7 +440,7 @@ pub fn tune(labels: &Labels, objective: Objective, folds: usize) -> OrderTuning 
     for k in 0..folds {
         let (test, train): (Vec<&str>, Vec<&str>) =
             names.iter().partition(|n| fold_of(n, folds) == k);
-        let f = descend(labels, &train, objective);
+        let f = descend(labels, &train, objective, order);
         for n in &test {
             held_factors.insert(n, f);
         }
@@ -347,23 +448,24 @@ pub fn tune(labels: &Labels, objective: Objective, folds: usize) -> OrderTuning 
             fold: k,
             held_out: test.iter().map(|s| s.to_string()).collect(),
             factors: named(&f),
-            train: measure(labels, &train, &f),
-            train_thesis: measure(labels, &train, &thesis),
-            test: measure(labels, &test, &f),
-            test_thesis: measure(labels, &test, &thesis),
+            train: measure(labels, &train, &f, order),
+            train_thesis: measure(labels, &train, &thesis, order),
+            test: measure(labels, &test, &f, order),
+            test_thesis: measure(labels, &test, &thesis, order),
         });
     }
     // The cross-validated estimate: each object under its own fold's factors.
-    let held_out = measure_with(labels, &names, &|n| held_factors[n]);
-    let thesis_m = measure(labels, &names, &thesis);
-    let all = descend(labels, &names, objective);
+    let held_out = measure_with(labels, &names, &|n| held_factors[n], order);
+    let thesis_m = measure(labels, &names, &thesis, order);
+    let all = descend(labels, &names, objective, order);
     OrderTuning {
         objective,
+        order,
         folds: results,
         held_out,
         thesis: thesis_m,
         factors: named(&all),
-        in_sample: measure(labels, &names, &all),
+        in_sample: measure(labels, &names, &all, order),
         generalizes: value(&held_out, objective) > value(&thesis_m, objective) + 1e-12,
     }
 }
@@ -371,9 +473,10 @@ pub fn tune(labels: &Labels, objective: Objective, folds: usize) -> OrderTuning 
 /// The tuned factors as a `[planner]` table a scenario or template can hold.
 pub fn planner_toml(t: &OrderTuning) -> String {
     let mut s = format!(
-        "# The order's factors tuned by `grasp-sim tune --labels` (objective {:?}); held out, the \
-         first candidate's mean hold probability {:.3} against the thesis's {:.3}.\n[planner]\n",
-        t.objective, t.held_out.first, t.thesis.first
+        "# The order's factors tuned by `grasp-sim tune --labels` (objective {:?}, the {:?} \
+         order); held out, the first candidate's mean hold probability {:.3} against the \
+         thesis's {:.3}.\n[planner]\n",
+        t.objective, t.order, t.held_out.first, t.thesis.first
     );
     for (k, v) in &t.factors {
         s.push_str(&format!("{k} = {v:?}\n"));
@@ -388,7 +491,12 @@ pub fn planner_toml(t: &OrderTuning) -> String {
 /// # Errors
 /// A label file that cannot be read or holds no labelled object, an output that cannot be
 /// written.
-pub fn run(labels: &Path, objective: Objective, folds: usize, out: &Path) -> anyhow::Result<u8> {
+pub fn run(
+    labels: &Path,
+    (objective, order): (Objective, Order),
+    folds: usize,
+    out: &Path,
+) -> anyhow::Result<u8> {
     crate::pipeline::check_output_dir(out).context("--out")?;
     let l = read_labels(labels)?;
     if l.len() < folds.max(2) {
@@ -399,14 +507,18 @@ pub fn run(labels: &Path, objective: Objective, folds: usize, out: &Path) -> any
             folds.max(2)
         );
     }
-    let t = tune(&l, objective, folds);
+    let t = tune(&l, objective, folds, order);
     let m = |m: &Measures| format!("{:>6.3} {:>6.2} {:>6.3}", m.first, m.checks, m.auc);
     println!(
-        "order tuned on {} ({} objects, {} candidates), objective {objective:?}, {} folds",
+        "order tuned on {} ({} objects, {} candidates), objective {objective:?}, {} folds, measured in the {} order",
         labels.display(),
         l.len(),
         l.values().map(Vec::len).sum::<usize>(),
-        t.folds.len()
+        t.folds.len(),
+        match order {
+            Order::Grade => "grade's (the planner's grade alone)",
+            Order::Search => "search's (the grade's first, then the closings')",
+        }
     );
     println!("columns: first-candidate hold probability, expected checks to a hold, AUC");
     println!(
@@ -473,6 +585,7 @@ mod tests {
             terms: OrderTerms::from_array([0.0, 0.0, spread, 0.0, 0.0]),
             hold,
             as_planned: hold,
+            closing: None,
         }
     }
 
@@ -496,9 +609,10 @@ mod tests {
             &labels,
             &labels.keys().map(String::as_str).collect::<Vec<_>>(),
             &OrderFactors::default(),
+            Order::Search,
         );
         assert_eq!(thesis.first, 0.0);
-        let t = tune(&labels, Objective::First, 5);
+        let t = tune(&labels, Objective::First, 5, Order::Search);
         assert!(t.factors["sf_spread"] > 0.0, "{:?}", t.factors);
         assert_eq!(t.held_out.first, 1.0);
         assert!(t.generalizes);
@@ -513,8 +627,67 @@ mod tests {
         for i in 0..6 {
             labels.insert(format!("o{i}"), vec![cand(0, 0.2, 0.5), cand(5, 0.9, 0.5)]);
         }
-        let t = tune(&labels, Objective::First, 3);
+        let t = tune(&labels, Objective::First, 3, Order::Search);
         assert!(t.factors.values().all(|&v| v == 0.0), "{:?}", t.factors);
         assert!(!t.generalizes);
+    }
+
+    fn closed(place: usize, hold: f64, as_planned: bool, shift_mm: f64) -> Labelled {
+        Labelled {
+            closing: Some(LabelledClosing {
+                as_planned,
+                shift_mm,
+                held_as_planned: as_planned && hold > 0.5,
+            }),
+            ..cand(place, 0.5, hold)
+        }
+    }
+
+    /// The search's order, as `select_by_closing` checks: the grade's first when it held as
+    /// planned, else the closings' order (as planned first, then the shift in whole
+    /// millimetres, then the grade's order), the first among them as not planned; the AUC by
+    /// place.
+    #[test]
+    fn the_search_order_checks_the_first_then_by_the_closings() {
+        let object = |first: Labelled| {
+            let mut labels = Labels::new();
+            labels.insert(
+                "o".into(),
+                vec![
+                    first,
+                    closed(1, 0.0, false, 12.0),
+                    closed(2, 0.5, true, 1.9),
+                    closed(3, 1.0, true, 1.2),
+                    closed(4, 0.75, true, 0.4),
+                ],
+            );
+            labels
+        };
+        let f = OrderFactors::default();
+        let places = |labels: &Labels, order| -> Vec<usize> {
+            ordered_as(&labels["o"], &f, order)
+                .iter()
+                .map(|c| c.place)
+                .collect()
+        };
+        // The first held as planned: it stays first, the others by their closings (0.4 mm
+        // first; 1.9 and 1.2 both round down to 1 mm, the grade's order between them).
+        let held = object(closed(0, 1.0, true, 3.0));
+        assert_eq!(places(&held, Order::Grade), [0, 1, 2, 3, 4]);
+        assert_eq!(places(&held, Order::Search), [0, 4, 2, 3, 1]);
+        // The first left its plan by 30 mm: after every pick, by its shift.
+        let left = object(closed(0, 0.25, false, 30.0));
+        assert_eq!(places(&left, Order::Search), [4, 2, 3, 1, 0]);
+        let m = measure(&left, &["o"], &f, Order::Search);
+        assert_eq!(m.first, 0.75);
+        // Holding as planned (p >= 0.5): places 4, 2, 3, all before 1 and 0.
+        assert_eq!(m.auc, 1.0);
+        // E[checks] = 1 + 0.25 + 0.25 · 0.5 (then place 3 holds surely).
+        assert!((m.checks - 1.375).abs() < 1e-12, "{}", m.checks);
+        // By the grade: every holding candidate scores below both that do not (place order).
+        assert_eq!(measure(&left, &["o"], &f, Order::Grade).auc, 0.0);
+        // A first whose closing kept the plan but did not hold: checked, so not as planned.
+        let fell = object(closed(0, 0.0, true, 0.2));
+        assert_eq!(places(&fell, Order::Search), [4, 2, 3, 0, 1]);
     }
 }
