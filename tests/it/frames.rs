@@ -4,7 +4,9 @@
 //! verdict is decided by the physics and not by round-off.
 //!
 //! With the physics check (the ignored test without `GRASP_SIM_FRAMES_NO_SIM`), a run checks
-//! candidates in search order until one holds. It must load the same object in every frame
+//! candidates in search order until one holds (`[sim] order_by_closing = 0`: the closing order
+//! ranks candidates by their closings, which are as chaotic as the verdicts, so its picks and
+//! their order may differ between frames; docs/FRAMES.md gives what it changes). It must load the same object in every frame
 //! (volume, mass and kind of collider) and check the same candidates in the same order, each
 //! the same grasp. Where a candidate's verdict differs between two frames, it is sampled under
 //! perturbation in both (`choose = "robust"`, every candidate sampled
@@ -137,6 +139,8 @@ fn plan_in(
     let mut s = base.clone();
     s.object.mesh = path;
     s.object.units = grasp_sim::mesh::LengthUnit::Mm;
+    // The search's order, candidate by candidate (the module docs).
+    s.sim.selection.order_by_closing = 0;
     if let Mode::Sampled(n) = mode {
         s.sim.robust.samples = n;
         s.sim.robust.choose = grasp_sim::sim::params::Choose::Robust;
