@@ -114,12 +114,14 @@ pub struct PlanReport {
     /// The first feasible grasp (the thesis's Grasp Parameter Set).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub grasp: Option<GraspReport>,
-    /// Every feasible grasp collected, in search order (across axes and rules): with
-    /// `--candidates N` at least N, with the physics check every candidate checked, each with
-    /// its verdict. Empty when the first grasp is the only one (it is `grasp`).
+    /// Every feasible grasp collected, in search order (across axes and rules; under `[sim]
+    /// order_by_closing` the closed picks first, in the order checked, each with its
+    /// `closing_order`): with `--candidates N` at least N, with the physics check every
+    /// candidate checked, each with its verdict. Empty when the first grasp is the only one (it
+    /// is `grasp`).
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub grasps: Vec<GraspReport>,
-    /// Candidates the physics check ran on, in search order until one held.
+    /// Candidates the physics check ran on, in the order checked until one held.
     pub candidates_checked: usize,
     /// Vertical slices (of the axis reported) with a contour that stays open after its ends
     /// were joined: an open mesh's gaps wider than the joining tolerance.
