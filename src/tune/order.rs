@@ -478,6 +478,13 @@ pub fn planner_toml(t: &OrderTuning) -> String {
          thesis's {:.3}.\n[planner]\n",
         t.objective, t.order, t.held_out.first, t.thesis.first
     );
+    if !t.generalizes {
+        s.insert_str(
+            0,
+            "# Held out, these factors do not beat the thesis's (every factor 0) on the \
+             objective: keep the thesis's.\n",
+        );
+    }
     for (k, v) in &t.factors {
         s.push_str(&format!("{k} = {v:?}\n"));
     }
@@ -616,6 +623,7 @@ mod tests {
         assert!(t.factors["sf_spread"] > 0.0, "{:?}", t.factors);
         assert_eq!(t.held_out.first, 1.0);
         assert!(t.generalizes);
+        assert!(planner_toml(&t).starts_with("# The order's factors tuned"));
         assert_eq!(t.held_out.checks, 1.0);
         assert!((thesis.checks - 2.9).abs() < 1e-12, "{}", thesis.checks);
     }
@@ -630,6 +638,7 @@ mod tests {
         let t = tune(&labels, Objective::First, 3, Order::Search);
         assert!(t.factors.values().all(|&v| v == 0.0), "{:?}", t.factors);
         assert!(!t.generalizes);
+        assert!(planner_toml(&t).starts_with("# Held out, these factors do not beat"));
     }
 
     fn closed(place: usize, hold: f64, as_planned: bool, shift_mm: f64) -> Labelled {
