@@ -37,13 +37,13 @@ def by_grade(cands, f):
 
 def ranked(cands, f, order="grade"):
     """The candidates in `order`: by the grade, or as a run's search checks them (`search`):
-    the first by the grade first if its nominal check held as planned; the others, and the
+    the first by the grade first if its nominal closing kept the plan; the others, and the
     first if it did not as one off plan, as planned first, then by the closing's shift in whole
     millimetres, then by the grade (`grasp-sim tune --order search`)."""
     g = by_grade(cands, f)
     if order != "search" or any("fidelity" not in c for c in g):
         return g
-    first_held = g[0]["fidelity"]["as_planned"] and g[0]["verdict"] == "hold"
+    first_held = g[0]["fidelity"]["as_planned"]
 
     def key(i):
         fid = g[i]["fidelity"]

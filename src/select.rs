@@ -197,12 +197,13 @@ pub fn select(
         return select_in(mesh, props, p, None, timings);
     }
     // `[sim] order_by_closing`: the search as without it, stopped at its first check if that
-    // check did not succeed (its closing left the plan, or the grasp did not hold).
+    // check did not succeed: its closing left the plan, or, with checks to spare, the grasp it
+    // kept did not hold (that check counts, [`select_by_closing`]).
     let left = std::cell::Cell::new(false);
     let first_call = std::cell::Cell::new(true);
     let check = |a: &AlignedObject, g: &Grasp| -> SimOutcome {
         let out = (p.check)(a, g);
-        if first_call.replace(false) && !out.succeeded() {
+        if first_call.replace(false) && !out.succeeded() && (max > 1 || !out.fidelity.as_planned) {
             left.set(true);
         }
         out
@@ -331,10 +332,21 @@ fn select_by_closing(
     let ranked = ranked_by_closing(&sel, p.hand, (n, close), first);
     let places = put_first(&mut sel, &ranked, p.collect);
     let mut first_check = Some(first_check);
+    // A first whose closing kept the plan was judged by its hold: that check counts from the
+    // start (with `max` 1 the search ends there). One whose closing left it was judged by the
+    // closing alone, as every pick is: its check counts if the order comes back to it.
+    if first.as_planned {
+        if let Some(k) = places.iter().position(|&place| place == 0) {
+            sel.candidates[k].check = first_check.take();
+        }
+    }
     let mut settled = false;
     for (k, &place) in places.iter().enumerate() {
         if sel.checked() >= max || has_hold(&sel) {
             break;
+        }
+        if sel.candidates[k].check.is_some() {
+            continue;
         }
         // With fewer candidates than checks the search goes on as without the setting when
         // none succeeds (below), the rules beyond the thesis among it: no early end then.

@@ -19,11 +19,11 @@
 //! Two orders can be measured ([`Order`]). `grade`: the planner's grade alone, the order of a
 //! search without `[sim] order_by_closing`; its AUC is the score's. `search` (the default): the
 //! order a run's search checks them in, read off each label's nominal check (its closing is
-//! the one the search runs). The first by the grade is checked; when that check does not hold
-//! as planned, the candidates are checked in the order their closings give (as planned first,
-//! then the shift in whole millimetres, then the grade), the first among them as not planned.
-//! Its AUC is by place in that order, the first first where it held as planned. The factors
-//! then decide the first candidate and the ties among the closings.
+//! the one the search runs). The first by the grade is checked first where its closing kept
+//! the plan, and the others follow in the order their closings give (as planned first, then
+//! the shift in whole millimetres, then the grade); where its closing left the plan it is
+//! ranked among them as one off plan. Its AUC is by place in that order. The factors then
+//! decide the first candidate and the ties among the closings.
 //!
 //! The search is coordinate descent over the five factors with a shrinking step (8, 4, ..., 1/8),
 //! from the thesis's order (every factor 0). It is chosen over a grid, which grows as the
@@ -97,8 +97,6 @@ pub struct LabelledClosing {
     pub as_planned: bool,
     /// The object's shift over the closing `[mm]` (`fidelity.shift_mm`).
     pub shift_mm: f64,
-    /// The nominal check held as planned (`verdict` `hold` and `as_planned`).
-    pub held_as_planned: bool,
 }
 
 /// The order measured and tuned (see the module docs).
@@ -164,8 +162,6 @@ pub fn read_labels(path: &Path) -> anyhow::Result<Labels> {
                     Some(LabelledClosing {
                         as_planned: v["fidelity"]["as_planned"].as_bool()?,
                         shift_mm: v["fidelity"]["shift_mm"].as_f64()?,
-                        held_as_planned: v["fidelity"]["as_planned"].as_bool()?
-                            && v["verdict"].as_str()? == "hold",
                     })
                 })(),
             })
@@ -201,22 +197,22 @@ fn ordered<'a>(cands: &'a [Labelled], f: &OrderFactors) -> Vec<&'a Labelled> {
 
 /// The candidates of one object in the order `order` gives them with the factors `f`: under
 /// [`Order::Search`] as `select::select_by_closing` checks them (the first by the grade first
-/// if it held as planned; the others, and the first if it did not as not planned, by their
-/// closings: as planned first, then the shift in whole millimetres, then the grade's order);
-/// by the grade alone where a label has no closing.
+/// if its closing kept the plan; the others, and the first if it did not as one off plan, by
+/// their closings: as planned first, then the shift in whole millimetres, then the grade's
+/// order); by the grade alone where a label has no closing.
 fn ordered_as<'a>(cands: &'a [Labelled], f: &OrderFactors, order: Order) -> Vec<&'a Labelled> {
     let by_grade = ordered(cands, f);
     let closings: Option<Vec<LabelledClosing>> = by_grade.iter().map(|c| c.closing).collect();
     let (Order::Search, Some(closings)) = (order, closings) else {
         return by_grade;
     };
-    let first_held = closings.first().is_some_and(|k| k.held_as_planned);
-    // (comes first, as planned, whole millimetres); the first, checked, is not as planned
-    // unless it held so.
+    let first_kept = closings.first().is_some_and(|k| k.as_planned);
+    // (comes first, as planned, whole millimetres); the first, checked first where its closing
+    // kept the plan, else one off plan.
     let key = |i: usize| {
         let k = closings[i];
         (
-            i == 0 && first_held,
+            i == 0 && first_kept,
             k.as_planned && i > 0,
             k.shift_mm.floor(),
         )
@@ -646,16 +642,15 @@ mod tests {
             closing: Some(LabelledClosing {
                 as_planned,
                 shift_mm,
-                held_as_planned: as_planned && hold > 0.5,
             }),
             ..cand(place, 0.5, hold)
         }
     }
 
-    /// The search's order, as `select_by_closing` checks: the grade's first when it held as
-    /// planned, else the closings' order (as planned first, then the shift in whole
-    /// millimetres, then the grade's order), the first among them as not planned; the AUC by
-    /// place.
+    /// The search's order, as `select_by_closing` checks: the grade's first when its closing
+    /// kept the plan, then the closings' order (as planned first, then the shift in whole
+    /// millimetres, then the grade's order), the first among them as one off plan where its
+    /// closing left it; the AUC by place.
     #[test]
     fn the_search_order_checks_the_first_then_by_the_closings() {
         let object = |first: Labelled| {
@@ -679,7 +674,7 @@ mod tests {
                 .map(|c| c.place)
                 .collect()
         };
-        // The first held as planned: it stays first, the others by their closings (0.4 mm
+        // The first closed as planned: it stays first, the others by their closings (0.4 mm
         // first; 1.9 and 1.2 both round down to 1 mm, the grade's order between them).
         let held = object(closed(0, 1.0, true, 3.0));
         assert_eq!(places(&held, Order::Grade), [0, 1, 2, 3, 4]);
@@ -695,8 +690,9 @@ mod tests {
         assert!((m.checks - 1.375).abs() < 1e-12, "{}", m.checks);
         // By the grade: every holding candidate scores below both that do not (place order).
         assert_eq!(measure(&left, &["o"], &f, Order::Grade).auc, 0.0);
-        // A first whose closing kept the plan but did not hold: checked, so not as planned.
+        // A first whose closing kept the plan but did not hold is still checked first.
         let fell = object(closed(0, 0.0, true, 0.2));
-        assert_eq!(places(&fell, Order::Search), [4, 2, 3, 0, 1]);
+        assert_eq!(places(&fell, Order::Search), [0, 4, 2, 3, 1]);
+        assert_eq!(measure(&fell, &["o"], &f, Order::Search).first, 0.0);
     }
 }

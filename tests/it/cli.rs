@@ -782,16 +782,28 @@ fn the_summary_lists_every_candidate_collected_or_checked() {
         .output()
         .unwrap();
     let text = String::from_utf8_lossy(&out.stdout);
-    // Its first candidate drops, so the search closes 16 picks and checks them in the order
-    // their closings gave (`[sim] order_by_closing`): 8 checked, every one a drop, each with
-    // its closing.
+    // Its first candidate closes as planned and drops, so the search closes 16 picks and
+    // checks them in the order their closings gave after it (`[sim] order_by_closing`): 8
+    // checked, the first among them, every one a drop, each with its closing.
     assert!(text.contains("667 candidates tried, 8 checked"), "{text}");
+    assert!(
+        text.contains("* 1. axis least (thesis), approach 140 deg, index 43 "),
+        "{text}"
+    );
     assert!(
         text.contains("16 collected, the closed ones first, in the order their closings gave"),
         "{text}"
     );
     assert_eq!(text.matches("; check: drop (").count(), 8, "{text}");
     assert_eq!(text.matches("; closed as planned, ").count(), 16, "{text}");
+    // With one check allowed (`max_checked = 1`), a first that closed as planned and dropped
+    // is the answer: its check counted, nothing else planned or closed.
+    let out = crate::grasp_sim()
+        .args(["scenarios/sim_cup_weak_motors.toml"])
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("1 candidate tried, 1 checked"), "{text}");
     // A single grasp is not listed twice.
     let out = crate::succeed(crate::grasp_sim().args(["scenarios/cup.toml", "--no-sim"]));
     let text = String::from_utf8_lossy(&out.stdout);
