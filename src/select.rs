@@ -296,8 +296,8 @@ fn choose_rechecked(sel: &mut Selection, p: &SelectParams) {
 }
 
 /// `[sim] order_by_closing = n` (issue 58), once the search's first check, `first_check`, did
-/// not succeed (its closing left the plan, or the grasp it kept did not hold): every candidate is planned as `label`
-/// plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), and the rule sets after
+/// not succeed (its closing left the plan, or the grasp it kept did not hold): every
+/// candidate is planned as `label` plans them (up to [`crate::pick::DEFAULT_CANDIDATES`], unchecked), and the rule sets after
 /// the first too while fewer than `max` were found (what the search could reach); `n` of the
 /// first rule set's are picked for diversity as `label` picks them (the first always among
 /// them), and `n` of the later rule sets' ([`picks_by_rule_set`]); the picks are closed with
@@ -332,21 +332,10 @@ fn select_by_closing(
     let ranked = ranked_by_closing(&sel, p.hand, (n, close), first);
     let places = put_first(&mut sel, &ranked, p.collect);
     let mut first_check = Some(first_check);
-    // A first whose closing kept the plan was judged by its hold: that check counts from the
-    // start (with `max` 1 the search ends there). One whose closing left it was judged by the
-    // closing alone, as every pick is: its check counts if the order comes back to it.
-    if first.as_planned {
-        if let Some(k) = places.iter().position(|&place| place == 0) {
-            sel.candidates[k].check = first_check.take();
-        }
-    }
     let mut settled = false;
     for (k, &place) in places.iter().enumerate() {
         if sel.checked() >= max || has_hold(&sel) {
             break;
-        }
-        if sel.candidates[k].check.is_some() {
-            continue;
         }
         // With fewer candidates than checks the search goes on as without the setting when
         // none succeeds (below), the rules beyond the thesis among it: no early end then.
@@ -373,8 +362,8 @@ fn select_by_closing(
 /// True when a checked candidate of `sel` held and none from the `k`-th on can succeed: each
 /// was closed and its closing left the plan, which its check's closing does again (the same
 /// closing), so none can hold as planned, or it is the search's first candidate (`places`: each
-/// one's place in search order), whose check did not succeed; [`choose`] then takes the first that held, whatever
-/// the rest would do. Not under `choose = "robust"` (a check with samples), whose success is
+/// one's place in search order), whose check did not succeed; [`choose`] then takes the first
+/// that held, whatever the rest would do. Not under `choose = "robust"` (a check with samples), whose success is
 /// the samples', not the closing's.
 fn held_and_none_left_can_succeed(sel: &Selection, k: usize, places: &[usize]) -> bool {
     let checked = || sel.candidates.iter().filter_map(|c| c.check.as_ref());
@@ -388,9 +377,11 @@ fn held_and_none_left_can_succeed(sel: &Selection, k: usize, places: &[usize]) -
 
 /// Up to `2n` of `sel`'s candidates picked for diversity ([`picks_by_rule_set`]), each
 /// with its closing by `close` (the first candidate's is `first`, closed already), in the
-/// order their closings give: as planned first (the first, whose check did not succeed, as
-/// one that left the plan), then the shift in whole millimetres, then the search order. The
-/// closings run in parallel; the order does not depend on the threads.
+/// order they are checked in. The first, checked already, comes first where its closing kept
+/// the plan (its hold judged it: that check counts from the start); where its closing left the
+/// plan it was judged by the closing alone, as every pick is, and goes among them. Then as
+/// planned first, then the shift in whole millimetres, then the search order. The closings run
+/// in parallel; the order does not depend on the threads.
 fn ranked_by_closing(
     sel: &Selection,
     hand: &Hand,
@@ -417,11 +408,11 @@ fn ranked_by_closing(
         })
         .collect();
     let mut ranked: Vec<(usize, Preclosed)> = picks.into_iter().zip(closed).collect();
-    // The first was checked and did not succeed: it goes as one that left the plan.
-    let kept = |i: usize, f: &Preclosed| f.as_planned && i != 0;
+    // (checked first, kept the plan): the first comes first where its closing kept the plan.
+    let key = |i: usize, f: &Preclosed| (i == 0 && f.as_planned, f.as_planned);
     ranked.sort_by(|(i, a), (j, b)| {
-        kept(*j, b)
-            .cmp(&kept(*i, a))
+        key(*j, b)
+            .cmp(&key(*i, a))
             .then(a.shift_mm.floor().total_cmp(&b.shift_mm.floor()))
             .then(i.cmp(j))
     });
