@@ -109,6 +109,7 @@ fn bench_plan(c: &mut Criterion) {
                         max_checked: None,
                         check: &never,
                         recheck: None,
+                        probe: None,
                         domains: None,
                         frame: grasp_sim::mesh::FrameRule::File,
                         order_by_closing: None,

@@ -98,6 +98,7 @@ fn plan_one(path: &Path, collect: usize) -> Result<Planned, String> {
             max_checked: None,
             check: &no_check,
             recheck: None,
+            probe: None,
             domains: None,
             frame: sc.object.frame,
             order_by_closing: None,

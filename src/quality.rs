@@ -981,6 +981,7 @@ mod tests {
                     max_checked: None,
                     check: &no_check,
                     recheck: None,
+                    probe: None,
                     domains: None,
                     frame: sc.object.frame,
                     order_by_closing: None,

@@ -161,6 +161,13 @@ pub struct SelectParams<'a> {
     /// is known. `None`: never (no check that `check` returns is decided by the closing).
     #[allow(clippy::type_complexity)]
     pub recheck: Option<&'a dyn Fn(&AlignedObject, &Grasp) -> SimOutcome>,
+    /// Under `[sim] order_by_closing`, the search's first check
+    /// ([`crate::sim::entry::search_probe`]): where the closing left the plan, the closing
+    /// alone, gravity never on (the closings' order decides what follows, and the first's
+    /// hold is run only if that order comes back to it); elsewhere `check`'s outcome, to the
+    /// bit. `None`: `check`.
+    #[allow(clippy::type_complexity)]
+    pub probe: Option<&'a dyn Fn(&AlignedObject, &Grasp) -> SimOutcome>,
     /// Stage-1 domains kept across calls (a parameter sweep): they depend only on the axis, the
     /// rule set, the AngularStep and the HeightStep. `None`: built afresh.
     pub domains: Option<&'a DomainCache>,
@@ -202,8 +209,12 @@ pub fn select(
     let left = std::cell::Cell::new(false);
     let first_call = std::cell::Cell::new(true);
     let check = |a: &AlignedObject, g: &Grasp| -> SimOutcome {
-        let out = (p.check)(a, g);
-        if first_call.replace(false) && !out.succeeded() && (max > 1 || !out.fidelity.as_planned) {
+        let first = first_call.replace(false);
+        let out = match p.probe {
+            Some(probe) if first => probe(a, g),
+            _ => (p.check)(a, g),
+        };
+        if first && !out.succeeded() && (max > 1 || !out.fidelity.as_planned) {
             left.set(true);
         }
         out
@@ -320,6 +331,7 @@ fn select_by_closing(
         collect: crate::pick::DEFAULT_CANDIDATES.max(p.collect),
         max_checked: None,
         recheck: None,
+        probe: None,
         order_by_closing: None,
         plan_reach: max,
         ..*p
@@ -343,7 +355,8 @@ fn select_by_closing(
             settled = true;
             break;
         }
-        let out = match first_check.take_if(|_| place == 0) {
+        // The first's check is reused unless its closing alone was run (the probe).
+        let out = match first_check.take_if(|o| place == 0 && !o.decided_by_closing()) {
             Some(out) => out,
             None => {
                 let c = &sel.candidates[k];
@@ -803,6 +816,7 @@ mod tests {
                 max_checked: None,
                 check: &no_check,
                 recheck: None,
+                probe: None,
                 domains: None,
                 frame: FrameRule::default(),
                 order_by_closing: None,

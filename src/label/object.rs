@@ -420,6 +420,7 @@ fn plan_candidates(
             max_checked: None,
             check: &no_check,
             recheck: None,
+            probe: None,
             domains: None,
             frame: scenario.object.frame,
             order_by_closing: None,

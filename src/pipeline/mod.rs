@@ -533,6 +533,11 @@ fn select_grasps(
     let recheck = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
         check_grasp(scenario, object, a, g, sim::entry::search_in_full)
     };
+    // `[sim] order_by_closing`: the search's first check, where its closing left the plan
+    // the closing alone (`select::SelectParams::probe`).
+    let probe = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> sim::SimOutcome {
+        check_grasp(scenario, object, a, g, sim::entry::search_probe)
+    };
     // `[sim] order_by_closing`: the closing alone, gravity off.
     let close = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> select::Preclosed {
         preclosed(scenario, object, a, g)
@@ -554,6 +559,7 @@ fn select_grasps(
             max_checked: checks_candidates.then_some(max_checked.max(1)),
             check: &check,
             recheck: Some(&recheck),
+            probe: Some(&probe),
             domains: None,
             frame: scenario.object.frame,
             order_by_closing: Some((scenario.sim.selection.order_by_closing, &close)),

@@ -10,7 +10,7 @@
 //! that a replay checks the grasp the run without it chose.
 
 use super::outcome::{SimOutcome, Verdict};
-use super::params::Choose;
+use super::params::{Choose, Protocol};
 use super::payload::{check_with_payload, payload_bracket};
 use super::protocol::check;
 use super::robust::{check_sample, sample, Perturbation, Perturbed};
@@ -27,6 +27,27 @@ pub fn search(case: &Case) -> SimOutcome {
         out.robust = Some(sample(case));
     }
     out
+}
+
+/// The search's first check under `[sim] order_by_closing` ([`crate::select::SelectParams::probe`]):
+/// [`search`], except that a closing that left the plan decides the check at once, gravity
+/// never on (as under `[sim] closing_decides`): the closings' order then decides what is
+/// checked, and the hold of this grasp runs only if that order comes back to it. Where the
+/// closing kept the plan the hold runs as in [`search`], to the bit: the setting acts only on
+/// a failed closing ([`super::hold`]). In full under the `full` protocol, and under `choose =
+/// "robust"` with samples, whose success is the samples' and not the closing's.
+pub fn search_probe(case: &Case) -> SimOutcome {
+    let rp = &case.params.robust;
+    let robust = rp.samples > 1 && rp.choose == Choose::Robust;
+    if robust || case.params.protocol != Protocol::Fast || case.params.hold.closing_decides {
+        return search(case);
+    }
+    let mut params = case.params.clone();
+    params.hold.closing_decides = true;
+    check(&Case {
+        params: &params,
+        ..*case
+    })
 }
 
 /// [`search`] in full, whatever `[sim] closing_decides` says: the re-check of a candidate the

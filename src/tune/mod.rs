@@ -738,6 +738,7 @@ fn run_planned(
             max_checked: Some(p.scenario.sim.selection.max_checked.max(1)),
             check: &check,
             recheck: None,
+            probe: None,
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,
             order_by_closing: Some((p.scenario.sim.selection.order_by_closing, &close)),

@@ -9,6 +9,15 @@ use grasp_sim::sim::{self, Case, ObjectShape, SimHand, Verdict};
 /// The D40 cylinder's planned grasp, its palm moved `backoff_mm` away from the object along its
 /// normal, checked with `params`.
 fn d40_backed_off(backoff_mm: f64, params: &SimParams) -> sim::SimOutcome {
+    d40_backed_off_by(backoff_mm, params, sim::check)
+}
+
+/// [`d40_backed_off`] by the check `check` (a [`sim::entry`] point).
+fn d40_backed_off_by(
+    backoff_mm: f64,
+    params: &SimParams,
+    check: fn(&Case) -> sim::SimOutcome,
+) -> sim::SimOutcome {
     let hand =
         grasp_sim::hand::Hand::load(&crate::root().join("assets/hands/thesis.toml"), &[]).unwrap();
     let aligned = grasp_sim::mesh::align(&grasp_sim::objects::cylinder(40.0, 124.0));
@@ -24,7 +33,7 @@ fn d40_backed_off(backoff_mm: f64, params: &SimParams) -> sim::SimOutcome {
     pose.origin_mm += pose.axes[0] * backoff_mm;
     let volume = grasp_sim::mesh::mass_properties(&aligned.mesh).volume_mm3;
     let shape = ObjectShape::from_mesh(&aligned.mesh, volume);
-    sim::check(&Case {
+    check(&Case {
         hand: &hand,
         pose: &pose,
         object: &shape,
@@ -203,6 +212,42 @@ fn with_closing_decides_a_failed_closing_is_judged_without_a_hold() {
     assert_eq!(
         (flush.steps, &flush.directions),
         (flush_default.steps, &flush_default.directions)
+    );
+}
+
+#[test]
+fn the_search_probes_its_first_candidate_by_the_closing_alone() {
+    // `[sim] order_by_closing`'s first check (`sim::entry::search_probe`): the D40 with the
+    // palm 10 mm off is pushed past the bound, so its check ends with the closing, no step
+    // of hold, the same closing as the full check's (which holds under gravity); flush, it is
+    // as planned and the probe is the search's check, step for step.
+    let six = SimParams {
+        gravity: grasp_sim::scenario::GravityMode::Six,
+        ..SimParams::default()
+    };
+    let search = sim::entry::search;
+    let probe = sim::entry::search_probe;
+    let held = d40_backed_off_by(10.0, &six, search);
+    let probed = d40_backed_off_by(10.0, &six, probe);
+    assert!(!held.fidelity.as_planned && held.verdict == Verdict::Hold);
+    assert_eq!(
+        (&probed.closing, &probed.fidelity),
+        (&held.closing, &held.fidelity)
+    );
+    assert!(probed.decided_by_closing() && !probed.succeeded());
+    let closing_steps = (held.directions[0].closed_at_s / six.solver.timestep_s).round() as usize;
+    assert_eq!(probed.steps, closing_steps);
+    assert!(held.steps > closing_steps + 6 * 10, "{} steps", held.steps);
+    let flush = d40_backed_off_by(0.0, &six, search);
+    let flush_probed = d40_backed_off_by(0.0, &six, probe);
+    assert!(flush.held_as_planned());
+    assert_eq!(
+        (
+            flush_probed.steps,
+            &flush_probed.directions,
+            &flush_probed.fidelity
+        ),
+        (flush.steps, &flush.directions, &flush.fidelity)
     );
 }
 
