@@ -39,15 +39,10 @@ pub fn search(case: &Case) -> SimOutcome {
 pub fn search_probe(case: &Case) -> SimOutcome {
     let rp = &case.params.robust;
     let robust = rp.samples > 1 && rp.choose == Choose::Robust;
-    if robust || case.params.protocol != Protocol::Fast || case.params.hold.closing_decides {
+    if robust || case.params.protocol != Protocol::Fast {
         return search(case);
     }
-    let mut params = case.params.clone();
-    params.hold.closing_decides = true;
-    check(&Case {
-        params: &params,
-        ..*case
-    })
+    with_closing_decides(case, true, check)
 }
 
 /// [`search`] in full, whatever `[sim] closing_decides` says: the re-check of a candidate the
@@ -113,11 +108,16 @@ pub fn labelled_sample(case: &Case, k: usize) -> (Perturbation, SimOutcome) {
 
 /// `f` of `case` with `[sim] closing_decides` off.
 fn in_full<R>(case: &Case, f: impl FnOnce(&Case) -> R) -> R {
-    if !case.params.hold.closing_decides {
+    with_closing_decides(case, false, f)
+}
+
+/// `f` of `case` with `[sim] closing_decides` set to `on`.
+fn with_closing_decides<R>(case: &Case, on: bool, f: impl FnOnce(&Case) -> R) -> R {
+    if case.params.hold.closing_decides == on {
         return f(case);
     }
     let mut params = case.params.clone();
-    params.hold.closing_decides = false;
+    params.hold.closing_decides = on;
     f(&Case {
         params: &params,
         ..*case
