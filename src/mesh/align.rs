@@ -396,10 +396,17 @@ pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64>
             let z = e[0];
             (z, farthest(z).unwrap_or(e[1]))
         }
-        (true, true) => {
-            let z = farthest(Vector3::zeros()).unwrap_or(e[0]);
-            (z, farthest(z).unwrap_or_else(|| z.cross(&Vector3::x())))
-        }
+        // All three equal: equal moments tie by the canonical axis, X first, so X is the grasp
+        // axis tried first: the largest faces' normal where there are such faces (a cube's),
+        // with Z the farthest vertex's direction normal to it (a face's diagonal); else Z the
+        // farthest vertex's direction, X the farthest normal to it.
+        (true, true) => match face_axis(mesh, Vector3::zeros()) {
+            Some(x) => (farthest(x).unwrap_or_else(|| x.cross(&Vector3::z())), x),
+            None => {
+                let z = farthest(Vector3::zeros()).unwrap_or(e[0]);
+                (z, farthest(z).unwrap_or_else(|| z.cross(&Vector3::x())))
+            }
+        },
     };
     let x = (x - z * z.dot(&x)).normalize();
     let z = match sense(mesh, c, z) {
@@ -419,6 +426,94 @@ pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64>
         y.transpose(),
         z.transpose(),
     ]))
+}
+
+/// Flat faces count as one direction's when their unit normals are within this of it, or of its
+/// opposite `[deg]`; and lie in a plane when within this of it.
+const FACE_AXIS_DEG: f64 = 1.0;
+
+/// The faces along one direction must hold at least this share of the surface's area to decide an
+/// axis: each pair of a cube's faces (a third of its area), not a faceted ball's facets.
+const FACE_AXIS_SHARE: f64 = 0.15;
+
+/// Triangles whose faces seed the directions tried: the largest by area, and every
+/// `len / FACE_SEEDS_SPREAD`-th in the file's order (a face of many small triangles).
+const FACE_SEEDS_LARGEST: usize = 16;
+const FACE_SEEDS_SPREAD: usize = 64;
+
+/// Under [`FrameRule::Geometry`], the normal line of the object's largest flat faces that lie in
+/// the plane normal to `n` (all of space if `n` is zero; the rule uses it where all three
+/// moments are equal), unit length: the triangles whose unit
+/// normals are within [`FACE_AXIS_DEG`] of ±d, d a seed triangle's normal, grouped, and the
+/// group with the most area taken if it holds at least [`FACE_AXIS_SHARE`] of the surface.
+/// Groups within [`GEOMETRY_TIE`] of the most area tie, and the one holding the first triangle
+/// in the file's order is taken (a rigid motion keeps the order; a cube's three face pairs
+/// tie). The line is the group's area-weighted mean normal, each folded towards its first
+/// triangle's, so it does not depend on which of a face's triangles seeded it. `None` where no
+/// such faces exist: the farthest vertex then decides ([`farthest_vertex`]).
+///
+/// A cube's first grasp axis then runs square to its faces, where the farthest vertex put it
+/// along a diagonal: slices square to the axis are then the cube's own cross-section, its sides
+/// parallel to the axis (the thesis's straight vertical, Cat_1), where across a diagonal every
+/// side leans from the axis by 35–45°, past the friction cone.
+fn face_axis(mesh: &Mesh, n: Vector3<f64>) -> Option<Vector3<f64>> {
+    let in_plane = FACE_AXIS_DEG.to_radians().sin();
+    let close = FACE_AXIS_DEG.to_radians().cos();
+    let mut total = 0.0;
+    let mut faces: Vec<(usize, Vector3<f64>, f64)> = Vec::new();
+    for t in 0..mesh.triangles.len() {
+        let a = mesh.area_normal(t);
+        let area = 0.5 * a.norm();
+        total += area;
+        if let Some(u) = a.try_normalize(0.0) {
+            if area > 0.0 && u.dot(&n).abs() <= in_plane {
+                faces.push((t, u, area));
+            }
+        }
+    }
+    if faces.is_empty() || total.is_nan() || total <= 0.0 {
+        return None;
+    }
+    let mut seeds: Vec<usize> = (0..faces.len())
+        .step_by((faces.len() / FACE_SEEDS_SPREAD).max(1))
+        .collect();
+    let mut by_area: Vec<usize> = (0..faces.len()).collect();
+    let larger = |i: &usize, j: &usize| faces[*j].2.total_cmp(&faces[*i].2).then(i.cmp(j));
+    if by_area.len() > FACE_SEEDS_LARGEST {
+        by_area.select_nth_unstable_by(FACE_SEEDS_LARGEST, larger);
+        by_area.truncate(FACE_SEEDS_LARGEST);
+    }
+    seeds.extend(by_area);
+    seeds.sort_unstable();
+    seeds.dedup();
+    // Each seed's group: (area, first triangle, area-weighted normal folded to the first's).
+    let groups: Vec<(f64, usize, Vector3<f64>)> = seeds
+        .iter()
+        .map(|&s| {
+            let d = faces[s].1;
+            let mut first: Option<Vector3<f64>> = None;
+            let (mut area, mut first_t, mut sum) = (0.0, usize::MAX, Vector3::zeros());
+            for &(t, u, a) in &faces {
+                let cos = u.dot(&d);
+                if cos.abs() >= close {
+                    let f = *first.get_or_insert(u);
+                    first_t = first_t.min(t);
+                    area += a;
+                    sum += if u.dot(&f) < 0.0 { -u * a } else { u * a };
+                }
+            }
+            (area, first_t, sum)
+        })
+        .collect();
+    let most = groups.iter().map(|g| g.0).fold(0.0f64, f64::max);
+    if most < FACE_AXIS_SHARE * total {
+        return None;
+    }
+    groups
+        .iter()
+        .filter(|g| g.0 >= most * (1.0 - GEOMETRY_TIE))
+        .min_by_key(|g| g.1)
+        .and_then(|g| g.2.try_normalize(1e-12))
 }
 
 /// The direction from `c`, projected into the plane normal to `n` (all of space if `n` is

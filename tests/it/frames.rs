@@ -617,7 +617,7 @@ fn plan_mesh_in(
 #[test]
 fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frames() {
     // The shapes the frame rule is for: square sections (equal moments: the in-plane axes from
-    // the farthest vertex), a body of revolution wider at one end (the sense from the third
+    // the largest flat faces or the farthest vertex), a body of revolution wider at one end (the sense from the third
     // moment), and the thesis's chapter 4 object with its vertical ridge (no symmetry at all).
     // Each is planned as written and in five random rigid frames.
     use grasp_sim::objects::{self, hard};
@@ -625,6 +625,8 @@ fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frame
     let shapes = [
         ("square_bar_20", hard::square_bar(20.0, 150.0, 1)),
         ("square_bar_35", hard::square_bar(35.0, 150.0, 3)),
+        // Three equal moments: the first grasp axis square to a face.
+        ("cube_60", hard::square_bar(60.0, 60.0, 3)),
         ("frustum_56_80", objects::frustum(56.0, 80.0, 110.0)),
         (
             "chapter4",
@@ -643,4 +645,46 @@ fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frame
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+#[test]
+fn a_cube_is_grasped_square_to_its_faces_in_any_frame() {
+    // All three moments equal: the grasp axis runs along a face normal, as the faces pick it
+    // (the farthest vertex put it along a diagonal, where every side leans 35-45 degrees from
+    // the axis, past the friction cone, and the grasp needed `curvature_graded`: 4 of 6
+    // phalanges on plan, the closing 3.3 mm off it). In the file's frame and a turned one the
+    // grasp closes with every phalanx on plan and holds.
+    use grasp_sim::objects::hard;
+    use grasp_sim::plan::Relaxation;
+    let dir = tempfile::tempdir().unwrap();
+    let cube = hard::square_bar(60.0, 60.0, 3);
+    for frame in [Isometry3::identity(), frames()[1]] {
+        let mut m = cube.clone();
+        m.map_vertices(|p| frame * p);
+        let path = dir.path().join("cube.stl");
+        std::fs::write(&path, m.to_binary_stl()).unwrap();
+        let s = Scenario::parse(
+            "[object]\nmesh = \"cube.stl\"\n",
+            &dir.path().join("s.toml"),
+        )
+        .unwrap();
+        let r = run(&s, &RunOptions::default()).unwrap();
+        let g = r.plan.grasp.as_ref().expect("a grasp");
+        let axis = frame.rotation.inverse() * Vector3::from(g.axis);
+        let along = axis.x.abs().max(axis.y.abs()).max(axis.z.abs());
+        assert!(
+            along > 1.0 - 1e-9,
+            "axis {axis:?} (cube frame) is not square to a face"
+        );
+        assert!(
+            !g.relaxations.contains(&Relaxation::CurvatureGraded),
+            "{:?}",
+            g.relaxations
+        );
+        let f = r.sim.fidelity.as_ref().expect("a check");
+        assert_eq!(r.sim.verdict.verdict(), Some(Verdict::Hold));
+        assert!(f.as_planned, "{f:?}");
+        assert_eq!((f.phalanges_on_plan, f.phalanges), (6, 6), "{f:?}");
+        assert!(f.shift_mm < 1.0, "{f:?}");
+    }
 }
