@@ -400,7 +400,7 @@ pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64>
         // axis tried first: the largest faces' normal where there are such faces (a cube's),
         // with Z the farthest vertex's direction normal to it (a face's diagonal); else Z the
         // farthest vertex's direction, X the farthest normal to it.
-        (true, true) => match face_axis(mesh, Vector3::zeros()) {
+        (true, true) => match face_axis(mesh) {
             Some(x) => (farthest(x).unwrap_or_else(|| x.cross(&Vector3::z())), x),
             None => {
                 let z = farthest(Vector3::zeros()).unwrap_or(e[0]);
@@ -429,7 +429,7 @@ pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64>
 }
 
 /// Flat faces count as one direction's when their unit normals are within this of it, or of its
-/// opposite `[deg]`; and lie in a plane when within this of it.
+/// opposite `[deg]`.
 const FACE_AXIS_DEG: f64 = 1.0;
 
 /// The faces along one direction must hold at least this share of the surface's area to decide an
@@ -441,11 +441,10 @@ const FACE_AXIS_SHARE: f64 = 0.15;
 const FACE_SEEDS_LARGEST: usize = 16;
 const FACE_SEEDS_SPREAD: usize = 64;
 
-/// Under [`FrameRule::Geometry`], the normal line of the object's largest flat faces that lie in
-/// the plane normal to `n` (all of space if `n` is zero; the rule uses it where all three
-/// moments are equal), unit length: the triangles whose unit
-/// normals are within [`FACE_AXIS_DEG`] of ±d, d a seed triangle's normal, grouped, and the
-/// group with the most area taken if it holds at least [`FACE_AXIS_SHARE`] of the surface.
+/// Under [`FrameRule::Geometry`], where all three moments are equal, the normal line of the
+/// object's largest flat faces, unit length: the triangles whose unit normals are within
+/// [`FACE_AXIS_DEG`] of ±d, d a seed triangle's normal, grouped, and the group with the most
+/// area taken if it holds at least [`FACE_AXIS_SHARE`] of the surface.
 /// Groups within [`GEOMETRY_TIE`] of the most area tie, and the one holding the first triangle
 /// in the file's order is taken (a rigid motion keeps the order; a cube's three face pairs
 /// tie). The line is the group's area-weighted mean normal, each folded towards its first
@@ -456,8 +455,7 @@ const FACE_SEEDS_SPREAD: usize = 64;
 /// along a diagonal: slices square to the axis are then the cube's own cross-section, its sides
 /// parallel to the axis (the thesis's straight vertical, Cat_1), where across a diagonal every
 /// side leans from the axis by 35–45°, past the friction cone.
-fn face_axis(mesh: &Mesh, n: Vector3<f64>) -> Option<Vector3<f64>> {
-    let in_plane = FACE_AXIS_DEG.to_radians().sin();
+fn face_axis(mesh: &Mesh) -> Option<Vector3<f64>> {
     let close = FACE_AXIS_DEG.to_radians().cos();
     let mut total = 0.0;
     let mut faces: Vec<(usize, Vector3<f64>, f64)> = Vec::new();
@@ -465,10 +463,8 @@ fn face_axis(mesh: &Mesh, n: Vector3<f64>) -> Option<Vector3<f64>> {
         let a = mesh.area_normal(t);
         let area = 0.5 * a.norm();
         total += area;
-        if let Some(u) = a.try_normalize(0.0) {
-            if area > 0.0 && u.dot(&n).abs() <= in_plane {
-                faces.push((t, u, area));
-            }
+        if let Some(u) = a.try_normalize(0.0).filter(|_| area > 0.0) {
+            faces.push((t, u, area));
         }
     }
     if faces.is_empty() || total.is_nan() || total <= 0.0 {
