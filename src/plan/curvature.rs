@@ -457,6 +457,12 @@ fn angle_of(v: Vector2<f64>, side: SliceSide, vertical: Vertical) -> f64 {
     ds.atan2(dz)
 }
 
+/// A walk's vertex this far beyond the reach still counts `[mm]`: an object whose height is a
+/// whole number of HeightSteps puts an elevation exactly one reach below its top (10.5 mm =
+/// 100 mm − 7 mm − 33 × 2.5 mm), and round-off in another frame would put the top corner just
+/// outside it, grading the elevation Cat_1 there and as thinning above here (issue 30).
+const REACH_TIE_MM: f64 = 1e-4;
+
 struct Walk {
     /// The walk's largest excursion: the partial sum of outward turns of largest magnitude, so
     /// that a ledge (out, then up again) still reads as out `[rad]`.
@@ -503,7 +509,7 @@ impl WalkStart<'_> {
             }
         };
         for _ in 0..seg_count {
-            if dist > p.reach_mm || counted >= p.segments {
+            if dist > p.reach_mm + REACH_TIE_MM || counted >= p.segments {
                 break;
             }
             if is_end(c.points[vertex].y) && result.reached_end.is_none() {

@@ -627,6 +627,8 @@ fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frame
         ("square_bar_35", hard::square_bar(35.0, 150.0, 3)),
         // Three equal moments: the first grasp axis square to a face.
         ("cube_60", hard::square_bar(60.0, 60.0, 3)),
+        // 100 mm long: an elevation exactly one curvature reach below its end.
+        ("square_bar_50_100", hard::square_bar(50.0, 100.0, 1)),
         ("frustum_56_80", objects::frustum(56.0, 80.0, 110.0)),
         (
             "chapter4",
