@@ -483,22 +483,19 @@ fn face_axis(mesh: &Mesh) -> Option<Vector3<f64>> {
     seeds.sort_unstable();
     seeds.dedup();
     // Each seed's group: (area, first triangle, area-weighted normal folded to the first's).
+    // `faces` is in the file's order, so the first member met is the first triangle.
     let groups: Vec<(f64, usize, Vector3<f64>)> = seeds
         .iter()
         .map(|&s| {
             let d = faces[s].1;
-            let mut first: Option<Vector3<f64>> = None;
-            let (mut area, mut first_t, mut sum) = (0.0, usize::MAX, Vector3::zeros());
-            for &(t, u, a) in &faces {
-                let cos = u.dot(&d);
-                if cos.abs() >= close {
-                    let f = *first.get_or_insert(u);
-                    first_t = first_t.min(t);
-                    area += a;
-                    sum += if u.dot(&f) < 0.0 { -u * a } else { u * a };
-                }
+            let mut first: Option<(usize, Vector3<f64>)> = None;
+            let (mut area, mut sum) = (0.0, Vector3::zeros());
+            for &(t, u, a) in faces.iter().filter(|f| f.1.dot(&d).abs() >= close) {
+                let (_, f) = *first.get_or_insert((t, u));
+                area += a;
+                sum += if u.dot(&f) < 0.0 { -u * a } else { u * a };
             }
-            (area, first_t, sum)
+            (area, first.map_or(usize::MAX, |f| f.0), sum)
         })
         .collect();
     let most = groups.iter().map(|g| g.0).fold(0.0f64, f64::max);

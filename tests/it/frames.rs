@@ -599,27 +599,34 @@ fn plan_mesh_in(
     frame: &Isometry3<f64>,
     dir: &std::path::Path,
 ) -> RunReport {
+    let options = RunOptions {
+        no_sim: true,
+        ..RunOptions::default()
+    };
+    run_mesh_in(mesh, frame, dir, &options)
+}
+
+/// Runs `mesh` (in mm) written in `frame` as a bare scenario with `options`.
+fn run_mesh_in(
+    mesh: &grasp_sim::mesh::Mesh,
+    frame: &Isometry3<f64>,
+    dir: &std::path::Path,
+    options: &RunOptions,
+) -> RunReport {
     let mut m = mesh.clone();
     m.map_vertices(|p| frame * p);
     let path = dir.join("m.stl");
     std::fs::write(&path, m.to_binary_stl()).unwrap();
     let s = Scenario::parse("[object]\nmesh = \"m.stl\"\n", &dir.join("s.toml")).unwrap();
-    run(
-        &s,
-        &RunOptions {
-            no_sim: true,
-            ..RunOptions::default()
-        },
-    )
-    .unwrap()
+    run(&s, options).unwrap()
 }
 
 #[test]
 fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frames() {
     // The shapes the frame rule is for: square sections (equal moments: the in-plane axes from
-    // the largest flat faces or the farthest vertex), a body of revolution wider at one end (the sense from the third
-    // moment), and the thesis's chapter 4 object with its vertical ridge (no symmetry at all).
-    // Each is planned as written and in five random rigid frames.
+    // the largest flat faces or the farthest vertex), a body of revolution wider at one end
+    // (the sense from the third moment), and the thesis's chapter 4 object with its vertical
+    // ridge (no symmetry at all). Each is planned as written and in five random rigid frames.
     use grasp_sim::objects::{self, hard};
     let dir = tempfile::tempdir().unwrap();
     let shapes = [
@@ -661,16 +668,7 @@ fn a_cube_is_grasped_square_to_its_faces_in_any_frame() {
     let dir = tempfile::tempdir().unwrap();
     let cube = hard::square_bar(60.0, 60.0, 3);
     for frame in [Isometry3::identity(), frames()[1]] {
-        let mut m = cube.clone();
-        m.map_vertices(|p| frame * p);
-        let path = dir.path().join("cube.stl");
-        std::fs::write(&path, m.to_binary_stl()).unwrap();
-        let s = Scenario::parse(
-            "[object]\nmesh = \"cube.stl\"\n",
-            &dir.path().join("s.toml"),
-        )
-        .unwrap();
-        let r = run(&s, &RunOptions::default()).unwrap();
+        let r = run_mesh_in(&cube, &frame, dir.path(), &RunOptions::default());
         let g = r.plan.grasp.as_ref().expect("a grasp");
         let axis = frame.rotation.inverse() * Vector3::from(g.axis);
         let along = axis.x.abs().max(axis.y.abs()).max(axis.z.abs());
