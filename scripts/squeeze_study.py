@@ -37,6 +37,8 @@ from collections import defaultdict
 
 import numpy as np
 
+from order_study import term_auc
+
 SCALE = {"mm": 1.0, "cm": 10.0, "m": 1000.0, "inch": 25.4}
 CONE_DEG = math.degrees(math.atan(0.3))
 
@@ -129,17 +131,8 @@ def figures(record, units):
 
 
 def auc(by, objects, score):
-    """AUC against a hold as planned, within objects (ties count a half)."""
-    num = den = 0.0
-    for o in objects:
-        s = [(score(r), r["ap"] >= 0.5) for r in by[o]]
-        for x, pos in s:
-            if pos:
-                for y, neg in s:
-                    if not neg:
-                        den += 1
-                        num += 1.0 if x > y else 0.5 if x == y else 0.0
-    return num / den if den else float("nan")
+    """AUC against a hold as planned, within objects (ties count a half): order_study's."""
+    return term_auc({o: by[o] for o in objects}, score)
 
 
 def fitted(by, objects, keys):
@@ -183,7 +176,7 @@ def study(name, path, units):
             continue
         terms = r["grade"]["terms"]
         f.update(
-            ap=r.get("as_planned_probability", 0.0),
+            as_planned_probability=r.get("as_planned_probability", 0.0),
             hp=r["hold_probability"],
             margin=terms["margin"],
             even=terms["even"],
