@@ -122,8 +122,11 @@ impl Domain {
         let h = params.height_step_mm;
         let mut elevations = Vec::new();
         if effective[0].is_finite() && effective[1] >= effective[0] {
-            // A tiny tolerance so that an end landing exactly on a step is kept despite rounding.
-            let n = ((effective[1] - effective[0]) / h + 1e-9).floor() as usize + 1;
+            // An end landing on a step is kept within [`SLICE_END_MM`]: the file's frame rounds
+            // the span by some 1e-5 mm, and a tolerance of 1e-9 steps kept the top elevation of
+            // a 40 mm plate (50 mm under the extended rules, 20 steps) in one frame and not in
+            // another, and with it a sorted index and 40 candidates (issue 30).
+            let n = ((effective[1] - effective[0] + SLICE_END_MM) / h).floor() as usize + 1;
             elevations = (0..n).map(|i| effective[0] + i as f64 * h).collect();
         }
         let crossings = elevations

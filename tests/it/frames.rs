@@ -636,6 +636,9 @@ fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frame
         ("cube_60", hard::square_bar(60.0, 60.0, 3)),
         // 100 mm long: an elevation exactly one curvature reach below its end.
         ("square_bar_50_100", hard::square_bar(50.0, 100.0, 1)),
+        // A square plate: a diamond's corner on the axis in the palm's plane, a span of a whole
+        // number of steps.
+        ("square_plate_70_40", hard::square_bar(70.0, 40.0, 2)),
         ("frustum_56_80", objects::frustum(56.0, 80.0, 110.0)),
         (
             "chapter4",
