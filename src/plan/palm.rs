@@ -169,20 +169,20 @@ pub fn place_palm_on(
     })
 }
 
-/// Points this close to the axis `[mm]` are on it, not on the object's right side: a vertex the
-/// aligned frame puts on the axis (a diamond's corner, a pole) lies 1e-14 mm to one side or the
-/// other as the file's frame rounds it, and counting it by its sign made the palm pitch onto it
-/// (and the candidate fail the pitch range) in some frames and stand upright in others (issue
-/// 30). The same as [`OUTERMOST_TIE_MM`].
+/// Points this close to the axis `[mm]` count as on the object's right side: a vertex the
+/// aligned frame puts on the axis (a diamond's corner, a pole, a bottom's centre) lies 1e-14 mm
+/// to one side or the other as the file's frame rounds it, and counting it by its sign let the
+/// palm pitch onto it (and the candidate fail the pitch range) in some frames and stand upright
+/// in others (issue 30). The same as [`OUTERMOST_TIE_MM`].
 const AXIS_TIE_MM: f64 = OUTERMOST_TIE_MM;
 
-/// The palm domain in `vslice`: the points on the object's right side (x > [`AXIS_TIE_MM`])
+/// The palm domain in `vslice`: the points on the object's right side (x > −[`AXIS_TIE_MM`])
 /// between heights `z_lo` and `z_hi`, and where a contour crosses those heights there.
 fn palm_domain(vslice: &Slice, z_lo: f64, z_hi: f64) -> Vec<Point2<f64>> {
     let mut domain: Vec<Point2<f64>> = Vec::new();
     for c in &vslice.contours {
         for (i, p) in c.points.iter().enumerate() {
-            if p.x > AXIS_TIE_MM && p.y >= z_lo && p.y <= z_hi {
+            if p.x > -AXIS_TIE_MM && p.y >= z_lo && p.y <= z_hi {
                 domain.push(*p);
             }
             if i < c.segment_count() {
@@ -191,7 +191,7 @@ fn palm_domain(vslice: &Slice, z_lo: f64, z_hi: f64) -> Vec<Point2<f64>> {
                     if (a.y - z) * (b.y - z) < 0.0 {
                         let t = (z - a.y) / (b.y - a.y);
                         let q = a + (b - a) * t;
-                        if q.x > AXIS_TIE_MM {
+                        if q.x > -AXIS_TIE_MM {
                             domain.push(q);
                         }
                     }

@@ -1,0 +1,120 @@
+#!/usr/bin/env python3
+"""Does each mesh plan alike written in five random rigid frames (issue 30, on any folder)?
+
+    python3 scripts/frames_plan.py [--units U] [--bin PATH] [--keep DIR] MESH...
+
+The test `frames::every_real_object_plans_alike_in_five_random_frames` does this for the
+real-object set; this script does it for meshes of your own (STL or OBJ). Each mesh is written
+as a binary STL in single precision as it is and in five random rigid frames (seed 30: a
+uniformly random rotation and a translation of up to 200 mm, or 0.2 in `--units m`), each
+planned with `grasp-sim MESH --no-sim --json`, and the reported grasp compared with the one as
+written in the aligned frame, as the test compares them: the palm within 0.5 mm and 0.5 degrees,
+every joint angle within 0.5 degrees, the same status. Prints one line per mesh (`OK`, or each
+frame that differs) and the count. Needs numpy; `--bin` defaults to target/release/grasp-sim.
+"""
+import json
+import math
+import os
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+from squeeze_study import load_obj, load_stl
+
+
+def rotation(rng):
+    w, x, y, z = (q := rng.normal(size=4)) / np.linalg.norm(q)
+    return np.array(
+        [
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ]
+    )
+
+
+def write_stl(triangles, path):
+    rec = np.zeros(len(triangles), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    rec["v"] = triangles
+    with open(path, "wb") as f:
+        f.write(b"\0" * 80)
+        f.write(np.uint32(len(triangles)).tobytes())
+        f.write(rec.tobytes())
+
+
+def plan(binary, path, units):
+    r = subprocess.run(
+        [binary, path, "--no-sim", "--json", "--units", units], capture_output=True, text=True
+    )
+    try:
+        return json.loads(r.stdout)
+    except json.JSONDecodeError:
+        return None
+
+
+def differences(a, b):
+    if a is None or b is None:
+        return ["no JSON (see grasp-sim's message)"]
+    pa, pb = a["plan"], b["plan"]
+    if pa["status"] != pb["status"]:
+        return [f"status {pa['status']} / {pb['status']}"]
+    g, h = pa.get("grasp"), pb.get("grasp")
+    if not g or not h:
+        return []
+    out = []
+    p, q = g["palm_pose_aligned"], h["palm_pose_aligned"]
+    apart = float(np.linalg.norm(np.subtract(p["position_mm"], q["position_mm"])))
+    dot = abs(sum(x * y for x, y in zip(p["quaternion_wxyz"], q["quaternion_wxyz"])))
+    angle = math.degrees(2 * math.acos(min(1.0, dot)))
+    if apart > 0.5 or angle > 0.5:
+        name = lambda x: f"{x['axis_name']} #{x['elevation_index']} {x['approach_angle_deg']:g} deg"
+        out.append(f"palm {apart:.2f} mm, {angle:.1f} deg apart ({name(g)} / {name(h)})")
+    for f, e in zip(g["fingers"], h["fingers"]):
+        d = max(abs(f["theta1_deg"] - e["theta1_deg"]), abs(f["theta2_deg"] - e["theta2_deg"]))
+        if d > 0.5:
+            out.append(f"{f['name']}: joint angles {d:.2f} deg apart")
+    return out
+
+
+def main(argv):
+    units, binary, keep, meshes = "mm", "target/release/grasp-sim", None, []
+    it = iter(argv)
+    for a in it:
+        if a == "--units":
+            units = next(it)
+        elif a == "--bin":
+            binary = next(it)
+        elif a == "--keep":
+            keep = next(it)
+        else:
+            meshes.append(a)
+    if not meshes:
+        sys.exit(__doc__)
+    rng = np.random.default_rng(30)
+    reach = 0.2 if units == "m" else 200.0
+    frames = [(rotation(rng), rng.uniform(-reach, reach, 3)) for _ in range(5)]
+    folder = keep or tempfile.mkdtemp()
+    os.makedirs(folder, exist_ok=True)
+    differing = 0
+    for path in meshes:
+        tri = load_stl(path) if path.lower().endswith(".stl") else load_obj(path)
+        name = os.path.splitext(os.path.basename(path))[0]
+        written = os.path.join(folder, f"{name}_0.stl")
+        write_stl(tri, written)
+        reference = plan(binary, written, units)
+        lines = []
+        for k, (r, t) in enumerate(frames, 1):
+            moved = os.path.join(folder, f"{name}_{k}.stl")
+            write_stl(tri @ r.T + t, moved)
+            d = differences(reference, plan(binary, moved, units))
+            if d:
+                lines.append(f"  frame {k}: " + "; ".join(d))
+        differing += bool(lines)
+        print(name, "OK" if not lines else "\n" + "\n".join(lines), flush=True)
+    print(f"{differing} of {len(meshes)} meshes plan differently in some frame")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
