@@ -264,15 +264,7 @@ pub fn align_with_rule(
             // equal moments, which round-off would turn with the file's frame.
             let m = c.matrix();
             let turned = m * props.inertia * m.transpose();
-            let mut d = [turned[(0, 0)], turned[(1, 1)], turned[(2, 2)]];
-            for (i, j) in [(0, 1), (1, 2), (0, 2)] {
-                let scale = d[i].abs().max(d[j].abs()).max(f64::MIN_POSITIVE);
-                if (d[i] - d[j]).abs() / scale <= GEOMETRY_EQUAL_MOMENTS {
-                    let mean = 0.5 * (d[i] + d[j]);
-                    d[i] = mean;
-                    d[j] = mean;
-                }
-            }
+            let d = equalized([turned[(0, 0)], turned[(1, 1)], turned[(2, 2)]]);
             let turned_props = MassProperties {
                 centroid: c * props.centroid,
                 inertia: Matrix3::from_diagonal(&Vector3::new(d[0], d[1], d[2])),
@@ -287,6 +279,34 @@ pub fn align_with_rule(
             a
         }
     }
+}
+
+/// `d` with the moments [`canonical_rotation`] calls equal made exactly equal: where two pairs
+/// are equal all three take their mean (a cube, a ball), else the one equal pair its own. Pair
+/// by pair, a cube's three came out 1e-16 apart (the last pair's mean moved the first pair's
+/// shared value), and which the file rule then took as the least moment, the face normal or
+/// the face diagonal, turned with the file's frame.
+fn equalized(mut d: [f64; 3]) -> [f64; 3] {
+    let equal = |a: f64, b: f64| {
+        let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
+        (a - b).abs() / scale <= GEOMETRY_EQUAL_MOMENTS
+    };
+    let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
+        .into_iter()
+        .filter(|&(i, j)| equal(d[i], d[j]))
+        .collect();
+    match pairs.as_slice() {
+        [] => {}
+        &[(i, j)] => {
+            let mean = 0.5 * (d[i] + d[j]);
+            (d[i], d[j]) = (mean, mean);
+        }
+        _ => {
+            let mean = (d[0] + d[1] + d[2]) / 3.0;
+            d = [mean; 3];
+        }
+    }
+    d
 }
 
 /// The mass properties (unit density) of the solid the triangles enclose as a fan of
@@ -580,4 +600,25 @@ fn sign_towards(v: Vector3<f64>, hints: &[Vector3<f64>]) -> Vector3<f64> {
         }
     }
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::equalized;
+
+    #[test]
+    fn moments_equal_in_a_chain_come_out_exactly_equal() {
+        // 0 ~ 1 and 1 ~ 2 within 1e-4, 0 and 2 not: all three are one (a cube written in
+        // another frame). Pair by pair the last mean moved the first pair's shared value.
+        let a = 2.0e6;
+        let d = equalized([a, a * (1.0 + 6e-5), a * (1.0 + 1.2e-4)]);
+        assert_eq!(d[0], d[1]);
+        assert_eq!(d[1], d[2]);
+        assert!((d[0] - a * (1.0 + 6e-5)).abs() < 1e-9 * a);
+        // One pair: those two only; none: unchanged.
+        let d = equalized([a, 3.0 * a, a * (1.0 + 5e-5)]);
+        assert_eq!(d[0], d[2]);
+        assert_eq!(d[1], 3.0 * a);
+        assert_eq!(equalized([1.0, 2.0, 3.0]), [1.0, 2.0, 3.0]);
+    }
 }

@@ -634,6 +634,9 @@ fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frame
         ("square_bar_35", hard::square_bar(35.0, 150.0, 3)),
         // Three equal moments: the first grasp axis square to a face.
         ("cube_60", hard::square_bar(60.0, 60.0, 3)),
+        // Twelve triangles: the three equal moments must stay exactly equal.
+        ("cube_40", hard::square_bar(40.0, 40.0, 1)),
+        ("cube_90", hard::square_bar(90.0, 90.0, 1)),
         // 100 mm long: an elevation exactly one curvature reach below its end.
         ("square_bar_50_100", hard::square_bar(50.0, 100.0, 1)),
         // A square plate: a diamond's corner on the axis in the palm's plane, a span of a whole
