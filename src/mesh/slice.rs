@@ -198,6 +198,23 @@ struct Segment {
 /// Contour segments shorter than this are merged away `[mm]`.
 const TINY_SEGMENT_MM: f64 = 1e-9;
 
+/// A vertex this near the cutting plane is on it `[mm]`: its distance is taken as 0, so the
+/// plane crosses there or not by the other vertices alone. A face the plane lies in (a flat
+/// bottom at a finger plane's height, which HeightSteps put there on a box a whole number of
+/// steps tall) is cut as in the file's own frame whatever frame rounded its vertices 1e-5 mm
+/// to either side: left out, its rim the cut where the object lies on the other side (issue 30).
+pub const ON_PLANE_MM: f64 = 1e-4;
+
+/// `plane`'s signed distance to `p`, 0 within [`ON_PLANE_MM`].
+fn snapped_distance(plane: &Plane, p: &Point3<f64>) -> f64 {
+    let d = plane.distance(p);
+    if d.abs() <= ON_PLANE_MM {
+        0.0
+    } else {
+        d
+    }
+}
+
 /// How [`slice()`] cuts: where it finds the triangles the plane may cut, and how far it repairs
 /// and bridges the raw cut. [`SliceOptions::default()`] is the exact cut, repaired, through
 /// every triangle.
@@ -293,11 +310,15 @@ fn cut_by(mesh: &Mesh, plane: &Plane, options: SliceOptions) -> Slice {
     match options.index {
         Some(index) => {
             let tris = index.candidates(plane);
-            let dist = |i: u32| plane.distance(&mesh.vertices[i as usize]);
+            let dist = |i: u32| snapped_distance(plane, &mesh.vertices[i as usize]);
             made(raw_contours(mesh, plane, tris.into_iter(), &dist))
         }
         None => {
-            let dist: Vec<f64> = mesh.vertices.iter().map(|p| plane.distance(p)).collect();
+            let dist: Vec<f64> = mesh
+                .vertices
+                .iter()
+                .map(|p| snapped_distance(plane, p))
+                .collect();
             let d = |i: u32| dist[i as usize];
             made(raw_contours(mesh, plane, 0..mesh.triangles.len(), &d))
         }
@@ -334,7 +355,7 @@ fn bridged_through_cache(
     let canonical = || {
         let c = canonical_plane(&key);
         let tris = index.candidates(&c);
-        let dist = |i: u32| c.distance(&mesh.vertices[i as usize]);
+        let dist = |i: u32| snapped_distance(&c, &mesh.vertices[i as usize]);
         let raw = raw_contours(mesh, &c, tris.into_iter(), &dist);
         (!is_simple_cut(&raw)).then(|| repair(c, raw, tol_mm).bridged_within(gap_mm, tol_mm))
     };
@@ -628,7 +649,7 @@ impl SliceIndex {
             let d = n.dot(&(c - o));
             let r = na.dot(&e);
             // Generous slack: the exact side test is made per vertex afterwards.
-            let slack = 1e-6 * (1.0 + r + d.abs());
+            let slack = 1e-6 * (1.0 + r + d.abs()) + ON_PLANE_MM;
             if d - r > slack || d + r < -slack {
                 continue;
             }
@@ -699,7 +720,7 @@ pub fn cut_segments_indexed(
     plane: &Plane,
 ) -> Vec<(Point2<f64>, Point2<f64>)> {
     let tris = index.candidates_unsorted(plane);
-    let dist = |i: u32| plane.distance(&mesh.vertices[i as usize]);
+    let dist = |i: u32| snapped_distance(plane, &mesh.vertices[i as usize]);
     crossing_segments(mesh, tris.into_iter(), |i| dist(i) >= 0.0)
         .iter()
         .map(|s| {

@@ -71,6 +71,7 @@
 //! - An elevation is ungraspable if it is ungraspable in any slice (the palm may approach from
 //!   any angle, and the search must not waste time on a level with a sharp edge somewhere).
 
+use super::domain::SLICE_END_MM;
 use super::PlannerParams;
 use super::{Domain, Grade, Touch};
 use crate::hand::Hand;
@@ -501,11 +502,14 @@ impl WalkStart<'_> {
         let (mut vertex, mut prev, mut dist) = self.first_step(forward, vertical);
         let mut counted = 0usize;
         let mut skips = 0usize;
+        // Within SLICE_END_MM of the slice's end: a flat bottom's two corners lie 1e-5 mm apart
+        // in a file written in another frame, and at 1e-9 the walk met the end at one corner
+        // and not at the other (a hexagonal prism's lowest graded elevation, issue 30).
         let is_end = |z: f64| {
             if up {
-                z >= z_end - 1e-9
+                z >= z_end - SLICE_END_MM
             } else {
-                z <= z_end + 1e-9
+                z <= z_end + SLICE_END_MM
             }
         };
         for _ in 0..seg_count {

@@ -621,6 +621,22 @@ fn run_mesh_in(
     run(&s, options).unwrap()
 }
 
+/// A right prism on a regular `n`-gon of circumradius `r`, `h` tall, standing on Z = 0 `[mm]`.
+fn regular_prism(n: usize, r: f64, h: f64) -> grasp_sim::mesh::Mesh {
+    let corner = |k: usize, z: f64| {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        Point3::new(r * a.cos(), r * a.sin(), z)
+    };
+    let (bottom, top) = (Point3::new(0.0, 0.0, 0.0), Point3::new(0.0, 0.0, h));
+    let mut soup = Vec::new();
+    for k in 0..n {
+        let (a, b) = (corner(k, 0.0), corner(k + 1, 0.0));
+        let (a2, b2) = (corner(k, h), corner(k + 1, h));
+        soup.extend([[a, b, b2], [a, b2, a2], [bottom, b, a], [top, a2, b2]]);
+    }
+    grasp_sim::mesh::Mesh::from_triangles(&soup).0
+}
+
 #[test]
 fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frames() {
     // The shapes the frame rule is for: square sections (equal moments: the in-plane axes from
@@ -643,6 +659,8 @@ fn square_bars_bodies_of_revolution_and_a_ridged_object_plan_alike_in_five_frame
         // number of steps.
         ("square_plate_70_40", hard::square_bar(70.0, 40.0, 2)),
         ("frustum_56_80", objects::frustum(56.0, 80.0, 110.0)),
+        // 70 mm tall: the lowest finger's plane lies in the bottom face.
+        ("hexagonal_prism_50_70", regular_prism(6, 27.0, 70.0)),
         (
             "chapter4",
             objects::chapter4(&objects::Chapter4Dims::default()),
