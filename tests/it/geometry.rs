@@ -195,18 +195,34 @@ fn planes_through_vertices_edges_and_faces_still_chain() {
             .windows(2)
             .all(|w| (w[1] - w[0]).norm() > 1e-9));
     }
-    // A plane lying in a cap is taken just below it: in the top cap it gives the whole outline,
-    // in the bottom cap nothing (as just below the object).
-    let s = slice(&prism, &Plane::horizontal(124.0), SliceOptions::default());
-    assert_eq!(s.contours.len(), 1);
-    assert!((s.contours[0].signed_area() - 15.0 * 30.0).abs() < 1e-9);
-    assert!(slice(&prism, &Plane::horizontal(0.0), SliceOptions::default()).is_empty());
-    assert!(slice(
+    // A plane lying in a cap, to within ON_PLANE_MM either way (the round-off of a file
+    // written in another frame), is taken just below it: in the top cap it gives the whole
+    // outline, in the bottom cap nothing (as just below the object). Beyond that, nothing above
+    // the top and the whole outline above the bottom.
+    let tie = grasp_sim::slice::ON_PLANE_MM;
+    for dz in [0.0, 1e-9, -1e-9, 0.5 * tie, -0.5 * tie] {
+        let s = slice(
+            &prism,
+            &Plane::horizontal(124.0 + dz),
+            SliceOptions::default(),
+        );
+        assert_eq!(s.contours.len(), 1, "{dz}");
+        assert!(
+            (s.contours[0].signed_area() - 15.0 * 30.0).abs() < 1e-9,
+            "{dz}"
+        );
+        let s = slice(&prism, &Plane::horizontal(dz), SliceOptions::default());
+        assert!(s.is_empty(), "{dz}");
+    }
+    let above = Plane::horizontal(124.0 + 2.0 * tie);
+    assert!(slice(&prism, &above, SliceOptions::default()).is_empty());
+    let s = slice(
         &prism,
-        &Plane::horizontal(124.0 + 1e-9),
-        SliceOptions::default()
-    )
-    .is_empty());
+        &Plane::horizontal(2.0 * tie),
+        SliceOptions::default(),
+    );
+    assert_eq!(s.contours.len(), 1);
+    assert!((s.contours[0].signed_area() - 15.0 * 30.0).abs() < 1e-6);
 }
 
 #[test]
