@@ -15,33 +15,15 @@ frame that differs) and the count. Needs numpy; `--bin` defaults to target/relea
 import json
 import math
 import os
+import random
 import subprocess
 import sys
 import tempfile
 
 import numpy as np
 
+from gen_dataset import random_rotation, write_binary_stl
 from squeeze_study import load_obj, load_stl
-
-
-def rotation(rng):
-    w, x, y, z = (q := rng.normal(size=4)) / np.linalg.norm(q)
-    return np.array(
-        [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    )
-
-
-def write_stl(triangles, path):
-    rec = np.zeros(len(triangles), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
-    rec["v"] = triangles
-    with open(path, "wb") as f:
-        f.write(b"\0" * 80)
-        f.write(np.uint32(len(triangles)).tobytes())
-        f.write(rec.tobytes())
 
 
 def plan(binary, path, units):
@@ -92,9 +74,12 @@ def main(argv):
             meshes.append(a)
     if not meshes:
         sys.exit(__doc__)
-    rng = np.random.default_rng(30)
+    rng = random.Random(30)
     reach = 0.2 if units == "m" else 200.0
-    frames = [(rotation(rng), rng.uniform(-reach, reach, 3)) for _ in range(5)]
+    frames = [
+        (np.array(random_rotation(rng)), np.array([rng.uniform(-reach, reach) for _ in range(3)]))
+        for _ in range(5)
+    ]
     folder = keep or tempfile.mkdtemp()
     os.makedirs(folder, exist_ok=True)
     differing = 0
@@ -102,12 +87,12 @@ def main(argv):
         tri = load_stl(path) if path.lower().endswith(".stl") else load_obj(path)
         name = os.path.splitext(os.path.basename(path))[0]
         written = os.path.join(folder, f"{name}_0.stl")
-        write_stl(tri, written)
+        write_binary_stl(written, tri, name)
         reference = plan(binary, written, units)
         lines = []
         for k, (r, t) in enumerate(frames, 1):
             moved = os.path.join(folder, f"{name}_{k}.stl")
-            write_stl(tri @ r.T + t, moved)
+            write_binary_stl(moved, tri @ r.T + t, name)
             d = differences(reference, plan(binary, moved, units))
             if d:
                 lines.append(f"  frame {k}: " + "; ".join(d))
