@@ -287,13 +287,9 @@ pub fn align_with_rule(
 /// shared value), and which the file rule then took as the least moment, the face normal or
 /// the face diagonal, turned with the file's frame.
 fn equalized(mut d: [f64; 3]) -> [f64; 3] {
-    let equal = |a: f64, b: f64| {
-        let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
-        (a - b).abs() / scale <= GEOMETRY_EQUAL_MOMENTS
-    };
     let pairs: Vec<(usize, usize)> = [(0, 1), (1, 2), (0, 2)]
         .into_iter()
-        .filter(|&(i, j)| equal(d[i], d[j]))
+        .filter(|&(i, j)| moments_equal(d[i], d[j]))
         .collect();
     match pairs.as_slice() {
         [] => {}
@@ -307,6 +303,12 @@ fn equalized(mut d: [f64; 3]) -> [f64; 3] {
         }
     }
     d
+}
+
+/// Two moments the frame rule calls equal: within [`GEOMETRY_EQUAL_MOMENTS`] of the larger.
+fn moments_equal(a: f64, b: f64) -> bool {
+    let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
+    (b - a).abs() / scale <= GEOMETRY_EQUAL_MOMENTS
 }
 
 /// The mass properties (unit density) of the solid the triangles enclose as a fan of
@@ -398,12 +400,8 @@ pub fn canonical_rotation(mesh: &Mesh, props: &MassProperties) -> Rotation3<f64>
         .map(|&i| eig.eigenvectors.column(i).into_owned())
         .collect();
     let c = props.centroid;
-    let equal = |a: f64, b: f64| {
-        let scale = a.abs().max(b.abs()).max(f64::MIN_POSITIVE);
-        (b - a).abs() / scale <= GEOMETRY_EQUAL_MOMENTS
-    };
     let farthest = |n: Vector3<f64>| farthest_vertex(mesh, c, n);
-    let (z, x) = match (equal(m[0], m[1]), equal(m[1], m[2])) {
+    let (z, x) = match (moments_equal(m[0], m[1]), moments_equal(m[1], m[2])) {
         (false, false) => (e[0], e[1]),
         // Least and middle equal: Z within their plane, X the middle of what is left.
         (true, false) => {
