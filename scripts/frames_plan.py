@@ -10,8 +10,10 @@ uniformly random rotation and a translation of up to 200 mm, or 0.2 in `--units 
 planned with `grasp-sim MESH --no-sim --json`, and the reported grasp compared with the one as
 written in the aligned frame, as the test compares them: the palm within 0.5 mm and 0.5 degrees,
 every joint angle within 0.5 degrees, the same status. Prints one line per mesh (`OK`, or each
-frame that differs) and the count. Needs numpy; `--bin` defaults to target/release/grasp-sim.
+frame that differs) and the count; exits 1 if a mesh differs or cannot be read. Needs numpy;
+`--bin` defaults to target/release/grasp-sim.
 """
+import argparse
 import json
 import math
 import os
@@ -61,19 +63,15 @@ def differences(a, b):
 
 
 def main(argv):
-    units, binary, keep, meshes = "mm", "target/release/grasp-sim", None, []
-    it = iter(argv)
-    for a in it:
-        if a == "--units":
-            units = next(it)
-        elif a == "--bin":
-            binary = next(it)
-        elif a == "--keep":
-            keep = next(it)
-        else:
-            meshes.append(a)
-    if not meshes:
-        sys.exit(__doc__)
+    ap = argparse.ArgumentParser(
+        description="Does each mesh plan alike in five random rigid frames? (see the module docs)"
+    )
+    ap.add_argument("--units", default="mm", help="the meshes' length unit, as grasp-sim --units")
+    ap.add_argument("--bin", default="target/release/grasp-sim", help="the grasp-sim binary")
+    ap.add_argument("--keep", help="keep the written STLs in this folder")
+    ap.add_argument("meshes", nargs="+", metavar="MESH", help="STL or OBJ files")
+    args = ap.parse_args(argv)
+    units, binary, keep, meshes = args.units, args.bin, args.keep, args.meshes
     rng = random.Random(30)
     reach = 0.2 if units == "m" else 200.0
     frames = [
@@ -82,9 +80,14 @@ def main(argv):
     ]
     folder = keep or tempfile.mkdtemp()
     os.makedirs(folder, exist_ok=True)
-    differing = 0
+    differing = unread = 0
     for path in meshes:
-        tri = load_stl(path) if path.lower().endswith(".stl") else load_obj(path)
+        try:
+            tri = load_stl(path) if path.lower().endswith(".stl") else load_obj(path)
+        except (OSError, ValueError) as e:
+            print(f"{path}: not read: {e}", flush=True)
+            unread += 1
+            continue
         name = os.path.splitext(os.path.basename(path))[0]
         written = os.path.join(folder, f"{name}_0.stl")
         write_binary_stl(written, tri, name)
@@ -98,8 +101,10 @@ def main(argv):
                 lines.append(f"  frame {k}: " + "; ".join(d))
         differing += bool(lines)
         print(name, "OK" if not lines else "\n" + "\n".join(lines), flush=True)
-    print(f"{differing} of {len(meshes)} meshes plan differently in some frame")
+    print(f"{differing} of {len(meshes)} meshes plan differently in some frame"
+          + (f"; {unread} not read" if unread else ""))
+    return 1 if differing or unread else 0
 
 
 if __name__ == "__main__":
-    main(sys.argv[1:])
+    sys.exit(main(sys.argv[1:]))

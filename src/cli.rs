@@ -268,7 +268,8 @@ pub enum Command {
     },
     /// Check given grasps: every line of --grasps FILE (JSON Lines with `palm_pose` 4 x 4 in
     /// the object file's frame [mm] and `joint_angles_deg`, one [θ1, θ2] per finger; a `label`
-    /// file is valid input) on the object, one record per line, as `label` writes them.
+    /// file is valid input) on the object, one record per line, as `label` writes them; of a
+    /// file of several objects, the lines whose `object` is this one's.
     ///
     /// Exit status: 0 every line checked, 2 a line could not be (its record has an `error`;
     /// the other lines are still checked).

@@ -857,11 +857,13 @@ pub fn check(request: &CheckRequest, progress: &dyn Progress) -> anyhow::Result<
     let bytes = crate::files::read_regular(&request.grasps, crate::files::MAX_RESULTS_BYTES)
         .with_context(|| format!("{}", request.grasps.display()))?;
     let text = String::from_utf8_lossy(&bytes);
-    let lines: Vec<Result<String, String>> = text
+    let given: Vec<(usize, &str)> = text
         .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| Ok(l.trim_end_matches('\r').to_string()))
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty())
+        .map(|(i, l)| (i + 1, l.trim_end_matches('\r')))
         .collect();
+    let (numbers, lines) = lines_of_object(&given, &scenario.name, &request.grasps);
     let key = Key {
         input: request.input.display().to_string(),
         input_hash: args.input_hash(&item, &template),
@@ -888,7 +890,8 @@ pub fn check(request: &CheckRequest, progress: &dyn Progress) -> anyhow::Result<
         );
         out.lock().unwrap_or_else(|p| p.into_inner()).push(l);
     };
-    let summary = super::check_lines(&scenario, &lines, request.samples, &info, &emit)?;
+    let summary =
+        super::check_numbered_lines(&scenario, &lines, &numbers, request.samples, &info, &emit)?;
     progress.end();
     // In line order.
     let mut records = out.into_inner().unwrap_or_else(|p| p.into_inner());
@@ -905,6 +908,46 @@ pub fn check(request: &CheckRequest, progress: &dyn Progress) -> anyhow::Result<
         summary.wall_ms / 1000.0
     );
     Ok(if errors > 0 { 2 } else { 0 })
+}
+
+/// The lines of a grasp file to check on the object `name`, with their numbers in the file: when
+/// some line's `object` is `name` (a label file of many objects), those lines and the lines that
+/// name no object; otherwise every line, with a warning if they name other objects. Says on
+/// stderr how many lines of other objects it leaves out.
+fn lines_of_object(
+    given: &[(usize, &str)],
+    name: &str,
+    file: &Path,
+) -> (Vec<usize>, Vec<Result<String, String>>) {
+    let objects: Vec<Option<String>> = given
+        .iter()
+        .map(|(_, l)| {
+            serde_json::from_str::<serde_json::Value>(l)
+                .ok()
+                .and_then(|v| v.get("object")?.as_str().map(str::to_string))
+        })
+        .collect();
+    let ours = objects.iter().any(|o| o.as_deref() == Some(name));
+    let keep = |o: &Option<String>| !ours || o.as_deref().is_none_or(|o| o == name);
+    let skipped = objects.iter().filter(|o| !keep(o)).count();
+    if skipped > 0 {
+        eprintln!(
+            "check: {}: {} of other objects left out (only those of `{name}` are checked)",
+            file.display(),
+            batch::plural(skipped, "line")
+        );
+    } else if let Some(other) = objects.iter().flatten().find(|o| *o != name) {
+        eprintln!(
+            "check: warning: {}: no line is of `{name}` (a line names `{other}`): every line is checked on `{name}`",
+            file.display()
+        );
+    }
+    given
+        .iter()
+        .zip(&objects)
+        .filter(|(_, o)| keep(o))
+        .map(|((n, l), _)| (*n, Ok(l.to_string())))
+        .unzip()
 }
 
 impl CheckRequest {

@@ -22,4 +22,6 @@ pub mod object;
 pub use crate::pick;
 
 pub use line::{GraspLine, LabelInfo, LabelRecord};
-pub use object::{check_lines, label_object, LabelParams, Line, ObjectSummary};
+pub use object::{
+    check_lines, check_numbered_lines, label_object, LabelParams, Line, ObjectSummary,
+};

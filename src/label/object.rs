@@ -600,6 +600,23 @@ pub fn check_lines(
     info: &(dyn Fn(usize, f64) -> LabelInfo + Sync),
     emit: &(dyn Fn(Line) + Sync),
 ) -> Result<ObjectSummary, Error> {
+    let numbers: Vec<usize> = (1..=lines.len()).collect();
+    check_numbered_lines(scenario, lines, &numbers, samples, info, emit)
+}
+
+/// [`check_lines`] with each line's number in its file (`numbers[i]` for `lines[i]`), which an
+/// error record names: the file's blank lines and the lines of other objects are not given.
+///
+/// # Errors
+/// [`Error`] for a bad mesh file.
+pub fn check_numbered_lines(
+    scenario: &Scenario,
+    lines: &[Result<String, String>],
+    numbers: &[usize],
+    samples: usize,
+    info: &(dyn Fn(usize, f64) -> LabelInfo + Sync),
+    emit: &(dyn Fn(Line) + Sync),
+) -> Result<ObjectSummary, Error> {
     let t0 = Instant::now();
     let scenario = with_samples(scenario, samples);
     let mut timings = StageTimings::default();
@@ -647,7 +664,7 @@ pub fn check_lines(
             Err(why) => emit(error_line(
                 &scenario.name,
                 Some(i),
-                &format!("line {}: {why}", i + 1),
+                &format!("line {}: {why}", numbers.get(i).copied().unwrap_or(i + 1)),
                 info(i, 0.0),
             )),
         }

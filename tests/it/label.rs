@@ -202,6 +202,65 @@ fn a_bad_given_line_gets_an_error_record_and_the_others_are_checked() {
 }
 
 #[test]
+fn a_label_file_of_two_objects_is_checked_on_each_object_by_its_own_lines() {
+    let dir = tempfile::tempdir().unwrap();
+    let cup = root().join("assets/objects/cup.stl");
+    let d40 = root().join("assets/objects/cylinder_d40.stl");
+    let both = dir.path().join("both.jsonl");
+    let (code, err) = label(
+        &[&cup, &d40],
+        &["--grasps", "2", "--samples", "1", "--in-process"],
+        &both,
+    );
+    assert_eq!(code, Some(0), "{err}");
+    let labelled = lines(&both);
+    assert_eq!(labelled.len(), 4, "{err}");
+    let of =
+        |name: &str| -> Vec<&Value> { labelled.iter().filter(|l| l["object"] == name).collect() };
+    assert_eq!(of("cup").len(), 2);
+    // The file with a blank line and a bad line of the D40 after the four: the check on the
+    // D40 checks its two lines and the bad one (named by its line in the file), not the cup's.
+    let mut bad = of("cylinder_d40")[0].clone();
+    bad["joint_angles_deg"] = Value::from(7);
+    let given = dir.path().join("given.jsonl");
+    let text = std::fs::read_to_string(&both).unwrap();
+    std::fs::write(&given, format!("{text}\n{bad}\n")).unwrap();
+    let checked = dir.path().join("checked.jsonl");
+    let o = grasp_sim()
+        .args(["check", "--samples", "1", "--grasps"])
+        .arg(&given)
+        .arg(&d40)
+        .arg("--out")
+        .arg(&checked)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(err.contains("2 lines of other objects left out"), "{err}");
+    let c = lines(&checked);
+    assert_eq!(c.len(), 3, "{err}");
+    for (got, want) in c.iter().zip(of("cylinder_d40")) {
+        assert_eq!(without_label(got), without_label(want));
+    }
+    let e = c[2]["error"].as_str().unwrap_or_else(|| panic!("{}", c[2]));
+    assert!(e.starts_with("line 6:"), "{e}");
+    // Lines that name only another object are all checked, with a warning.
+    let cup_only = dir.path().join("cup_only.jsonl");
+    let cup_lines: String = of("cup").iter().map(|l| format!("{l}\n")).collect();
+    std::fs::write(&cup_only, cup_lines).unwrap();
+    let o = grasp_sim()
+        .args(["check", "--samples", "1", "--grasps"])
+        .arg(&cup_only)
+        .arg(&d40)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("no line is of `cylinder_d40`"), "{err}");
+    assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 2);
+}
+
+#[test]
 fn an_ungraspable_object_gets_one_line_saying_why() {
     let dir = tempfile::tempdir().unwrap();
     let d10 = root().join("scenarios/cylinder_d10.toml");
