@@ -1224,19 +1224,32 @@ fn enclosed_volume(mesh: &Mesh, is_open: bool, diag2: f64, path: &Path) -> Resul
 pub const MAX_PLANNER_CELLS: u64 = 400_000;
 
 /// Checks that the planner's work on `mesh` is bounded: at most [`MAX_PLANNER_CELLS`] indexed
-/// elevations (the bounding box's diagonal over `height_step_mm`, a bound for every axis the
-/// planner tries) times approach angles (180° over `angular_step_deg`).
+/// elevations (the diameter of the sphere about `centre` that holds the mesh, over
+/// `height_step_mm`: a bound for every axis the planner tries) times approach angles (180° over
+/// `angular_step_deg`). About the centroid, the bound does not depend on the frame the file was
+/// written in (the file's bounding box does: a cube written turned is a third wider in it).
 ///
 /// # Errors
 /// [`MeshError::TooLarge`] naming `path`, the cells and the limit.
 pub fn check_planner_work(
     mesh: &Mesh,
+    centre: Point3<f64>,
     path: &Path,
     height_step_mm: f64,
     angular_step_deg: f64,
 ) -> Result<(), MeshError> {
     let (lo, hi) = mesh.bounds();
-    let extent_mm = (hi - lo).norm();
+    let centre = if centre.coords.iter().all(|c| c.is_finite()) {
+        centre
+    } else {
+        nalgebra::center(&lo, &hi)
+    };
+    let extent_mm = 2.0
+        * mesh
+            .vertices
+            .iter()
+            .map(|p| (p - centre).norm())
+            .fold(0.0, f64::max);
     let elevations = (extent_mm / height_step_mm).floor() + 1.0;
     let angles = (180.0 / angular_step_deg).round().max(1.0);
     let cells = elevations * angles;

@@ -280,6 +280,7 @@ pub fn prepare(scenario: &Scenario, timings: &mut StageTimings) -> Result<Prepar
     let p = &scenario.planner;
     mesh::check_planner_work(
         object.mesh(),
+        object.props.centroid,
         &scenario.object.mesh,
         p.height_step_mm,
         p.angular_step_deg,

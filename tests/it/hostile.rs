@@ -899,6 +899,42 @@ fn an_object_too_large_for_the_planner_steps_is_refused() {
     );
 }
 
+/// The planner's work bound is taken in the object's aligned frame, not the file's: a 28 m cube
+/// (1.73 × 28 m across square, 2.24 × 28 m in its file's box when written turned 45° about z)
+/// plans alike written either way; the file's box refused it turned (450,000 cells against
+/// the 400,000 limit) and planned it square.
+#[test]
+fn the_planner_work_bound_does_not_depend_on_the_file_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let s = 28_000.0_f32;
+    let square = cube([0.0; 3], s);
+    let (c, h) = (std::f32::consts::FRAC_1_SQRT_2, s / 2.0);
+    let turned: Vec<[[f32; 3]; 3]> = square
+        .iter()
+        .map(|t| {
+            t.map(|p| {
+                [
+                    c * (p[0] - h) - c * (p[1] - h),
+                    c * (p[0] - h) + c * (p[1] - h),
+                    p[2],
+                ]
+            })
+        })
+        .collect();
+    let mut plans = Vec::new();
+    for (name, tris) in [("square.stl", &square), ("turned.stl", &turned)] {
+        let path = dir.path().join(name);
+        std::fs::write(&path, binary_stl(tris)).unwrap();
+        let v = plan_json(&path);
+        plans.push((
+            v["plan"]["status"].clone(),
+            v["plan"]["indexed_elevations"].clone(),
+        ));
+    }
+    assert_eq!(plans[0], plans[1]);
+    assert_eq!(plans[0].0, "ungraspable", "{:?}", plans[0]);
+}
+
 /// From the probe (issue 32): a time bound of 1e300 s overflowed the timer and panicked (now
 /// refused, the cap stated); a URDF naming a mesh that is a link to `/dev/zero` said "not
 /// found" (now: what it is).
