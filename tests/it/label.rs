@@ -38,6 +38,18 @@ fn label(inputs: &[&Path], args: &[&str], out: &Path) -> (Option<i32>, String) {
     )
 }
 
+/// `check --grasps given` on `input` with `samples`, into `out` (stdout if `None`).
+fn check(given: &Path, input: &Path, samples: &str, out: Option<&Path>) -> std::process::Output {
+    let mut c = grasp_sim();
+    c.args(["check", "--samples", samples, "--grasps"])
+        .arg(given)
+        .arg(input);
+    if let Some(out) = out {
+        c.arg("--out").arg(out);
+    }
+    c.output().unwrap()
+}
+
 #[test]
 fn label_records_equal_single_checks_of_the_same_grasps() {
     let dir = tempfile::tempdir().unwrap();
@@ -72,14 +84,7 @@ fn label_records_equal_single_checks_of_the_same_grasps() {
         let one = dir.path().join(format!("g{k}.jsonl"));
         std::fs::write(&one, format!("{l}\n")).unwrap();
         let checked = dir.path().join(format!("c{k}.jsonl"));
-        let o = grasp_sim()
-            .args(["check", "--samples", "3", "--grasps"])
-            .arg(&one)
-            .arg(&cup)
-            .arg("--out")
-            .arg(&checked)
-            .output()
-            .unwrap();
+        let o = check(&one, &cup, "3", Some(&checked));
         assert_eq!(
             o.status.code(),
             Some(0),
@@ -169,14 +174,7 @@ fn a_bad_given_line_gets_an_error_record_and_the_others_are_checked() {
     )
     .unwrap();
     let checked = dir.path().join("checked.jsonl");
-    let o = grasp_sim()
-        .args(["check", "--samples", "2", "--grasps"])
-        .arg(&given)
-        .arg(&d40)
-        .arg("--out")
-        .arg(&checked)
-        .output()
-        .unwrap();
+    let o = check(&given, &d40, "2", Some(&checked));
     assert_eq!(
         o.status.code(),
         Some(2),
@@ -226,14 +224,7 @@ fn a_label_file_of_two_objects_is_checked_on_each_object_by_its_own_lines() {
     let text = std::fs::read_to_string(&both).unwrap();
     std::fs::write(&given, format!("{text}\n{bad}\n")).unwrap();
     let checked = dir.path().join("checked.jsonl");
-    let o = grasp_sim()
-        .args(["check", "--samples", "1", "--grasps"])
-        .arg(&given)
-        .arg(&d40)
-        .arg("--out")
-        .arg(&checked)
-        .output()
-        .unwrap();
+    let o = check(&given, &d40, "1", Some(&checked));
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(err.contains("2 lines of other objects left out"), "{err}");
@@ -248,12 +239,7 @@ fn a_label_file_of_two_objects_is_checked_on_each_object_by_its_own_lines() {
     let cup_only = dir.path().join("cup_only.jsonl");
     let cup_lines: String = of("cup").iter().map(|l| format!("{l}\n")).collect();
     std::fs::write(&cup_only, cup_lines).unwrap();
-    let o = grasp_sim()
-        .args(["check", "--samples", "1", "--grasps"])
-        .arg(&cup_only)
-        .arg(&d40)
-        .output()
-        .unwrap();
+    let o = check(&cup_only, &d40, "1", None);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert!(err.contains("no line is of `cylinder_d40`"), "{err}");
