@@ -937,6 +937,12 @@ fn lines_of_object(
             batch::plural(skipped, "line")
         );
     } else if let Some(other) = objects.iter().flatten().find(|o| *o != name) {
+        // The file's text, escaped and cut short: the warning stays one line.
+        let other: String = other
+            .chars()
+            .take(60)
+            .flat_map(char::escape_debug)
+            .collect();
         eprintln!(
             "check: warning: {}: no line is of `{name}` (a line names `{other}`): every line is checked on `{name}`",
             file.display()

@@ -235,14 +235,29 @@ fn a_label_file_of_two_objects_is_checked_on_each_object_by_its_own_lines() {
     }
     let e = c[2]["error"].as_str().unwrap_or_else(|| panic!("{}", c[2]));
     assert!(e.starts_with("line 6:"), "{e}");
-    // Lines that name only another object are all checked, with a warning.
+    // Lines that name only another object are all checked, with a one-line warning (a name
+    // with a line break is shown escaped).
     let cup_only = dir.path().join("cup_only.jsonl");
-    let cup_lines: String = of("cup").iter().map(|l| format!("{l}\n")).collect();
+    let cup_lines: String = of("cup")
+        .iter()
+        .map(|l| {
+            let mut l = (*l).clone();
+            l["object"] = Value::from("cup\nsecond");
+            format!("{l}\n")
+        })
+        .collect();
     std::fs::write(&cup_only, cup_lines).unwrap();
     let o = check(&cup_only, &d40, "1", None);
     let err = String::from_utf8_lossy(&o.stderr);
     assert_eq!(o.status.code(), Some(0), "{err}");
-    assert!(err.contains("no line is of `cylinder_d40`"), "{err}");
+    let warning = err
+        .lines()
+        .find(|l| l.contains("warning"))
+        .unwrap_or_default();
+    assert!(
+        warning.contains("no line is of `cylinder_d40` (a line names `cup\\nsecond`)"),
+        "{err}"
+    );
     assert_eq!(String::from_utf8_lossy(&o.stdout).lines().count(), 2);
 }
 
