@@ -129,10 +129,12 @@ def agreement_summary(rows):
     engines' differences in the closing's shift and in the phalanges on plan."""
     n = len(rows)
     verdicts = sum(r["agree"] for r in rows)
+    held = sum(r["agree_held"] for r in rows)
     planned = sum(r["agree_ap"] for r in rows)
     shifts = [abs(a - b) for a, b in (r["shift"] for r in rows) if a is not None and b is not None]
     on_plan = [abs(a - b) for a, b in (r["on_plan"] for r in rows) if a is not None and b is not None]
     words = [f"{n} grasps: the verdicts agree on {verdicts} ({100 * verdicts / n:.0f} %), "
+             f"whether it held (hold against slip or drop) on {held} ({100 * held / n:.0f} %), "
              f"as_planned on {planned} ({100 * planned / n:.0f} %)"]
     q = quantiles(shifts)
     if q:
@@ -214,6 +216,7 @@ def labels(path, scenes, jsonl, libccd=False):
                "shift": (r["fidelity"]["shift_mm"], m["fidelity"]["shift_mm"]),
                "on_plan": (r["fidelity"]["phalanges_on_plan"], m["fidelity"]["phalanges_on_plan"])}
         row["agree"] = row["rapier"] == row["mujoco"]
+        row["agree_held"] = (row["rapier"] == "hold") == (row["mujoco"] == "hold")
         row["agree_ap"] = row["rapier_as_planned"] == row["mujoco_as_planned"]
         rows.append(row)
         o = per_object.setdefault(r["object"], [0, 0, 0])
@@ -325,6 +328,7 @@ def main(argv):
         fr, fm = sim.get("fidelity") or {}, m["fidelity"]
         agree_ap = fr.get("as_planned") == fm["as_planned"]
         rows.append({"agree": agree, "agree_ap": agree_ap,
+                     "agree_held": (m["verdict"] == "hold") == (sim["verdict"] == "hold"),
                      "rapier_as_planned": fr.get("as_planned"),
                      "mujoco_as_planned": fm["as_planned"],
                      "translation_mm": (sim["translation_mm"], m["translation_mm"]),

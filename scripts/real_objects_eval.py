@@ -335,7 +335,7 @@ def table(results, no_mujoco, before=None):
         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     n = {"graspable": 0, "planned": 0, "down": 0, "six": 0, "down_ap": 0, "six_ap": 0,
-         "mj": 0, "agree": 0, "agree_ap": 0}
+         "mj": 0, "agree": 0, "agree_held": 0, "agree_ap": 0}
     for name, r in sorted(results.items()):
         d, s = r["down"], r["six"]
         rel = ", ".join(d.get("relaxations", [])) if d.get("rules") == "extended" else ""
@@ -343,6 +343,8 @@ def table(results, no_mujoco, before=None):
         mj = r.get("mujoco")
         agree = mj is not None and mj["verdict"] == d["verdict"]
         agree_ap = mj is not None and mj.get("as_planned") == d.get("as_planned")
+        # Whether the object stayed, apart from which of slip and drop it did otherwise.
+        agree_held = mj is not None and (mj["verdict"] == "hold") == (d["verdict"] == "hold")
         rows.append(
             f"| {name} | {r['label']} | {d.get('triangles', '')} | {d.get('axis', '')} "
             f"| {d.get('rules', '')}{f' ({rel})' if rel else ''} | {plan} "
@@ -371,6 +373,7 @@ def table(results, no_mujoco, before=None):
         if mj is not None:
             n["mj"] += 1
             n["agree"] += agree
+            n["agree_held"] += agree_held
             n["agree_ap"] += agree_ap
     pct = lambda a, b: f"{100.0 * a / b:.0f} %" if b else "n/a"  # noqa: E731
     line = (
@@ -382,7 +385,9 @@ def table(results, no_mujoco, before=None):
     )
     if not no_mujoco:
         line += (f" MuJoCo replays {n['mj']} checked grasps and agrees on the verdict for "
-                 f"{n['agree']} ({pct(n['agree'], n['mj'])}), on `as_planned` for {n['agree_ap']} "
+                 f"{n['agree']} ({pct(n['agree'], n['mj'])}), on whether it held (hold against slip "
+                 f"or drop) for {n['agree_held']} ({pct(n['agree_held'], n['mj'])}), on "
+                 f"`as_planned` for {n['agree_ap']} "
                  f"({pct(n['agree_ap'], n['mj'])}).")
     line += "\n\n" + stats_line("**Closing** (this run)", closing_stats(results))
     mj = sorted(r["mujoco"]["closing_shift_mm"] for r in results.values()
