@@ -16,6 +16,28 @@ pub const MAX_TEXT_BYTES: u64 = 16 << 20;
 /// The largest results file read (`summarize`, `--resume`, `--merge`) `[bytes]`: 1 GiB.
 pub const MAX_RESULTS_BYTES: u64 = 1 << 30;
 
+/// The longest JSON line read from a results or grasps file `[bytes]`: 16 MiB, some 300 times
+/// a batch record (45 KB) and 5,000 times a label line. A line of numbers parses to some 16
+/// times its length in memory (32 times for a batch record read back), so a 1 GiB file of one
+/// line would take more memory than a machine has.
+pub const MAX_JSON_LINE_BYTES: usize = 16 << 20;
+
+/// Parses one line of a JSON-lines file, refusing a line longer than [`MAX_JSON_LINE_BYTES`]
+/// before the parser allocates for it.
+///
+/// # Errors
+/// The line is too long, or not JSON (the parser's message).
+pub fn parse_json_line(line: &str) -> Result<serde_json::Value, String> {
+    if line.len() > MAX_JSON_LINE_BYTES {
+        return Err(format!(
+            "a line of {} bytes, longer than the {} a line may have",
+            line.len(),
+            size(MAX_JSON_LINE_BYTES as u64)
+        ));
+    }
+    serde_json::from_str(line).map_err(|e| format!("not JSON ({e})"))
+}
+
 /// `n` bytes in the largest binary unit that keeps it whole-ish: `256 MiB`, `16 MiB`, `1 GiB`.
 fn size(n: u64) -> String {
     if n >= 1 << 30 && n.is_multiple_of(1 << 30) {

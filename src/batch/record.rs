@@ -39,8 +39,8 @@ pub struct BatchInfo {
 /// Why a line is not a batch record.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum RecordError {
-    /// Not JSON, with the parser's message.
-    #[error("not JSON ({0})")]
+    /// Not JSON, or too long to read: the parser's message, or the length.
+    #[error("{0}")]
     NotJson(String),
     /// JSON without `batch.<field>`.
     #[error("no `batch.{0}` (not a line written by `batch`)")]
@@ -123,8 +123,7 @@ impl Record {
     /// # Errors
     /// [`RecordError`]: what is wrong with the line.
     pub fn parse(line: &str) -> Result<Record, RecordError> {
-        let value: serde_json::Value =
-            serde_json::from_str(line).map_err(|e| RecordError::NotJson(e.to_string()))?;
+        let value = crate::files::parse_json_line(line).map_err(RecordError::NotJson)?;
         let view = RecordView::of(&value);
         let key = Key {
             input: (view.batch.input.clone()).ok_or(RecordError::NoBatchField("input"))?,

@@ -167,7 +167,7 @@ struct ReadLine {
 
 /// Reads a line written by `label`.
 fn read_line(text: &str) -> Result<ReadLine, String> {
-    let v: serde_json::Value = serde_json::from_str(text).map_err(|e| format!("not JSON ({e})"))?;
+    let v = crate::files::parse_json_line(text)?;
     let info: LabelInfo = serde_json::from_value(v["label"].clone()).map_err(|_| {
         "no `label` with `input`, `input_hash`, `grasps` (not a line written by `label`)"
             .to_string()
@@ -622,7 +622,7 @@ fn run_isolated(
     let summary: Mutex<Option<ObjectSummary>> = Mutex::new(None);
     let on_line = |text: &str| {
         if let Some(s) = text.strip_prefix("summary ") {
-            if let Ok(v) = serde_json::from_str::<serde_json::Value>(s) {
+            if let Ok(v) = crate::files::parse_json_line(s) {
                 *summary.lock().unwrap_or_else(|p| p.into_inner()) = summary_of(&v);
             }
             return;
@@ -804,7 +804,7 @@ fn write_npz(
             .lines
             .values()
             .filter(|l| l.grasp_index.is_some() && !l.is_error)
-            .filter_map(|l| serde_json::from_str(&l.text).ok())
+            .filter_map(|l| crate::files::parse_json_line(&l.text).ok())
             .collect();
         let Some(first) = lines.first() else { continue };
         let name = first["object"].as_str().unwrap_or("object").to_string();
@@ -922,7 +922,7 @@ fn lines_of_object(
     let objects: Vec<Option<String>> = given
         .iter()
         .map(|(_, l)| {
-            serde_json::from_str::<serde_json::Value>(l)
+            crate::files::parse_json_line(l)
                 .ok()
                 .and_then(|v| v.get("object")?.as_str().map(str::to_string))
         })

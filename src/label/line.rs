@@ -71,12 +71,16 @@ impl GraspLine {
     /// What is wrong with the line, in words: not JSON, a field missing or of the wrong shape, a
     /// number that is not finite, a pose that is not rigid, an unknown axis.
     pub fn parse(line: &str, fingers: usize) -> Result<GraspLine, String> {
-        let v: serde_json::Value = serde_json::from_str(line).map_err(|e| {
+        let v = crate::files::parse_json_line(line).map_err(|e| {
             // Python's json.dumps writes NaN and Infinity, which are not JSON.
-            if ["NaN", "Infinity"].iter().any(|w| line.contains(w)) {
-                format!("holds NaN or Infinity, not a finite number (not JSON: {e})")
-            } else {
-                format!("not JSON ({e})")
+            match e.strip_prefix("not JSON ") {
+                Some(why) if ["NaN", "Infinity"].iter().any(|w| line.contains(w)) => {
+                    format!(
+                        "holds NaN or Infinity, not a finite number (not JSON: {})",
+                        why.trim_start_matches('(').trim_end_matches(')')
+                    )
+                }
+                _ => e,
             }
         })?;
         let obj = v.as_object().ok_or("not a JSON object")?;

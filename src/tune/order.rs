@@ -136,8 +136,8 @@ pub fn read_labels(path: &Path) -> anyhow::Result<Labels> {
         if line.trim().is_empty() {
             continue;
         }
-        let v: serde_json::Value = serde_json::from_str(line)
-            .map_err(|e| anyhow::anyhow!("{}: line {}: not JSON ({e})", path.display(), i + 1))?;
+        let v = crate::files::parse_json_line(line)
+            .map_err(|e| anyhow::anyhow!("{}: line {}: {e}", path.display(), i + 1))?;
         if v.get("error").is_some() || v.get("hold_probability").is_none() {
             continue;
         }

@@ -1414,3 +1414,101 @@ fn an_output_that_cannot_be_written_says_why() {
         &["--report", "cannot create folder", "Not a directory"],
     );
 }
+
+/// A JSON line longer than 16 MiB (`files::MAX_JSON_LINE_BYTES`) is refused before it is
+/// parsed: parsed, a line of numbers takes 16–32 times its length in memory, so a results or
+/// grasps file of one 1 GiB line (the largest read) would exhaust a machine. In a grasps file it
+/// costs its own record only; as a batch's or label's `--out` to resume, or as `tune --labels`,
+/// it is refused with its line.
+#[test]
+fn a_json_line_longer_than_16_mib_is_refused_before_it_is_parsed() {
+    let dir = tempfile::tempdir().unwrap();
+    let d40 = crate::root().join("assets/objects/cylinder_d40.stl");
+    let plan = grasp_sim()
+        .args(["--no-sim", "--json"])
+        .arg(&d40)
+        .output()
+        .unwrap();
+    let r: serde_json::Value = serde_json::from_slice(&plan.stdout).unwrap();
+    let g = &r["plan"]["grasp"];
+    let angles: Vec<[f64; 2]> = g["fingers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| {
+            [
+                f["theta1_deg"].as_f64().unwrap(),
+                f["theta2_deg"].as_f64().unwrap(),
+            ]
+        })
+        .collect();
+    let good = serde_json::json!({
+        "palm_pose": g["palm_pose"],
+        "joint_angles_deg": angles,
+        "axis_name": g["axis_name"],
+    });
+    let long = format!("{{\"palm_pose\": [{}1]}}", "1,".repeat(9 << 20));
+    assert!(long.len() > 16 << 20);
+    let given = dir.path().join("given.jsonl");
+    std::fs::write(&given, format!("{long}\n{good}\n")).unwrap();
+    let out = dir.path().join("o.jsonl");
+    let run = grasp_sim()
+        .args(["check", "--samples", "1", "--grasps"])
+        .arg(&given)
+        .arg(&d40)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    let text = std::fs::read_to_string(&out).unwrap();
+    let records: Vec<serde_json::Value> = text
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(records.len(), 2, "{text}");
+    let why = records[0]["error"].as_str().unwrap();
+    assert!(
+        why.starts_with("line 1: a line of ")
+            && why.ends_with("longer than the 16 MiB a line may have"),
+        "{why}"
+    );
+    assert_eq!(records[1]["verdict"], "hold", "{}", records[1]);
+
+    // The same line where a file of results is read back.
+    let results = dir.path().join("results.jsonl");
+    std::fs::write(&results, format!("{long}\n")).unwrap();
+    for args in [
+        vec!["batch", "--no-sim", "--resume", "--out"],
+        vec![
+            "label",
+            "--grasps",
+            "1",
+            "--samples",
+            "1",
+            "--resume",
+            "--out",
+        ],
+    ] {
+        let run = grasp_sim()
+            .args(&args)
+            .arg(&results)
+            .arg(&d40)
+            .output()
+            .unwrap();
+        refused(&run, &["results.jsonl", "line 1", "longer than the 16 MiB"]);
+    }
+    let run = grasp_sim()
+        .args(["tune", "--labels"])
+        .arg(&results)
+        .args(["--objective", "first", "--out"])
+        .arg(dir.path().join("tune"))
+        .output()
+        .unwrap();
+    refused(
+        &run,
+        &["results.jsonl: line 1: a line of", "longer than the 16 MiB"],
+    );
+}
