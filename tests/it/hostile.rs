@@ -1512,3 +1512,28 @@ fn a_json_line_longer_than_16_mib_is_refused_before_it_is_parsed() {
         &["results.jsonl: line 1: a line of", "longer than the 16 MiB"],
     );
 }
+
+/// Each line given to `check --grasps` becomes a record of some hundred bytes, so a grasps file
+/// of short lines within the 1 GiB cap would take hundreds of gigabytes: more than 1,000,000
+/// lines (`label::command::MAX_GIVEN_LINES`) are refused before any is read, nothing written.
+#[test]
+fn a_grasps_file_of_more_lines_than_a_check_takes_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d40 = crate::root().join("assets/objects/cylinder_d40.stl");
+    let given = dir.path().join("given.jsonl");
+    std::fs::write(&given, "{}\n".repeat(1_000_001)).unwrap();
+    let out = dir.path().join("o.jsonl");
+    let run = grasp_sim()
+        .args(["check", "--grasps"])
+        .arg(&given)
+        .arg(&d40)
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    refused(
+        &run,
+        &["given.jsonl: 1000001 lines, more than the 1000000 one check takes"],
+    );
+    assert!(!out.exists());
+}
