@@ -367,6 +367,13 @@ fn merge(request: &Request, keys: &[Key]) -> anyhow::Result<u8> {
                 .into_iter()
                 .map(|(line, r)| (format!("{}:{line}", f.display()), r)),
         );
+        if records.len() > journal::MAX_RECORDS {
+            anyhow::bail!(
+                "{}: more than the {} records a batch file may hold, with the shard files before it",
+                f.display(),
+                journal::MAX_RECORDS
+            );
+        }
     }
     let merged = super::merge(keys, records)?;
     let mut text = String::new();

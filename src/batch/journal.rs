@@ -35,15 +35,29 @@ pub fn read_records(path: &Path) -> Result<ReadRecords, BatchError> {
     parse_records(path, &bytes)
 }
 
+/// The most records a batch file read back may hold (`--resume`, `--merge`): a batch of a
+/// million objects. Each record read takes some 1.6 KB besides its line, so a file of short
+/// lines within the 1 GiB cap (27 million) would take some 40 GB.
+pub const MAX_RECORDS: usize = 1_000_000;
+
 fn parse_records(path: &Path, bytes: &[u8]) -> Result<ReadRecords, BatchError> {
     let complete = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     let mut out = ReadRecords {
         records: Vec::new(),
         partial_bytes: bytes.len() - complete,
     };
+    let mut count = 0;
     for (i, line) in bytes[..complete].split(|&b| b == b'\n').enumerate() {
         if line.iter().all(u8::is_ascii_whitespace) {
             continue;
+        }
+        count += 1;
+        if count > MAX_RECORDS {
+            return Err(BatchError::NotARecord {
+                path: path.to_path_buf(),
+                line: i + 1,
+                why: format!("more than the {MAX_RECORDS} records a batch file may hold"),
+            });
         }
         let not_record = |why: String| BatchError::NotARecord {
             path: path.to_path_buf(),

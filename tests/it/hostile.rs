@@ -1537,3 +1537,46 @@ fn a_grasps_file_of_more_lines_than_a_check_takes_is_refused() {
     );
     assert!(!out.exists());
 }
+
+/// A batch file read back (`--resume`, `--merge`) holds at most 1,000,000 records
+/// (`batch::journal::MAX_RECORDS`): each takes some 1.6 KB besides its line, so a file of short
+/// records within the 1 GiB cap would take some 40 GB. Refused with the line past the cap.
+#[test]
+fn a_batch_file_of_more_records_than_a_batch_holds_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d40 = crate::root().join("assets/objects/cylinder_d40.stl");
+    let text: String = (0..1_000_001)
+        .map(|i| format!("{{\"batch\":{{\"input\":\"a{i}\",\"input_hash\":\"h\"}}}}\n"))
+        .collect();
+    let results = dir.path().join("results.jsonl");
+    std::fs::write(&results, &text).unwrap();
+    let run = grasp_sim()
+        .args(["batch", "--no-sim", "--resume", "--out"])
+        .arg(&results)
+        .arg(&d40)
+        .output()
+        .unwrap();
+    refused(
+        &run,
+        &["results.jsonl: line 1000001 is not a batch record: more than the 1000000 records"],
+    );
+    let shards = dir.path().join("shards");
+    std::fs::create_dir(&shards).unwrap();
+    let half = text.len() / 2;
+    let cut = half + text[half..].find('\n').unwrap() + 1;
+    std::fs::write(shards.join("a.jsonl"), &text[..cut]).unwrap();
+    std::fs::write(shards.join("b.jsonl"), &text[cut..]).unwrap();
+    let run = grasp_sim()
+        .args(["batch", "--merge"])
+        .arg(&shards)
+        .arg("--out")
+        .arg(dir.path().join("merged.jsonl"))
+        .arg(&d40)
+        .output()
+        .unwrap();
+    refused(
+        &run,
+        &["b.jsonl: more than the 1000000 records a batch file may hold"],
+    );
+    assert!(!dir.path().join("merged.jsonl").exists());
+}
