@@ -1580,3 +1580,41 @@ fn a_batch_file_of_more_records_than_a_batch_holds_is_refused() {
     );
     assert!(!dir.path().join("merged.jsonl").exists());
 }
+
+/// `label --resume` reads back at most 1,000,000 lines (`label::command::MAX_GIVEN_LINES`): 2
+/// million short label lines took 3.6 GB, so a 1 GiB file of them some 23 GB. Refused with the
+/// line past the cap.
+#[test]
+fn a_label_file_of_more_lines_than_a_resume_takes_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    let d40 = crate::root().join("assets/objects/cylinder_d40.stl");
+    let text: String = (0..1_000_001)
+        .map(|i| {
+            format!(
+                "{{\"grasp_index\":0,\"label\":{{\"input\":\"a{i}\",\"input_hash\":\"h\",\
+                 \"grasps\":1,\"wall_ms\":0}}}}\n"
+            )
+        })
+        .collect();
+    let labels = dir.path().join("labels.jsonl");
+    std::fs::write(&labels, &text).unwrap();
+    let run = grasp_sim()
+        .args([
+            "label",
+            "--grasps",
+            "1",
+            "--samples",
+            "1",
+            "--resume",
+            "--out",
+        ])
+        .arg(&labels)
+        .arg(&d40)
+        .output()
+        .unwrap();
+    refused(
+        &run,
+        &["labels.jsonl: line 1000001 is past the 1000000 lines a label file may hold"],
+    );
+    assert_eq!(std::fs::read_to_string(&labels).unwrap(), text);
+}
