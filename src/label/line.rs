@@ -73,12 +73,12 @@ impl GraspLine {
     pub fn parse(line: &str, fingers: usize) -> Result<GraspLine, String> {
         let v = crate::files::parse_json_line(line).map_err(|e| {
             // Python's json.dumps writes NaN and Infinity, which are not JSON.
-            match e.strip_prefix("not JSON ") {
+            let why = e
+                .strip_prefix("not JSON (")
+                .and_then(|w| w.strip_suffix(')'));
+            match why {
                 Some(why) if ["NaN", "Infinity"].iter().any(|w| line.contains(w)) => {
-                    format!(
-                        "holds NaN or Infinity, not a finite number (not JSON: {})",
-                        why.trim_start_matches('(').trim_end_matches(')')
-                    )
+                    format!("holds NaN or Infinity, not a finite number (not JSON: {why})")
                 }
                 _ => e,
             }

@@ -1415,6 +1415,33 @@ fn an_output_that_cannot_be_written_says_why() {
     );
 }
 
+/// `check --grasps given input --out out`, one sample a grasp.
+fn check_grasps(
+    given: &std::path::Path,
+    input: &std::path::Path,
+    out: &std::path::Path,
+) -> std::process::Output {
+    grasp_sim()
+        .args(["check", "--samples", "1", "--grasps"])
+        .arg(given)
+        .arg(input)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+/// `label` resuming the file that follows, one grasp and one sample per object.
+const LABEL_RESUME: [&str; 7] = [
+    "label",
+    "--grasps",
+    "1",
+    "--samples",
+    "1",
+    "--resume",
+    "--out",
+];
+
 /// A JSON line longer than 16 MiB (`files::MAX_JSON_LINE_BYTES`) is refused before it is
 /// parsed: parsed, a line of numbers takes 16–32 times its length in memory, so a results or
 /// grasps file of one 1 GiB line (the largest read) would exhaust a machine. In a grasps file it
@@ -1452,14 +1479,7 @@ fn a_json_line_longer_than_16_mib_is_refused_before_it_is_parsed() {
     let given = dir.path().join("given.jsonl");
     std::fs::write(&given, format!("{long}\n{good}\n")).unwrap();
     let out = dir.path().join("o.jsonl");
-    let run = grasp_sim()
-        .args(["check", "--samples", "1", "--grasps"])
-        .arg(&given)
-        .arg(&d40)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let run = check_grasps(&given, &d40, &out);
     let err = String::from_utf8_lossy(&run.stderr);
     assert_eq!(run.status.code(), Some(2), "{err}");
     assert!(!err.contains("panicked"), "{err}");
@@ -1481,19 +1501,11 @@ fn a_json_line_longer_than_16_mib_is_refused_before_it_is_parsed() {
     let results = dir.path().join("results.jsonl");
     std::fs::write(&results, format!("{long}\n")).unwrap();
     for args in [
-        vec!["batch", "--no-sim", "--resume", "--out"],
-        vec![
-            "label",
-            "--grasps",
-            "1",
-            "--samples",
-            "1",
-            "--resume",
-            "--out",
-        ],
+        &["batch", "--no-sim", "--resume", "--out"][..],
+        &LABEL_RESUME,
     ] {
         let run = grasp_sim()
-            .args(&args)
+            .args(args)
             .arg(&results)
             .arg(&d40)
             .output()
@@ -1523,14 +1535,7 @@ fn a_grasps_file_of_more_lines_than_a_check_takes_is_refused() {
     let given = dir.path().join("given.jsonl");
     std::fs::write(&given, "{}\n".repeat(1_000_001)).unwrap();
     let out = dir.path().join("o.jsonl");
-    let run = grasp_sim()
-        .args(["check", "--grasps"])
-        .arg(&given)
-        .arg(&d40)
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
+    let run = check_grasps(&given, &d40, &out);
     refused(
         &run,
         &["given.jsonl: 1000001 lines, more than the 1000000 one check takes"],
@@ -1599,15 +1604,7 @@ fn a_label_file_of_more_lines_than_a_resume_takes_is_refused() {
     let labels = dir.path().join("labels.jsonl");
     std::fs::write(&labels, &text).unwrap();
     let run = grasp_sim()
-        .args([
-            "label",
-            "--grasps",
-            "1",
-            "--samples",
-            "1",
-            "--resume",
-            "--out",
-        ])
+        .args(LABEL_RESUME)
         .arg(&labels)
         .arg(&d40)
         .output()
