@@ -49,8 +49,18 @@ pub struct ExportInput<'a> {
 /// Metres per millimetre: the one conversion the rapier scene uses too.
 const MM: f64 = crate::sim::convert::M_PER_MM;
 
-/// MuJoCo's timestep in the exported scene `[s]` (see [`write_mjcf`]).
-pub const MUJOCO_TIMESTEP_S: f64 = 2e-4;
+/// MuJoCo's timestep in the exported scene `[s]`. The thesis hand's phalanx 2 (a 14 × 20 ×
+/// 14 mm box of 3.9 g, 5.9e-7 kg·m² about its joint) on its 20 N·m/rad servo has a natural
+/// frequency of 5,800 rad/s: at 0.2 ms (ω·dt 1.2) its servo, capped by `forcerange` while
+/// `implicitfast` treats the servo's damping as always acting, swung phalanx 2 at up to 180
+/// rad/s, three times rapier's speed, and struck objects out of the hand. At 0.05 ms (ω·dt
+/// 0.29) the replay's verdicts no longer change with a halved step
+/// (docs/studies/2026-12-06-mujoco-timestep.md).
+pub const MUJOCO_TIMESTEP_S: f64 = 5e-5;
+
+/// The time constant of MuJoCo's contacts (`solref`) `[s]`: 0.4 ms, the contact stiffness
+/// every replay has used, independent of the step (MuJoCo asks for at least twice the step).
+pub const MUJOCO_CONTACT_TIMECONST_S: f64 = 4e-4;
 
 /// Iterations of MuJoCo's noslip solver in the exported scene. MuJoCo's friction is a soft
 /// constraint: under a steady tangential load a held object creeps (MuJoCo's documentation of
@@ -196,8 +206,9 @@ fn mjcf_options(s: &mut String, case: &Case, meshes: &[(String, Mesh)]) {
     };
     let _ = writeln!(s, "  <compiler angle=\"radian\" autolimits=\"true\"/>");
     // MuJoCo integrates actuator stiffness explicitly: a 20–200 N·m/rad servo on a phalanx of
-    // about 1.5e-5 kg·m² (natural frequency 1,100–3,700 rad/s) is unstable at rapier's 1 ms
-    // step, so the scene uses MuJoCo's `implicitfast` integrator and a 0.2 ms step (ω·dt < 1).
+    // 5.9e-7–3.5e-5 kg·m² (natural frequencies 2,400–5,800 rad/s) is unstable at rapier's 1 ms
+    // step, so the scene uses MuJoCo's `implicitfast` integrator and a step with ω·dt < 0.3
+    // (`MUJOCO_TIMESTEP_S`).
     let _ = writeln!(
         s,
         "  <option timestep=\"{MUJOCO_TIMESTEP_S}\" integrator=\"implicitfast\" gravity=\"{g}\" cone=\"elliptic\" impratio=\"10\" noslip_iterations=\"{MUJOCO_NOSLIP_ITERATIONS}\"/>"
@@ -206,8 +217,7 @@ fn mjcf_options(s: &mut String, case: &Case, meshes: &[(String, Mesh)]) {
     let _ = writeln!(
         s,
         "    <geom friction=\"{} 0 0\" condim=\"3\" solref=\"{:.6} 1\"/>",
-        case.friction,
-        2.0 * MUJOCO_TIMESTEP_S
+        case.friction, MUJOCO_CONTACT_TIMECONST_S
     );
     let _ = writeln!(s, "  </default>");
     let _ = writeln!(s, "  <asset>");

@@ -150,6 +150,75 @@ fn a_non_convex_object_is_exported_as_its_convex_parts() {
     }
 }
 
+/// A box geom's moment of inertia `[kg·m²]` about the z axis through its body's origin (the
+/// hinge): its own about its centre plus the parallel-axis term.
+fn box_inertia_about_hinge(geom: roxmltree::Node) -> f64 {
+    let nums = |a: &str| -> Vec<f64> {
+        geom.attribute(a)
+            .unwrap()
+            .split(' ')
+            .map(|v| v.parse().unwrap())
+            .collect()
+    };
+    let (h, c) = (nums("size"), nums("pos"));
+    let density: f64 = geom.attribute("density").unwrap().parse().unwrap();
+    let mass = density * 8.0 * h[0] * h[1] * h[2];
+    mass * ((4.0 * h[0] * h[0] + 4.0 * h[1] * h[1]) / 12.0 + c[0] * c[0] + c[1] * c[1])
+}
+
+/// The exported step resolves the fastest finger servo: MuJoCo's `implicitfast` integrates a
+/// position servo's stiffness explicitly, and at a step where ω·dt was 1.2 (phalanx 2 on its
+/// 20 N·m/rad servo, 0.2 ms) the capped servo swung phalanx 2 three times as fast as rapier's
+/// motor and struck objects out of the hand (docs/studies/2026-12-06-mujoco-timestep.md).
+/// Phalanx 2 on its servo, and joint 1 under the replay's lock (ten times the stiffness) with
+/// the whole finger on it, each within ω·dt 0.3.
+#[test]
+fn the_mujoco_step_resolves_the_finger_servos() {
+    let dir = export("cylinder_d40");
+    let text = std::fs::read_to_string(dir.path().join("cylinder_d40/scene.xml")).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    let dt: f64 = doc
+        .descendants()
+        .find(|n| n.has_tag_name("option"))
+        .and_then(|n| n.attribute("timestep"))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let geom = |name: &str| {
+        doc.descendants()
+            .find(|n| n.has_tag_name("geom") && n.attribute("name") == Some(name))
+            .unwrap_or_else(|| panic!("geom {name}"))
+    };
+    let kp = |name: &str| -> f64 {
+        doc.descendants()
+            .find(|n| n.has_tag_name("position") && n.attribute("name") == Some(name))
+            .and_then(|n| n.attribute("kp"))
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    for f in ["finger_1", "finger_2", "finger_3"] {
+        let i2 = box_inertia_about_hinge(geom(&format!("{f}_phalanx_2")));
+        // 3.9 g, 20 mm long: 5.9e-7 kg·m² about joint 2.
+        assert!((i2 - 5.9e-7).abs() < 0.1e-7, "{f}: phalanx 2 {i2:e} kg·m²");
+        let w2 = (kp(&format!("{f}_joint_2")) / i2).sqrt();
+        assert!(
+            w2 * dt <= 0.3,
+            "{f} joint 2: ω {w2:.0} rad/s, ω·dt {:.2}",
+            w2 * dt
+        );
+        // Joint 1 carries phalanx 1 and, straight out beyond it, phalanx 2 (the least inertia
+        // over the bends is at least phalanx 1's alone).
+        let i1 = box_inertia_about_hinge(geom(&format!("{f}_phalanx_1")));
+        let w1 = (10.0 * kp(&format!("{f}_joint_1")) / i1).sqrt();
+        assert!(
+            w1 * dt <= 0.3,
+            "{f} joint 1 locked: ω {w1:.0} rad/s, ω·dt {:.2}",
+            w1 * dt
+        );
+    }
+}
+
 #[test]
 fn urdf_has_links_joints_limits_and_effort() {
     let dir = export("cup");
