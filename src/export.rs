@@ -51,12 +51,14 @@ const MM: f64 = crate::sim::convert::M_PER_MM;
 
 /// MuJoCo's timestep in the exported scene `[s]`. The thesis hand's phalanx 2 (a 14 × 20 ×
 /// 14 mm box of 3.9 g, 5.9e-7 kg·m² about its joint) on its 20 N·m/rad servo has a natural
-/// frequency of 5,800 rad/s: at 0.2 ms (ω·dt 1.2) its servo, capped by `forcerange` while
-/// `implicitfast` treats the servo's damping as always acting, swung phalanx 2 at up to 180
-/// rad/s, three times rapier's speed, and struck objects out of the hand. At 0.05 ms (ω·dt
-/// 0.29) the replay's verdicts no longer change with a halved step
-/// (docs/studies/2026-12-06-mujoco-timestep.md).
-pub const MUJOCO_TIMESTEP_S: f64 = 5e-5;
+/// frequency of 5,800 rad/s. Where `forcerange` caps that servo, `implicitfast` (which
+/// linearises the servo's damping into its step) makes joint 2's velocity alternate from step
+/// to step unless ω·dt is small: at 0.2 ms (ω·dt 1.2) phalanx 2 swung between 0 and 170 rad/s,
+/// 19.5° in 4 ms where the motor law (`clamp(kp·e − kv·ω, ±τ)`, integrated at 1 µs) swings
+/// it 7.5°, and struck objects out of the hand; at 0.05 ms it was still 6.9° off under a 1 N·m
+/// cap. At 0.025 ms (ω·dt 0.15) a lone phalanx 2 follows the law within 0.4°
+/// (docs/studies/2026-12-06-mujoco-timestep.md, `scripts/mujoco_servo_step.py`).
+pub const MUJOCO_TIMESTEP_S: f64 = 2.5e-5;
 
 /// The time constant of MuJoCo's contacts (`solref`) `[s]`: 0.4 ms, the contact stiffness
 /// every replay has used, independent of the step (MuJoCo asks for at least twice the step).
@@ -207,7 +209,7 @@ fn mjcf_options(s: &mut String, case: &Case, meshes: &[(String, Mesh)]) {
     let _ = writeln!(s, "  <compiler angle=\"radian\" autolimits=\"true\"/>");
     // MuJoCo integrates actuator stiffness explicitly: a 20–200 N·m/rad servo on a phalanx of
     // 5.9e-7–3.5e-5 kg·m² (natural frequencies 2,400–5,800 rad/s) is unstable at rapier's 1 ms
-    // step, so the scene uses MuJoCo's `implicitfast` integrator and a step with ω·dt < 0.3
+    // step, so the scene uses MuJoCo's `implicitfast` integrator and a step with ω·dt ≤ 0.15
     // (`MUJOCO_TIMESTEP_S`).
     let _ = writeln!(
         s,

@@ -168,10 +168,11 @@ fn box_inertia_about_hinge(geom: roxmltree::Node) -> f64 {
 
 /// The exported step resolves the fastest finger servo: MuJoCo's `implicitfast` integrates a
 /// position servo's stiffness explicitly, and at a step where ω·dt was 1.2 (phalanx 2 on its
-/// 20 N·m/rad servo, 0.2 ms) the capped servo swung phalanx 2 three times as fast as rapier's
-/// motor and struck objects out of the hand (docs/studies/2026-12-06-mujoco-timestep.md).
-/// Phalanx 2 on its servo, and joint 1 under the replay's lock (ten times the stiffness) with
-/// the whole finger on it, each within ω·dt 0.3.
+/// 20 N·m/rad servo, 0.2 ms) the capped servo swung phalanx 2 at twice the motor law's speed
+/// and struck objects out of the hand; at ω·dt 0.29 it was still 1.5 times too fast, at 0.15
+/// it follows the law (docs/studies/2026-12-06-mujoco-timestep.md). Phalanx 2 on its servo,
+/// and joint 1 under the replay's lock (ten times the stiffness) with the whole finger on it,
+/// each within ω·dt 0.15.
 #[test]
 fn the_mujoco_step_resolves_the_finger_servos() {
     let dir = export("cylinder_d40");
