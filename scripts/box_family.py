@@ -12,7 +12,8 @@ import struct
 import sys
 
 
-def box(w, d, h, path):
+def box_triangles(w, d, h):
+    """The box's 12 triangles as (outward normal, (a, b, c)), anticlockwise seen from outside."""
     half = (w / 2, d / 2, h / 2)
     tris = []
     for axis in range(3):
@@ -32,6 +33,11 @@ def box(w, d, h, path):
                 if sum(cross[i] * n[i] for i in range(3)) < 0:
                     t = (t[0], t[2], t[1])
                 tris.append((n, t))
+    return tris
+
+
+def box(w, d, h, path):
+    tris = box_triangles(w, d, h)
     with open(path, "wb") as f:
         f.write(b"\0" * 80)
         f.write(struct.pack("<I", len(tris)))
