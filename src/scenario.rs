@@ -221,6 +221,61 @@ fn default_theta_tolerance() -> f64 {
     3.0
 }
 
+/// `message` with "; `key` is a key of `[section]`" appended when it is an unknown key that
+/// another section of a scenario takes (`friction` written under `[sim]` belongs in
+/// `[object]`), and no near key of its own section was suggested.
+fn with_section_hint(message: String) -> String {
+    let Some(unknown) = message
+        .split_once("unknown field `")
+        .and_then(|(_, rest)| rest.split_once('`'))
+        .map(|(key, _)| key.to_string())
+    else {
+        return message;
+    };
+    if message.contains("did you mean") {
+        return message;
+    }
+    let homes: Vec<String> = section_keys()
+        .into_iter()
+        .filter(|(_, keys)| keys.contains(&unknown))
+        .map(|(section, _)| format!("`[{section}]`"))
+        .collect();
+    if homes.is_empty() {
+        return message;
+    }
+    format!("{message}; `{unknown}` is a key of {}", homes.join(" and "))
+}
+
+/// Each scenario section's keys, read from its parser's own answer to a key it does not take
+/// (serde's "unknown field `x`, expected one of ..."), so that the list cannot drift from the
+/// structs.
+fn section_keys() -> Vec<(&'static str, Vec<String>)> {
+    fn keys<T: serde::de::DeserializeOwned>() -> Vec<String> {
+        let Err(e) = toml::from_str::<T>("__not_a_key__ = 0") else {
+            return Vec::new();
+        };
+        let message = e.message().to_string();
+        message
+            .split_once("expected")
+            .map(|(_, expected)| {
+                expected
+                    .split('`')
+                    .skip(1)
+                    .step_by(2)
+                    .map(str::to_string)
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+    vec![
+        ("object", keys::<RawObject>()),
+        ("hand", keys::<RawHand>()),
+        ("planner", keys::<PlannerParams>()),
+        ("sim", keys::<SimParams>()),
+        ("expect", keys::<Expect>()),
+    ]
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawScenario {
@@ -339,7 +394,7 @@ impl Scenario {
     fn parse_as(text: &str, path: &Path, template: bool) -> Result<Scenario, ScenarioError> {
         let raw: RawScenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
             path: path.to_path_buf(),
-            message: crate::messages::toml_message(&e, text),
+            message: with_section_hint(crate::messages::toml_message(&e, text)),
         })?;
         let _ = raw.description;
         let invalid = |key: &str, problem: String| ScenarioError::Invalid {

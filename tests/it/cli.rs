@@ -915,6 +915,17 @@ fn a_mistyped_key_gets_a_did_you_mean() {
         "{}",
         err(&p)
     );
+    // A key of another section is sent there: `friction` is the object's, not the check's.
+    let p = write(
+        "f.toml",
+        format!("[object]\nmesh = \"{mesh}\"\n[sim]\nfriction = 0.5\n"),
+    );
+    assert!(
+        err(&p).contains("unknown field `friction`")
+            && err(&p).contains("; `friction` is a key of `[object]`"),
+        "{}",
+        err(&p)
+    );
     // A value of the wrong type is named in the file's words, not Rust's.
     let p = write(
         "t.toml",
