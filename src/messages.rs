@@ -129,27 +129,30 @@ fn plain_types(message: &str) -> String {
 /// `None` for anything else.
 fn unknown_section(line: &str, message: &str) -> Option<String> {
     let header = line.strip_prefix('[')?.split(']').next()?.trim();
-    let (unknown, expected) = message.strip_prefix("unknown field `")?.split_once('`')?;
+    let (unknown, known) = unknown_field(message)?;
     if header != unknown || header.contains('.') {
         return None;
     }
-    let known: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
+    let (_, expected) = message.strip_prefix("unknown field `")?.split_once('`')?;
     Some(match did_you_mean(unknown, known) {
         Some(k) => format!("unknown section `[{unknown}]`; did you mean `[{k}]`?"),
         None => format!("unknown section `[{unknown}]`{expected}"),
     })
 }
 
+/// The unknown key and the keys expected instead, from serde's "unknown field `x`, expected
+/// one of `a`, `b`, ..." (or "expected `a`"); `None` for any other message.
+pub(crate) fn unknown_field(message: &str) -> Option<(&str, Vec<&str>)> {
+    let (unknown, expected) = message.strip_prefix("unknown field `")?.split_once('`')?;
+    Some((unknown, expected.split('`').skip(1).step_by(2).collect()))
+}
+
 /// `message` with "; did you mean `key`?" appended when it is serde's "unknown field `x`,
 /// expected one of `a`, `b`, ..." (or "expected `a`") and one known key is close to `x`.
 pub(crate) fn with_suggestion(message: &str) -> String {
-    let Some(rest) = message.strip_prefix("unknown field `") else {
+    let Some((unknown, known)) = unknown_field(message) else {
         return message.to_string();
     };
-    let Some((unknown, expected)) = rest.split_once('`') else {
-        return message.to_string();
-    };
-    let known: Vec<&str> = expected.split('`').skip(1).step_by(2).collect();
     match did_you_mean(unknown, known) {
         Some(k) => format!("{message}; did you mean `{k}`?"),
         None => message.to_string(),

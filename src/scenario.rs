@@ -221,23 +221,19 @@ fn default_theta_tolerance() -> f64 {
     3.0
 }
 
-/// `message` with "; `key` is a key of `[section]`" appended when it is an unknown key that
-/// another section of a scenario takes (`friction` written under `[sim]` belongs in
-/// `[object]`), and no near key of its own section was suggested.
-fn with_section_hint(message: String) -> String {
-    let Some(unknown) = message
-        .split_once("unknown field `")
-        .and_then(|(_, rest)| rest.split_once('`'))
-        .map(|(key, _)| key.to_string())
-    else {
+/// `message` (the one line made of `error`) with "; `key` is a key of `[section]`" appended
+/// when `error` is an unknown key that another section of a scenario takes (`friction` written
+/// under `[sim]` belongs in `[object]`) and no near key of its own section was suggested.
+fn with_section_hint(message: String, error: &str) -> String {
+    let Some((unknown, known)) = crate::messages::unknown_field(error) else {
         return message;
     };
-    if message.contains("did you mean") {
+    if crate::messages::did_you_mean(unknown, known).is_some() {
         return message;
     }
     let homes: Vec<String> = section_keys()
         .into_iter()
-        .filter(|(_, keys)| keys.contains(&unknown))
+        .filter(|(_, keys)| keys.iter().any(|k| k == unknown))
         .map(|(section, _)| format!("`[{section}]`"))
         .collect();
     if homes.is_empty() {
@@ -254,17 +250,8 @@ fn section_keys() -> Vec<(&'static str, Vec<String>)> {
         let Err(e) = toml::from_str::<T>("__not_a_key__ = 0") else {
             return Vec::new();
         };
-        let message = e.message().to_string();
-        message
-            .split_once("expected")
-            .map(|(_, expected)| {
-                expected
-                    .split('`')
-                    .skip(1)
-                    .step_by(2)
-                    .map(str::to_string)
-                    .collect()
-            })
+        crate::messages::unknown_field(e.message())
+            .map(|(_, known)| known.into_iter().map(str::to_string).collect())
             .unwrap_or_default()
     }
     vec![
@@ -394,7 +381,7 @@ impl Scenario {
     fn parse_as(text: &str, path: &Path, template: bool) -> Result<Scenario, ScenarioError> {
         let raw: RawScenario = toml::from_str(text).map_err(|e| ScenarioError::Parse {
             path: path.to_path_buf(),
-            message: with_section_hint(crate::messages::toml_message(&e, text)),
+            message: with_section_hint(crate::messages::toml_message(&e, text), e.message()),
         })?;
         let _ = raw.description;
         let invalid = |key: &str, problem: String| ScenarioError::Invalid {
