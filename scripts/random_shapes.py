@@ -23,22 +23,9 @@ import argparse
 import math
 import os
 import random
-import struct
 
 from box_family import box_triangles
-
-
-def random_rotation(rng):
-    """A uniformly random rotation matrix (Shoemake's method)."""
-    u1, u2, u3 = rng.random(), rng.random(), rng.random()
-    a, b = math.sqrt(1 - u1), math.sqrt(u1)
-    x, y = a * math.sin(2 * math.pi * u2), a * math.cos(2 * math.pi * u2)
-    z, w = b * math.sin(2 * math.pi * u3), b * math.cos(2 * math.pi * u3)
-    return [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ]
+from gen_dataset import random_rotation, write_binary_stl
 
 
 def grid_surface(point, nu, nv, closed_u=False):
@@ -226,14 +213,6 @@ def handle(rng):
 KINDS = [superellipsoid, lathe, prism, compound, torus, handle]
 
 
-def write_stl(path, tris):
-    with open(path, "wb") as f:
-        f.write(b"random_shapes.py".ljust(80, b" "))
-        f.write(struct.pack("<I", len(tris)))
-        for a, b, c in tris:
-            f.write(struct.pack("<12fH", 0, 0, 0, *a, *b, *c, 0))
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("out")
@@ -247,7 +226,8 @@ def main():
         tris = kind(rng)
         off = tuple(rng.uniform(-40, 40) for _ in range(3))
         tris = transform(tris, random_rotation(rng), off)
-        write_stl(os.path.join(args.out, f"{i:03d}_{kind.__name__}.stl"), tris)
+        path = os.path.join(args.out, f"{i:03d}_{kind.__name__}.stl")
+        write_binary_stl(path, tris, "random_shapes.py")
 
 
 if __name__ == "__main__":
