@@ -66,7 +66,8 @@ def block():
         f"({p['slowest']}) {p['max_s']} s, in a run at load average {p['load']} on 2 cores "
         "([BENCHMARKS.md](BENCHMARKS.md#planning-time-on-any-mesh)).",
         f"- **The check's speed.** The D40 cylinder's check takes {s['down_ratio']} of the time "
-        f"MuJoCo's replay of the same scene takes with gravity down ({s['down_ms']} ms) and "
+        f"MuJoCo's replay of the same scene (at its 0.025 ms step) takes with gravity down "
+        f"({s['down_ms']} ms) and "
         f"{s['six_ratio']} in six directions; a batch of the real-object set runs "
         f"{s['checks_per_s']} six-direction "
         f"checks a second on 2 cores at load average {s['load']} "

@@ -545,7 +545,8 @@ fn expected_headline() -> String {
         ),
         format!(
             "- **The check's speed.** The D40 cylinder's check takes {} of the time MuJoCo's \
-             replay of the same scene takes with gravity down ({} ms) and {} in six directions; \
+             replay of the same scene (at its 0.025 ms step) takes with gravity down ({} ms) and \
+             {} in six directions; \
              a batch of the real-object set runs {} six-direction checks a second on 2 cores at \
              load average {} ([BENCHMARKS.md](BENCHMARKS.md#physics-check)).",
             s["down_ratio"], s["down_ms"], s["six_ratio"], s["checks_per_s"], s["load"]
