@@ -697,14 +697,52 @@ impl LoadedMesh {
         w
     }
 
+    /// The largest extent of the file's bounding box `[mm]`: within a factor √3 of
+    /// [`Self::geometric_size_mm`] whatever the frame (in any frame the box's largest extent
+    /// lies between the mesh's diameter over √3 and its diameter), so it decides a size test
+    /// alike in every frame where it is that far from the threshold.
+    fn box_size_mm(&self) -> f64 {
+        let (lo, hi) = self.mesh.bounds();
+        (hi - lo).max()
+    }
+
+    /// The object's largest extent `[mm]` in its frame from the geometry
+    /// ([`super::align::canonical_rotation`]): the same whatever frame the file was written
+    /// in, where the file's box is not (a 6 mm rod turned 45° in its box spans 4.6 mm of it).
+    /// The file's box where the mesh encloses no volume.
+    fn geometric_size_mm(&self) -> f64 {
+        let boxed = self.box_size_mm();
+        let Some(props) = super::align::covariant_mass_properties(&self.mesh) else {
+            return boxed;
+        };
+        let turn = super::align::canonical_rotation(&self.mesh, &props);
+        let (mut lo, mut hi) = (
+            nalgebra::Vector3::repeat(f64::INFINITY),
+            nalgebra::Vector3::repeat(f64::NEG_INFINITY),
+        );
+        for v in &self.mesh.vertices {
+            let p = turn * v.coords;
+            lo = lo.inf(&p);
+            hi = hi.sup(&p);
+        }
+        let size = (hi - lo).max();
+        if size.is_finite() {
+            size
+        } else {
+            boxed
+        }
+    }
+
     /// For an object the planner found ungraspable: a hint when it is plausibly sized but
     /// smaller than twice the smallest diameter the hand grasps (`smallest_grasp_mm`), and a
     /// larger unit makes it hand-sized, as a file in centimetres read as millimetres does. Of
     /// the larger units, the one that puts its largest extent nearest 100 mm is named. `None`
     /// when [`Self::units_warning`] already speaks of the size.
     pub fn small_object_hint(&self, smallest_grasp_mm: f64) -> Option<String> {
-        let (lo, hi) = self.mesh.bounds();
-        let size = (hi - lo).max();
+        if self.box_size_mm() >= 2.0 * smallest_grasp_mm * 3f64.sqrt() {
+            return None;
+        }
+        let size = self.geometric_size_mm();
         if !(PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(&size)
             || size >= 2.0 * smallest_grasp_mm
             || self.format == MeshFormat::Urdf
@@ -739,8 +777,11 @@ impl LoadedMesh {
     /// its largest extent), naming the unit it was read in and the likely one: of the other
     /// units, the one that makes it plausible and nearest 100 mm (a hand-sized object).
     pub fn units_warning(&self) -> Option<String> {
-        let (lo, hi) = self.mesh.bounds();
-        let size = (hi - lo).max();
+        let boxed = self.box_size_mm();
+        if (PLAUSIBLE_MIN_MM * 3f64.sqrt()..=PLAUSIBLE_MAX_MM / 3f64.sqrt()).contains(&boxed) {
+            return None;
+        }
+        let size = self.geometric_size_mm();
         if (PLAUSIBLE_MIN_MM..=PLAUSIBLE_MAX_MM).contains(&size) {
             return None;
         }

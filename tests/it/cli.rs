@@ -578,6 +578,40 @@ fn implausible_sizes_warn_with_the_likely_unit() {
     assert_eq!(r["warnings"], serde_json::json!([]), "{}", r["warnings"]);
 }
 
+/// The size messages judge the object's own extent, not the file's box: a 6 mm rod turned 45°
+/// spans 4.8 mm of its box, which read as implausible (under 5 mm) where the same rod written
+/// square did not; a 4 mm rod is implausible in both frames, with the same message.
+#[test]
+fn the_size_messages_do_not_depend_on_the_file_frame() {
+    let env = Env::new();
+    let turn =
+        nalgebra::Rotation3::from_axis_angle(&nalgebra::Vector3::y_axis(), 45f64.to_radians());
+    let stderr_of = |name: &str, length: f64, turned: bool| {
+        let mut m = grasp_sim::objects::cylinder(0.8, length);
+        if turned {
+            m.map_vertices(|p| turn * p);
+        }
+        env.write(name, m.to_binary_stl());
+        let out = env.run(&["--no-sim", name]);
+        String::from_utf8_lossy(&out.stderr).replace(name, "ROD")
+    };
+    let (square, turned) = (
+        stderr_of("a.stl", 6.0, false),
+        stderr_of("b.stl", 6.0, true),
+    );
+    assert!(!square.contains("implausible"), "{square}");
+    assert!(!turned.contains("implausible"), "{turned}");
+    let (square, turned) = (
+        stderr_of("c.stl", 4.0, false),
+        stderr_of("d.stl", 4.0, true),
+    );
+    assert!(
+        square.contains("the object is 4.00 mm across as read"),
+        "{square}"
+    );
+    assert_eq!(square, turned);
+}
+
 /// Issue 16 item 10: `gen-assets` outside the repository writes scenarios that run there (they
 /// name the bundled hand, not a path into the repository).
 #[test]
