@@ -716,15 +716,9 @@ impl LoadedMesh {
             return boxed;
         };
         let turn = super::align::canonical_rotation(&self.mesh, &props);
-        let (mut lo, mut hi) = (
-            nalgebra::Vector3::repeat(f64::INFINITY),
-            nalgebra::Vector3::repeat(f64::NEG_INFINITY),
-        );
-        for v in &self.mesh.vertices {
-            let p = turn * v.coords;
-            lo = lo.inf(&p);
-            hi = hi.sup(&p);
-        }
+        let mut turned = self.mesh.clone();
+        turned.map_vertices(|p| turn * p);
+        let (lo, hi) = turned.bounds();
         let size = (hi - lo).max();
         if size.is_finite() {
             size
