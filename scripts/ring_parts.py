@@ -5,6 +5,7 @@
     python3 scripts/ring_parts.py run --binary B --out O [--half DEG] [--sectors N] \
         [--units U] [--jobs N] [--gravity six] MESH...
     python3 scripts/ring_parts.py summary O
+    python3 scripts/ring_parts.py crops --binary B [--halves 50,70,90,120,150] O
 
 The planner's axes pass through the object's centroid, which for a ring lies in its hole, so it
 never sees the ring's tube as a bar to wrap. This crops a ring to an arc of its tube, plans on
@@ -32,6 +33,13 @@ scales the meshes to mm first (written so into O/whole and O/parts).
 probability and each arc's first grasp's; the means over the rings planned both ways and over
 the rings each arc plans; and the arc grasps' closings (as planned, shift, turn). Meshes are
 binary or ASCII STL, or OBJ. Needs numpy.
+
+`crops` (after `run`): checks each arc's grasps again on wider crops of the whole ring about the
+same direction (`--halves`, degrees; written into O/crops), and prints, per crop and for the
+whole ring, the nominal closings kept as planned and their median shift; then the arc grasps by
+where the palm sits on the tube (on its outer rim, in the hole, on a face of the ring's plane):
+their hold probability on the whole ring and their closings as planned on the arc and on the
+whole.
 """
 import argparse
 import collections
@@ -223,12 +231,81 @@ def summary(out):
               f"median shift {shift:.1f} mm, turn {turn:.1f} deg")
 
 
+def tube_frame(tris, k):
+    """The ring's plane normal, arc direction k and tube radius, as `arc` takes them."""
+    verts = tris.reshape(-1, 3)
+    mean = verts.mean(0)
+    _, vecs = np.linalg.eigh(np.cov((verts - mean).T))
+    normal, e1, e2 = vecs[:, 0], vecs[:, 2], vecs[:, 1]
+    ang = math.pi / 2 * k
+    v = verts - mean
+    radial = np.linalg.norm(v - np.outer(v @ normal, normal), axis=1)
+    return mean, normal, math.cos(ang) * e1 + math.sin(ang) * e2, (radial.min() + radial.max()) / 2
+
+
+def placement(tris, k, palm_pose):
+    """Where the palm sits about the tube: `rim` (outside), `hole` or `face`."""
+    mean, normal, _, radius = tube_frame(tris, k)
+    p = np.array(palm_pose)[:3, 3] - mean
+    out = np.linalg.norm(p - (p @ normal) * normal) - radius
+    a = abs(math.degrees(math.atan2(p @ normal, out)))
+    return "rim" if a < 45 else "hole" if a > 135 else "face"
+
+
+def crops(args):
+    grasps = os.path.join(args.out, "grasps")
+    cdir = os.path.join(args.out, "crops")
+    os.makedirs(cdir, exist_ok=True)
+    halves = [float(h) for h in args.halves.split(",")]
+    closed = collections.defaultdict(list)
+    places = collections.defaultdict(list)
+    for f in sorted(os.listdir(grasps)):
+        if f.endswith(".out.jsonl"):
+            continue
+        name = f[: -len(".jsonl")]
+        given = records(os.path.join(grasps, f))
+        tris = load_mesh(os.path.join(args.out, "whole", name + ".stl"))
+        for g, r in zip(given, records(os.path.join(grasps, name + ".out.jsonl"))):
+            if "fidelity" not in r:
+                continue
+            closed["whole"].append(r["fidelity"])
+            k = int(g["part"].rsplit("_k", 1)[1])
+            places[placement(tris, k, g["palm_pose"])].append((r, g["fidelity"]["as_planned"]))
+        for part in sorted({g["part"] for g in given}):
+            k = int(part.rsplit("_k", 1)[1])
+            mine = [g for g in given if g["part"] == part]
+            gfile = os.path.join(cdir, part + ".jsonl")
+            with open(gfile, "w") as fh:
+                fh.writelines(json.dumps(g) + "\n" for g in mine)
+            for h in halves:
+                mesh = os.path.join(cdir, f"{part}_h{h:g}.stl")
+                write_stl(mesh, arc(tris, h, k))
+                cmd = [args.binary, "check", "--grasps", gfile, mesh, "--samples", "1"]
+                out = subprocess.run(cmd, capture_output=True, text=True).stdout
+                closed[f"+-{h:g} deg"] += [r["fidelity"] for r in map(json.loads, out.splitlines()) if "fidelity" in r]
+    print("| checked on | grasps | nominal closings as planned | median shift [mm] |")
+    print("|---|---|---|---|")
+    for key, fs in closed.items():
+        shift = statistics.median(f["shift_mm"] for f in fs)
+        print(f"| {key} | {len(fs)} | {sum(f['as_planned'] for f in fs)} | {shift:.1f} |")
+    print("\n| palm | grasps | hold probability on the whole | as planned: arc / whole |")
+    print("|---|---|---|---|")
+    for where, rs in sorted(places.items()):
+        p = sum(r["hold_probability"] for r, _ in rs) / len(rs)
+        whole = sum(r["fidelity"]["as_planned"] for r, _ in rs)
+        print(f"| {where} | {len(rs)} | {p:.3f} | {sum(a for _, a in rs)} / {whole} |")
+
+
 def main():
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
     g = sub.add_parser("gate")
     g.add_argument("meshes", nargs="+")
     sub.add_parser("summary").add_argument("out")
+    c = sub.add_parser("crops")
+    c.add_argument("--binary", required=True)
+    c.add_argument("--halves", default="50,70,90,120,150")
+    c.add_argument("out")
     r = sub.add_parser("run")
     r.add_argument("--binary", required=True)
     r.add_argument("--out", required=True)
@@ -241,6 +318,8 @@ def main():
     args = ap.parse_args()
     if args.cmd == "summary":
         summary(args.out)
+    elif args.cmd == "crops":
+        crops(args)
     elif args.cmd == "gate":
         for m in args.meshes:
             print(("ring " if is_ring(load_mesh(m)) else "     ") + m)
