@@ -6,6 +6,7 @@
         [--units U] [--jobs N] [--gravity six] MESH...
     python3 scripts/ring_parts.py summary O
     python3 scripts/ring_parts.py crops --binary B [--halves 50,70,90,120,150] O
+    python3 scripts/ring_parts.py order LABELS.jsonl O
 
 The planner's axes pass through the object's centroid, which for a ring lies in its hole, so it
 never sees the ring's tube as a bar to wrap. This crops a ring to an arc of its tube, plans on
@@ -40,6 +41,14 @@ whole ring, the nominal closings kept as planned and their median shift; then th
 where the palm sits on the tube (on its outer rim, in the hole, on a face of the ring's plane):
 their hold probability on the whole ring and their closings as planned on the arc and on the
 whole.
+
+`order` (after `run`): what the search's closing order (`[sim] order_by_closing`) would check
+first, from the nominal closings already run. LABELS.jsonl is `grasp-sim label` of the whole
+rings with several grasps each (`--grasps 16`). Per ring, the first of: the whole ring's picks as
+the tool orders them today (its first candidate if its closing kept the plan, else the closing
+kept as planned, then the least shift), the first arc's first grasp, and the same closing order
+over the arc grasps, and over the arc grasps and the whole ring's picks together; each one's
+hold probability, and their means.
 """
 import argparse
 import collections
@@ -296,6 +305,50 @@ def crops(args):
         print(f"| {where} | {len(rs)} | {p:.3f} | {sum(a for _, a in rs)} / {whole} |")
 
 
+def closing_order(rs):
+    """The candidate the closings' order puts first: kept as planned, then the least shift."""
+    return min(rs, key=lambda r: (not r["fidelity"]["as_planned"], r["fidelity"]["shift_mm"]))
+
+
+def order(args):
+    whole = collections.defaultdict(list)
+    for r in records(args.labels):
+        if "hold_probability" in r:
+            whole[r["object"]].append(r)
+    grasps = os.path.join(args.out, "grasps")
+    rows = []
+    for f in sorted(os.listdir(grasps)):
+        if not f.endswith(".out.jsonl"):
+            continue
+        name = f[: -len(".out.jsonl")]
+        given = records(os.path.join(grasps, name + ".jsonl"))
+        arcs = [dict(r, part=g["part"]) for g, r in zip(given, records(os.path.join(grasps, f)))
+                if "hold_probability" in r]
+        if not arcs:
+            continue
+        first_part = min(r["part"] for r in arcs)
+        first = min((r for r in arcs if r["part"] == first_part), key=lambda r: r["grasp_index"])
+        kept = first["fidelity"]["as_planned"]
+        w = sorted(whole.get(name, []), key=lambda r: r["grasp_index"])
+        today = None
+        if w:
+            today = w[0] if w[0]["fidelity"]["as_planned"] else closing_order(w)
+        rows.append((name, today and today["hold_probability"], first["hold_probability"],
+                     (first if kept else closing_order(arcs))["hold_probability"],
+                     (first if kept else closing_order(arcs + w))["hold_probability"]))
+    heads = ["whole ring, the tool today", "first arc's first grasp",
+             "closings' order over the arc grasps", "closings' order over arcs and whole"]
+    print("| ring | " + " | ".join(heads) + " |")
+    print("|---|" + "---|" * len(heads))
+    for r in rows:
+        print(f"| {r[0]} | " + " | ".join("no plan" if x is None else f"{x:.3f}" for x in r[1:]) + " |")
+    both = [r for r in rows if r[1] is not None]
+    for i, h in enumerate(heads, 1):
+        every = [r[i] for r in rows if r[i] is not None]
+        print(f"{h}: {sum(every) / len(every):.3f} over {len(every)} rings; "
+              f"{sum(r[i] for r in both) / max(1, len(both)):.3f} over the {len(both)} planned both ways")
+
+
 def main():
     ap = argparse.ArgumentParser()
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -306,6 +359,9 @@ def main():
     c.add_argument("--binary", required=True)
     c.add_argument("--halves", default="50,70,90,120,150")
     c.add_argument("out")
+    o = sub.add_parser("order")
+    o.add_argument("labels")
+    o.add_argument("out")
     r = sub.add_parser("run")
     r.add_argument("--binary", required=True)
     r.add_argument("--out", required=True)
@@ -320,6 +376,8 @@ def main():
         summary(args.out)
     elif args.cmd == "crops":
         crops(args)
+    elif args.cmd == "order":
+        order(args)
     elif args.cmd == "gate":
         for m in args.meshes:
             print(("ring " if is_ring(load_mesh(m)) else "     ") + m)
