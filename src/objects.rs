@@ -282,3 +282,31 @@ pub fn training_objects() -> Vec<(&'static str, Mesh)> {
         ("wide_drum", cylinder(110.0, 100.0)),
     ]
 }
+
+/// A torus about Z, its tube's centre line `big` from the axis and its tube `small` in radius
+/// `[mm]`, `around` segments about the axis and `across` about the tube (closed, manifold): a
+/// ring, which the planner searches on arcs of its tube first ([`crate::mesh::ring`]).
+pub fn torus(big: f64, small: f64, around: u32, across: u32) -> Mesh {
+    let (n, m) = (around.max(3), across.max(3));
+    let mut vertices = Vec::new();
+    for i in 0..n {
+        let a = f64::from(i) / f64::from(n) * std::f64::consts::TAU;
+        for j in 0..m {
+            let b = f64::from(j) / f64::from(m) * std::f64::consts::TAU;
+            let r = big + small * b.cos();
+            vertices.push(Point3::new(r * a.cos(), r * a.sin(), small * b.sin()));
+        }
+    }
+    let v = |i: u32, j: u32| (i % n) * m + (j % m);
+    let mut triangles = Vec::new();
+    for i in 0..n {
+        for j in 0..m {
+            triangles.push([v(i, j), v(i + 1, j), v(i + 1, j + 1)]);
+            triangles.push([v(i, j), v(i + 1, j + 1), v(i, j + 1)]);
+        }
+    }
+    Mesh {
+        vertices,
+        triangles,
+    }
+}

@@ -101,11 +101,15 @@ impl Selection {
     }
 
     /// The axis plan the report describes: the chosen grasp's, else the thesis's axis under the
-    /// thesis's rules (the first planned).
+    /// thesis's rules (the first planned of the whole object's: a ring's arcs come before it).
     pub fn reported_axis(&self) -> &AxisPlan {
         match self.chosen() {
             Some(c) => &self.axes[c.axis_plan],
-            None => &self.axes[0],
+            None => self
+                .axes
+                .iter()
+                .find(|a| a.aligned.axis.arc.is_none())
+                .unwrap_or(&self.axes[0]),
         }
     }
 
@@ -233,6 +237,9 @@ pub fn select(
         .unwrap_or_else(|| select_in(mesh, props, p, None, timings))
 }
 
+/// An axis's frame for [`select_in`]: the object in it, and for an arc of a ring the arc in it.
+type Frames = (AlignedObject, Option<AlignedObject>);
+
 /// [`select`] without `order_by_closing`; the search ends as soon as `stop` is set (what it
 /// found is returned as it stands, nothing chosen).
 fn select_in(
@@ -248,34 +255,49 @@ fn select_in(
         chosen: None,
     };
     let collect = p.collect.max(1);
-    let mut aligned_cache: Vec<Option<AlignedObject>> = vec![None; GraspAxis::SEARCH_ORDER.len()];
+    // A ring's arcs first ([`crate::mesh::ring`]), then the whole object's axes.
+    let ring = crate::mesh::ring::is_ring(mesh, props, p.frame);
+    let axes: Vec<GraspAxis> = if ring {
+        GraspAxis::RING_ARCS
+            .iter()
+            .chain(&GraspAxis::SEARCH_ORDER)
+            .copied()
+            .collect()
+    } else {
+        GraspAxis::SEARCH_ORDER.to_vec()
+    };
+    // Per axis: the object in its frame, and for an arc the arc in it, which the planner sees.
+    let mut aligned_cache: Vec<Option<Option<Frames>>> = vec![None; axes.len()];
     for rules in [RuleSet::Thesis, RuleSet::Extended, RuleSet::Pinch] {
         if rules.is_extended() && (!p.planner.extended_rules || !wants_extended(&sel, p)) {
             break;
         }
         // The candidates this rule set has tried over its axes (the budget is per rule set).
         let mut spent = 0usize;
-        for (k, axis) in GraspAxis::SEARCH_ORDER.iter().enumerate() {
+        for (k, axis) in axes.iter().enumerate() {
             if is_done(&sel, p, collect) || stop.is_some_and(std::cell::Cell::get) {
                 break;
             }
-            let aligned = aligned_cache[k]
-                .get_or_insert_with(|| align_with_rule(mesh, props, *axis, p.frame))
-                .clone();
+            let frames = aligned_cache[k].get_or_insert_with(|| match axis.arc {
+                Some(_) => crate::mesh::ring::arc_frames(mesh, props, *axis, p.frame)
+                    .map(|(whole, arc)| (whole, Some(arc))),
+                None => Some((align_with_rule(mesh, props, *axis, p.frame), None)),
+            });
+            let Some((aligned, arc)) = frames.clone() else {
+                continue;
+            };
             let mut t = StageTimings::default();
-            let graded = graded_for(&sel, p, rules, &aligned, &mut t);
+            let graded = graded_for(&sel, p, rules, arc.as_ref().unwrap_or(&aligned), &mut t);
             // An equal share of what is left of the rule set's budget (rounded up, so an axis
             // with few candidates leaves more to those after it).
             let budget = match p.planner.candidate_budget {
                 0 => usize::MAX,
-                b => b
-                    .saturating_sub(spent)
-                    .div_ceil(GraspAxis::SEARCH_ORDER.len() - k),
+                b => b.saturating_sub(spent).div_ceil(axes.len() - k),
             };
             let plan = search_axis(
                 &mut sel,
                 p,
-                (aligned, rules, graded),
+                (aligned, arc, rules, graded),
                 budget,
                 (collect, stop),
                 &mut t,
@@ -587,7 +609,12 @@ fn graded_for(
 fn search_axis(
     sel: &mut Selection,
     p: &SelectParams,
-    (aligned, rules, graded): (AlignedObject, RuleSet, plan::GradedDomain),
+    (aligned, arc, rules, graded): (
+        AlignedObject,
+        Option<AlignedObject>,
+        RuleSet,
+        plan::GradedDomain,
+    ),
     budget: usize,
     (collect, stop): (usize, Option<&std::cell::Cell<bool>>),
     t: &mut StageTimings,
@@ -613,10 +640,12 @@ fn search_axis(
         });
         !is_done(sel, p, collect) && !stop.is_some_and(std::cell::Cell::get)
     };
+    // The planner sees the arc of a ring; the check, the whole object in the arc's frame.
+    let planned_on = arc.as_ref().unwrap_or(&aligned);
     let factors = OrderFactors::of(p.planner);
     let (tried, rejections) = if factors.is_thesis() {
         search_with(
-            &aligned.mesh,
+            &planned_on.mesh,
             p.hand,
             &graded,
             p.planner,
@@ -631,9 +660,9 @@ fn search_axis(
     } else {
         // Issue 58: the axis's feasible grasps in the thesis's order, then taken by falling
         // score ([`crate::plan::order`]); the candidate budget bounds the search as before.
-        let (all, searched) = all_feasible(p, &aligned, &graded, rules, budget);
+        let (all, searched) = all_feasible(p, planned_on, &graded, rules, budget);
         found = all.len();
-        let order = crate::plan::order::reorder(&all, &aligned, p.hand, &factors);
+        let order = crate::plan::order::reorder(&all, planned_on, p.hand, &factors);
         let mut slots: Vec<Option<Grasp>> = all.into_iter().map(Some).collect();
         stopped = order
             .into_iter()

@@ -91,7 +91,7 @@ impl GraspLine {
             None | Some(serde_json::Value::Null) => GraspAxis::THESIS,
             Some(serde_json::Value::String(name)) => GraspAxis::from_name(name).ok_or_else(|| {
                 format!(
-                    "`axis_name` \"{name}\" is none of least, middle, largest (each with - when turned round)"
+                    "`axis_name` \"{name}\" is none of least, middle, largest (each with - when turned round), arc0, arc90"
                 )
             })?,
             Some(_) => return Err("`axis_name` is not a string".into()),

@@ -74,6 +74,10 @@ pub struct GraspAxis {
     pub rank: usize,
     /// True if and only if the axis is turned round (the object stands on its other end).
     pub flipped: bool,
+    /// For an arc of a ring ([`crate::mesh::ring`]): the arc's direction in degrees from the
+    /// ring's axis of least moment, about its axis of the largest; `rank` is then the arc's own
+    /// axis. `None` for the whole object.
+    pub arc: Option<u16>,
 }
 
 impl GraspAxis {
@@ -81,7 +85,31 @@ impl GraspAxis {
     pub const THESIS: GraspAxis = GraspAxis {
         rank: 0,
         flipped: false,
+        arc: None,
     };
+
+    /// The arcs of a ring the planner searches before the whole object: ±50° of the tube about
+    /// the ring's axis of least moment, and about the direction a quarter turn from it.
+    pub const RING_ARCS: [GraspAxis; 2] = [GraspAxis::ring_arc(0), GraspAxis::ring_arc(90)];
+
+    /// The principal axis of rank `rank` (0 the least moment), flipped or not.
+    pub const fn principal(rank: usize, flipped: bool) -> GraspAxis {
+        GraspAxis {
+            rank,
+            flipped,
+            arc: None,
+        }
+    }
+
+    /// The arc of a ring `degrees` from its axis of least moment, searched along its own axis
+    /// of least moment.
+    pub const fn ring_arc(degrees: u16) -> GraspAxis {
+        GraspAxis {
+            rank: 0,
+            flipped: false,
+            arc: Some(degrees),
+        }
+    }
 
     /// The order in which the planner tries the axes: the thesis's axis first (the thesis
     /// method, and the long axis of an elongated object, which the fingers wrap best), then the
@@ -92,26 +120,32 @@ impl GraspAxis {
         GraspAxis {
             rank: 0,
             flipped: false,
+            arc: None,
         },
         GraspAxis {
             rank: 1,
             flipped: false,
+            arc: None,
         },
         GraspAxis {
             rank: 2,
             flipped: false,
+            arc: None,
         },
         GraspAxis {
             rank: 0,
             flipped: true,
+            arc: None,
         },
         GraspAxis {
             rank: 1,
             flipped: true,
+            arc: None,
         },
         GraspAxis {
             rank: 2,
             flipped: true,
+            arc: None,
         },
     ];
 
@@ -121,15 +155,26 @@ impl GraspAxis {
             Some(m) => (m, true),
             None => (name, false),
         };
+        if let Some(degrees) = m.strip_prefix("arc") {
+            let degrees: u16 = degrees.parse().ok().filter(|d| *d < 360)?;
+            return Some(GraspAxis {
+                flipped,
+                ..GraspAxis::ring_arc(degrees)
+            });
+        }
         let rank = ["least", "middle", "largest"]
             .iter()
             .position(|n| *n == m)?;
-        Some(GraspAxis { rank, flipped })
+        Some(GraspAxis::principal(rank, flipped))
     }
 
-    /// A short name: `least`, `middle` or `largest` (moment), with `-` when flipped.
+    /// A short name: `least`, `middle` or `largest` (moment), or `arc0`, `arc90` for an arc of
+    /// a ring, with `-` when flipped.
     pub fn name(&self) -> String {
-        let m = ["least", "middle", "largest"][self.rank.min(2)];
+        let m = match self.arc {
+            Some(degrees) => format!("arc{degrees}"),
+            None => ["least", "middle", "largest"][self.rank.min(2)].to_string(),
+        };
         if self.flipped {
             format!("{m}-")
         } else {
@@ -246,6 +291,15 @@ pub fn align_with_rule(
     which: GraspAxis,
     rule: FrameRule,
 ) -> AlignedObject {
+    if which.arc.is_some() {
+        if let Some((whole, _)) = super::ring::arc_frames(mesh, props, which, rule) {
+            return whole;
+        }
+        // An arc with no volume (not a ring): the whole object about its own axis.
+        let mut a = align_with_rule(mesh, props, GraspAxis { arc: None, ..which }, rule);
+        a.axis = which;
+        return a;
+    }
     let given = props;
     match rule {
         FrameRule::File => align_with(mesh, props, which),

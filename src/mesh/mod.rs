@@ -17,6 +17,7 @@ mod load;
 mod mass;
 mod polygon_limits;
 pub mod primitives;
+pub mod ring;
 pub mod slice;
 pub mod urdf;
 

@@ -254,7 +254,7 @@ fn checked_axis(
         )))),
         None => Err(Error::Given(format!(
             "axis \"{name}\" is not a principal axis (least, middle, largest, each with `-` \
-             when flipped)"
+             when flipped) nor an arc of a ring (arc0, arc90)"
         ))),
     }
 }

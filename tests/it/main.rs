@@ -20,6 +20,7 @@ mod quality;
 mod real_meshes;
 mod repository;
 mod resume;
+mod rings;
 mod robust;
 mod settings;
 mod sim;
