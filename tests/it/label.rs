@@ -7,7 +7,7 @@ use serde_json::Value;
 use std::path::Path;
 
 /// The lines of a JSON Lines file.
-fn lines(path: &Path) -> Vec<Value> {
+pub(crate) fn lines(path: &Path) -> Vec<Value> {
     std::fs::read_to_string(path)
         .unwrap()
         .lines()
@@ -16,7 +16,7 @@ fn lines(path: &Path) -> Vec<Value> {
 }
 
 /// A line without what differs between runs: its `label` part (input, hash, wall time).
-fn without_label(v: &Value) -> Value {
+pub(crate) fn without_label(v: &Value) -> Value {
     let mut v = v.clone();
     v.as_object_mut().unwrap().remove("label");
     v

@@ -2,6 +2,7 @@
 //! and held, its label lines check again as given grasps to the bit, and no real object is
 //! taken for a ring.
 
+use crate::label::{lines, without_label};
 use crate::{grasp_sim, root};
 use grasp_sim::mesh::{self, FrameRule};
 use serde_json::Value;
@@ -14,17 +15,18 @@ fn torus_stl(dir: &std::path::Path) -> std::path::PathBuf {
     path
 }
 
+/// Asserts a run exited 0, showing its stderr if not.
+fn succeeded(o: &std::process::Output) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(0), "{err}");
+}
+
 #[test]
 fn a_torus_is_held_by_a_grasp_planned_on_an_arc_of_its_tube() {
     let dir = tempfile::tempdir().unwrap();
     let torus = torus_stl(dir.path());
     let o = grasp_sim().arg(&torus).arg("--json").output().unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    succeeded(&o);
     let v: Value = serde_json::from_slice(&o.stdout).unwrap();
     // The arcs are searched first, along the tube: both before every axis of the whole ring.
     let axes: Vec<&str> = v["plan"]["axes"]
@@ -64,17 +66,8 @@ fn an_arc_grasps_label_line_checks_again_to_the_bit() {
         .arg(&torus)
         .output()
         .unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let text = std::fs::read_to_string(&out).unwrap();
-    let labelled: Vec<Value> = text
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
+    succeeded(&o);
+    let labelled = lines(&out);
     assert_eq!(labelled.len(), 3);
     assert!(
         labelled[0]["axis_name"]
@@ -93,24 +86,11 @@ fn an_arc_grasps_label_line_checks_again_to_the_bit() {
         .arg(&checked)
         .output()
         .unwrap();
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    let again: Vec<Value> = std::fs::read_to_string(&checked)
-        .unwrap()
-        .lines()
-        .map(|l| serde_json::from_str(l).unwrap())
-        .collect();
-    let strip = |v: &Value| {
-        let mut v = v.clone();
-        v.as_object_mut().unwrap().remove("label");
-        v
-    };
+    succeeded(&o);
+    let again = lines(&checked);
+    assert_eq!(again.len(), 3);
     for (a, b) in labelled.iter().zip(&again) {
-        assert_eq!(strip(a), strip(b));
+        assert_eq!(without_label(a), without_label(b));
     }
 }
 
