@@ -643,8 +643,10 @@ def check(obj: Any, plan_or_grasp: Union[None, Plan, Grasp] = None,
         return result
     if source is not None:
         # The planner is deterministic: the same object, hand and parameters give the same
-        # first grasp, and checking only it (max_checked 1) checks the plan's grasp.
+        # first grasp, and checking only it (max_checked 1, and no closings' order, which would
+        # check another candidate where its closing leaves the plan) checks the plan's grasp.
         flags["max_checked"] = 1
+        sim["order_by_closing"] = 0
     report = _run("grasp_sim.check", _scenario(o, h, pp, sim), **flags)
     result = Check(report)
     if source is not None and source.grasp is not None:

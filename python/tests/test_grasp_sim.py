@@ -126,6 +126,16 @@ def test_a_grasp_from_a_pose_is_checked_as_given(cup, cup_plan):
     assert gs.check(cup, gs.Grasp.from_pose(back, g.joint_angles_deg, g.axis_name)).verdict == "drop"
 
 
+def test_a_plan_whose_first_closing_leaves_it_is_checked_on_its_own_grasp():
+    # The door handle's first candidate closes off its plan, so a run's search goes on to the
+    # closings' order; checking the plan checks the plan's grasp all the same.
+    handle = gs.Object.from_file(ROOT / "assets" / "real" / "meshes" / "mw_door_handle.stl")
+    p = gs.plan(handle)
+    c = gs.check(handle, p)
+    assert c.grasp.raw["palm_pose"] == p.grasp.raw["palm_pose"]
+    assert c.fidelity["as_planned"] is False
+
+
 def test_a_later_candidate_is_checked_as_given(cup):
     p = gs.plan(cup, candidates=3)
     assert len(p.candidates) == 3
