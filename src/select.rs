@@ -256,7 +256,8 @@ fn select_in(
     };
     let collect = p.collect.max(1);
     // A ring's arcs first ([`crate::mesh::ring`]), then the whole object's axes.
-    let ring = crate::mesh::ring::is_ring(mesh, props, p.frame);
+    let principal = crate::mesh::principal_axes(mesh, props, p.frame);
+    let ring = crate::mesh::ring::is_ring(mesh, props, &principal);
     let axes: Vec<GraspAxis> = if ring {
         GraspAxis::RING_ARCS
             .iter()
@@ -279,7 +280,7 @@ fn select_in(
                 break;
             }
             let frames = aligned_cache[k].get_or_insert_with(|| match axis.arc {
-                Some(_) => crate::mesh::ring::arc_frames(mesh, props, *axis, p.frame)
+                Some(_) => crate::mesh::ring::arc_frames(mesh, props, *axis, p.frame, &principal)
                     .map(|(whole, arc)| (whole, Some(arc))),
                 None => Some((align_with_rule(mesh, props, *axis, p.frame), None)),
             });

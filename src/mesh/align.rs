@@ -200,40 +200,9 @@ pub fn align_about(mesh: &Mesh, which: GraspAxis) -> AlignedObject {
 /// axis chosen).
 pub fn align_with(mesh: &Mesh, props: &MassProperties, which: GraspAxis) -> AlignedObject {
     let props = *props;
-    let eig = SymmetricEigen::new(props.inertia);
-    // Sort eigenpairs by moment, ascending; ties broken by index for determinism.
-    let mut order = [0usize, 1, 2];
-    order.sort_by(|&a, &b| {
-        eig.eigenvalues[a]
-            .total_cmp(&eig.eigenvalues[b])
-            .then(a.cmp(&b))
-    });
-    let axis = |i: usize| -> Vector3<f64> { eig.eigenvectors.column(order[i]).into_owned() };
-    let moment = |i: usize| eig.eigenvalues[order[i]];
-
-    let rank = which.rank.min(2);
-    let rest: Vec<usize> = (0..3).filter(|&i| i != rank).collect();
-    let z = sign_towards(axis(rank), &[Vector3::z(), Vector3::x(), Vector3::y()]);
-    let (m1, m2) = (moment(rest[0]), moment(rest[1]));
-    let scale = m1.abs().max(m2.abs()).max(f64::MIN_POSITIVE);
-    let x_raw = if (m2 - m1).abs() / scale > DEGENERATE_MOMENTS {
-        axis(rest[0])
-    } else {
-        [Vector3::x(), Vector3::y(), Vector3::z()]
-            .iter()
-            .map(|a| a - z * z.dot(a))
-            .find(|v| v.norm() > 1e-6)
-            .unwrap_or_else(Vector3::x)
-    };
-    // Re-orthogonalise against z (eigenvectors are orthogonal only to rounding).
-    let x = (x_raw - z * z.dot(&x_raw)).normalize();
-    let x = sign_towards(x, &[Vector3::x(), Vector3::y(), Vector3::z()]);
-    let z = if which.flipped { -z } else { z };
-    let y = z.cross(&x);
-
+    let (x, y, z) = aligned_axes(&props, which);
     // Rows of the rotation are the new axes expressed in the original frame.
-    let r = Matrix3::from_rows(&[x.transpose(), y.transpose(), z.transpose()]);
-    let rotation = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r));
+    let rotation = axes_rotation(x, y, z);
     let c = props.centroid.coords;
     let rotated_centroid = rotation * c;
     let mut to_aligned = Isometry3::from_parts(Translation3::from(-rotated_centroid), rotation);
@@ -265,6 +234,52 @@ pub fn align_with(mesh: &Mesh, props: &MassProperties, which: GraspAxis) -> Alig
     }
 }
 
+/// The aligned frame's axes in the original frame, from the mass properties alone: Z the
+/// principal axis `which` names, X the smaller-moment remaining axis, each signed by the file
+/// rule (see [`align_about`]).
+fn aligned_axes(
+    props: &MassProperties,
+    which: GraspAxis,
+) -> (Vector3<f64>, Vector3<f64>, Vector3<f64>) {
+    let eig = SymmetricEigen::new(props.inertia);
+    // Sort eigenpairs by moment, ascending; ties broken by index for determinism.
+    let mut order = [0usize, 1, 2];
+    order.sort_by(|&a, &b| {
+        eig.eigenvalues[a]
+            .total_cmp(&eig.eigenvalues[b])
+            .then(a.cmp(&b))
+    });
+    let axis = |i: usize| -> Vector3<f64> { eig.eigenvectors.column(order[i]).into_owned() };
+    let moment = |i: usize| eig.eigenvalues[order[i]];
+
+    let rank = which.rank.min(2);
+    let rest: Vec<usize> = (0..3).filter(|&i| i != rank).collect();
+    let z = sign_towards(axis(rank), &[Vector3::z(), Vector3::x(), Vector3::y()]);
+    let (m1, m2) = (moment(rest[0]), moment(rest[1]));
+    let scale = m1.abs().max(m2.abs()).max(f64::MIN_POSITIVE);
+    let x_raw = if (m2 - m1).abs() / scale > DEGENERATE_MOMENTS {
+        axis(rest[0])
+    } else {
+        [Vector3::x(), Vector3::y(), Vector3::z()]
+            .iter()
+            .map(|a| a - z * z.dot(a))
+            .find(|v| v.norm() > 1e-6)
+            .unwrap_or_else(Vector3::x)
+    };
+    // Re-orthogonalise against z (eigenvectors are orthogonal only to rounding).
+    let x = (x_raw - z * z.dot(&x_raw)).normalize();
+    let x = sign_towards(x, &[Vector3::x(), Vector3::y(), Vector3::z()]);
+    let z = if which.flipped { -z } else { z };
+    let y = z.cross(&x);
+    (x, y, z)
+}
+
+/// The rotation whose rows are `x`, `y` and `z`.
+fn axes_rotation(x: Vector3<f64>, y: Vector3<f64>, z: Vector3<f64>) -> UnitQuaternion<f64> {
+    let r = Matrix3::from_rows(&[x.transpose(), y.transpose(), z.transpose()]);
+    UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(r))
+}
+
 /// How an object's own frame (the aligned frame's axes and senses) is chosen.
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Deserialize, serde::Serialize,
@@ -292,7 +307,9 @@ pub fn align_with_rule(
     rule: FrameRule,
 ) -> AlignedObject {
     if which.arc.is_some() {
-        if let Some((whole, _)) = super::ring::arc_frames(mesh, props, which, rule) {
+        if let Some((whole, _)) =
+            super::ring::arc_frames(mesh, props, which, rule, &principal_axes(mesh, props, rule))
+        {
             return whole;
         }
         // An arc with no volume (not a ring): the whole object about its own axis.
@@ -304,26 +321,9 @@ pub fn align_with_rule(
     match rule {
         FrameRule::File => align_with(mesh, props, which),
         FrameRule::Geometry => {
-            // The frame from moments that turn with the mesh whatever its topology: for one
-            // closed shell they are `props`; for an open or a many-shell mesh `props` may be
-            // integrated about the file's bounding box or over slices in its frame.
-            let own = covariant_mass_properties(mesh).unwrap_or(*props);
-            let props = &own;
-            let c = canonical_rotation(mesh, props);
+            let (c, turned_props) = canonical_turn(mesh, props);
             let mut turned_mesh = mesh.clone();
             turned_mesh.map_vertices(|p| c * p);
-            // The inertia in the canonical frame, made exactly diagonal, and moments the rule
-            // calls equal made exactly equal: the file rule then takes the canonical axes as
-            // they are (ties by axis index), never the eigen-solver's choice within a plane of
-            // equal moments, which round-off would turn with the file's frame.
-            let m = c.matrix();
-            let turned = m * props.inertia * m.transpose();
-            let d = equalized([turned[(0, 0)], turned[(1, 1)], turned[(2, 2)]]);
-            let turned_props = MassProperties {
-                centroid: c * props.centroid,
-                inertia: Matrix3::from_diagonal(&Vector3::new(d[0], d[1], d[2])),
-                ..*props
-            };
             let mut a = align_with(&turned_mesh, &turned_props, which);
             a.to_aligned *= Isometry3::from_parts(
                 Translation3::identity(),
@@ -333,6 +333,52 @@ pub fn align_with_rule(
             a
         }
     }
+}
+
+/// The [`canonical_rotation`] of `mesh` and its mass properties turned by it, with which
+/// [`align_with_rule`] aligns under [`FrameRule::Geometry`].
+fn canonical_turn(mesh: &Mesh, props: &MassProperties) -> (Rotation3<f64>, MassProperties) {
+    // The frame from moments that turn with the mesh whatever its topology: for one closed
+    // shell they are `props`; for an open or a many-shell mesh `props` may be integrated about
+    // the file's bounding box or over slices in its frame.
+    let own = covariant_mass_properties(mesh).unwrap_or(*props);
+    let props = &own;
+    let c = canonical_rotation(mesh, props);
+    // The inertia in the canonical frame, made exactly diagonal, and moments the rule calls
+    // equal made exactly equal: the file rule then takes the canonical axes as they are (ties
+    // by axis index), never the eigen-solver's choice within a plane of equal moments, which
+    // round-off would turn with the file's frame.
+    let m = c.matrix();
+    let turned = m * props.inertia * m.transpose();
+    let d = equalized([turned[(0, 0)], turned[(1, 1)], turned[(2, 2)]]);
+    let turned_props = MassProperties {
+        centroid: c * props.centroid,
+        inertia: Matrix3::from_diagonal(&Vector3::new(d[0], d[1], d[2])),
+        ..*props
+    };
+    (c, turned_props)
+}
+
+/// The principal axes of ranks 0, 1 and 2 (least moment first) in the file's frame, each as
+/// `align_with_rule(mesh, props, GraspAxis::principal(rank, false), rule)
+/// .principal_axis_original()` gives it, to the bit, without moving the mesh: the ring gate
+/// and the arcs ([`super::ring`]) need no more.
+pub fn principal_axes(mesh: &Mesh, props: &MassProperties, rule: FrameRule) -> [Vector3<f64>; 3] {
+    let (turn, props) = match rule {
+        FrameRule::File => (UnitQuaternion::identity(), *props),
+        FrameRule::Geometry => {
+            let (c, turned) = canonical_turn(mesh, props);
+            (UnitQuaternion::from_rotation_matrix(&c), turned)
+        }
+    };
+    [0, 1, 2].map(|rank| {
+        let (x, y, z) = aligned_axes(&props, GraspAxis::principal(rank, false));
+        let rotation = match rule {
+            FrameRule::File => axes_rotation(x, y, z),
+            FrameRule::Geometry => axes_rotation(x, y, z) * turn,
+        };
+        rotation.inverse() * Vector3::z()
+    })
 }
 
 /// `d` with the moments [`canonical_rotation`] calls equal made exactly equal: where two pairs
@@ -672,5 +718,30 @@ mod tests {
         assert_eq!(d[0], d[2]);
         assert_eq!(d[1], 3.0 * a);
         assert_eq!(equalized([1.0, 2.0, 3.0]), [1.0, 2.0, 3.0]);
+    }
+
+    #[test]
+    fn principal_axes_are_the_aligned_frames_axes_to_the_bit() {
+        use super::{align_with_rule, principal_axes, FrameRule, GraspAxis};
+        use crate::mesh::mass_properties;
+        use nalgebra::Rotation3;
+        // A cup, a box turned off the file's axes, and a torus (whose in-plane moments tie).
+        let turn = Rotation3::from_euler_angles(0.3, -0.7, 1.1);
+        let mut tilted = crate::mesh::primitives::prism(30.0, 50.0, 80.0);
+        tilted.map_vertices(|p| turn * p);
+        let cup = crate::objects::thesis_objects().remove(0).1;
+        let torus = crate::objects::torus(40.0, 12.0, 72, 24);
+        for mesh in [cup, tilted, torus] {
+            let props = mass_properties(&mesh);
+            for rule in [FrameRule::Geometry, FrameRule::File] {
+                let axes = principal_axes(&mesh, &props, rule);
+                for (rank, axis) in axes.iter().enumerate() {
+                    let a = align_with_rule(&mesh, &props, GraspAxis::principal(rank, false), rule);
+                    assert_eq!(*axis, a.principal_axis_original(), "{rule:?} {rank}");
+                }
+                // Three distinct directions, one per rank.
+                assert!(axes[0].dot(&axes[1]).abs() < 1e-9 && axes[1].dot(&axes[2]).abs() < 1e-9);
+            }
+        }
     }
 }

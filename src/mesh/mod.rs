@@ -23,7 +23,7 @@ pub mod urdf;
 
 pub use align::{
     align, align_about, align_with, align_with_rule, canonical_rotation, covariant_mass_properties,
-    AlignedObject, FrameRule, GraspAxis,
+    principal_axes, AlignedObject, FrameRule, GraspAxis,
 };
 pub use load::{
     check_planner_work, load_mesh, load_stl, parse_mesh, parse_stl, LengthUnit, LoadedMesh,
@@ -546,12 +546,15 @@ impl Mesh {
                 continue;
             }
             let pts: Vec<Point3<f64>> = lp.iter().map(|&v| self.vertices[v as usize]).collect();
-            let extent = pts
-                .iter()
-                .flat_map(|p| pts.iter().map(move |q| (p - q).norm()))
-                .fold(0.0, f64::max);
-            if extent > max_extent_mm {
-                continue;
+            // The loop's extent is O(L²): measured only against a finite bound.
+            if max_extent_mm < f64::INFINITY {
+                let extent = pts
+                    .iter()
+                    .flat_map(|p| pts.iter().map(move |q| (p - q).norm()))
+                    .fold(0.0, f64::max);
+                if extent > max_extent_mm {
+                    continue;
+                }
             }
             let centre =
                 Point3::from(pts.iter().map(|p| p.coords).sum::<Vector3<f64>>() / pts.len() as f64);

@@ -21,15 +21,13 @@ pub const ARC_HALF_DEG: f64 = 50.0;
 /// largest moment meets no triangle, and each line through the centroid along the other two
 /// axes crosses the surface on both sides, an even number of times on each (the centroid lies
 /// outside the material, which surrounds it in the ring's plane). A cup or a bowl is not one
-/// (the axis meets its bottom), nor a U-shaped handle (no material on one side).
-pub fn is_ring(mesh: &Mesh, props: &MassProperties, rule: FrameRule) -> bool {
+/// (the axis meets its bottom), nor a U-shaped handle (no material on one side). `axes` are the
+/// mesh's [`principal_axes`](super::principal_axes) under the search's frame rule.
+pub fn is_ring(mesh: &Mesh, props: &MassProperties, axes: &[Vector3<f64>; 3]) -> bool {
     if props.volume_mm3.is_nan() || props.volume_mm3 <= 0.0 {
         return false;
     }
-    let axis = |rank: usize| {
-        let a = align_with_rule(mesh, props, GraspAxis::principal(rank, false), rule);
-        a.principal_axis_original()
-    };
+    let axis = |rank: usize| axes[rank];
     // The lines pass a hair beside the centroid, in no direction of the mesh's, so that none
     // runs exactly through a vertex or along an edge (the frame's in-plane axis points at the
     // farthest vertex) and every crossing counts once.
@@ -87,18 +85,17 @@ fn crossings(mesh: &Mesh, p: &Point3<f64>, d: &Vector3<f64>) -> (usize, usize) {
 /// moment, about the axis of the largest) and the frame the planner searches it in: the arc's
 /// own axis of least moment, in `which`'s sense, aligned as any object is under `rule`.
 /// Returns the whole mesh in that frame (for the check: its collider, gravity and the palm's
-/// pose) and the arc in it (for the planner). `None` when the arc holds no volume.
+/// pose) and the arc in it (for the planner). `None` when the arc holds no volume. `axes` are
+/// the mesh's [`principal_axes`](super::principal_axes) under `rule`.
 pub fn arc_frames(
     mesh: &Mesh,
     props: &MassProperties,
     which: GraspAxis,
     rule: FrameRule,
+    axes: &[Vector3<f64>; 3],
 ) -> Option<(AlignedObject, AlignedObject)> {
     let degrees = f64::from(which.arc?);
-    let least = align_with_rule(mesh, props, GraspAxis::principal(0, false), rule)
-        .principal_axis_original();
-    let normal = align_with_rule(mesh, props, GraspAxis::principal(2, false), rule)
-        .principal_axis_original();
+    let (least, normal) = (axes[0], axes[2]);
     let (s, c) = degrees.to_radians().sin_cos();
     let dir = least * c + normal.cross(&least) * s;
     let crop = arc_of(mesh, &props.centroid, &normal, &dir, ARC_HALF_DEG)?;
@@ -168,6 +165,7 @@ fn arc_of(
 mod tests {
     use super::*;
     use crate::mesh::primitives;
+    use crate::mesh::principal_axes;
 
     fn torus(big: f64, small: f64) -> Mesh {
         crate::objects::torus(big, small, 72, 24)
@@ -184,14 +182,15 @@ mod tests {
             "{}",
             props.volume_mm3
         );
-        assert!(is_ring(&t, &props, FrameRule::Geometry));
+        let axes = |m: &Mesh, p: &MassProperties| principal_axes(m, p, FrameRule::Geometry);
+        assert!(is_ring(&t, &props, &axes(&t, &props)));
         let others = crate::objects::thesis_objects()
             .into_iter()
             .chain(crate::objects::training_objects())
             .chain([("ball", primitives::uv_sphere(30.0, 36))]);
         for (name, other) in others {
             let p = mass_properties(&other);
-            assert!(!is_ring(&other, &p, FrameRule::Geometry), "{name}");
+            assert!(!is_ring(&other, &p, &axes(&other, &p)), "{name}");
         }
     }
 
@@ -199,9 +198,11 @@ mod tests {
     fn an_arc_spans_its_angle_is_closed_and_lies_along_the_tube() {
         let t = torus(40.0, 12.0);
         let props = mass_properties(&t);
+        let axes = principal_axes(&t, &props, FrameRule::Geometry);
         for arc in [0, 90] {
             let which = GraspAxis::ring_arc(arc);
-            let (whole, planned) = arc_frames(&t, &props, which, FrameRule::Geometry).unwrap();
+            let (whole, planned) =
+                arc_frames(&t, &props, which, FrameRule::Geometry, &axes).unwrap();
             assert!(planned.mesh.topology().is_closed_manifold());
             // The tube's volume over 100° of the 360°, to the facets' and the fans' error.
             let v = mass_properties(&planned.mesh).volume_mm3;

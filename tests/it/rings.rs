@@ -112,7 +112,11 @@ fn no_real_object_is_taken_for_a_ring() {
         let mut t = grasp_sim::plan::timings::StageTimings::default();
         let object = grasp_sim::prepared::PreparedObject::load(&s.object, &mut t).unwrap();
         assert!(
-            !mesh::ring::is_ring(object.mesh(), &object.props, FrameRule::Geometry),
+            !mesh::ring::is_ring(
+                object.mesh(),
+                &object.props,
+                &mesh::principal_axes(object.mesh(), &object.props, FrameRule::Geometry)
+            ),
             "{}",
             path.display()
         );
