@@ -644,7 +644,19 @@ fn search_axis(
     // The planner sees the arc of a ring; the check, the whole object in the arc's frame.
     let planned_on = arc.as_ref().unwrap_or(&aligned);
     let factors = OrderFactors::of(p.planner);
-    let (tried, rejections) = if factors.is_thesis() {
+    // Under the rules beyond the thesis, a grasp whose net push along the axis leaves the
+    // friction cone is rejected ([`plan::squeeze`]).
+    let surface = plan::squeeze::Surface::new(&planned_on.mesh);
+    let mut pushed_out = 0usize;
+    let mut pushes_out = |g: &Grasp| {
+        let out = p.planner.net_push_cone
+            && rules.is_extended()
+            && plan::squeeze::net_push_lean(&surface, &plan::contacts::planned_contacts(g, p.hand))
+                .is_some_and(|lean| lean > p.friction);
+        pushed_out += usize::from(out);
+        out
+    };
+    let (tried, mut rejections) = if factors.is_thesis() {
         search_with(
             &planned_on.mesh,
             p.hand,
@@ -653,6 +665,9 @@ fn search_axis(
             rules,
             budget,
             |g| {
+                if pushes_out(&g) {
+                    return true;
+                }
                 found += 1;
                 stopped = !take(sel, g, found - 1);
                 !stopped
@@ -661,7 +676,8 @@ fn search_axis(
     } else {
         // Issue 58: the axis's feasible grasps in the thesis's order, then taken by falling
         // score ([`crate::plan::order`]); the candidate budget bounds the search as before.
-        let (all, searched) = all_feasible(p, planned_on, &graded, rules, budget);
+        let (mut all, searched) = all_feasible(p, planned_on, &graded, rules, budget);
+        all.retain(|g| !pushes_out(g));
         found = all.len();
         let order = crate::plan::order::reorder(&all, planned_on, p.hand, &factors);
         let mut slots: Vec<Option<Grasp>> = all.into_iter().map(Some).collect();
@@ -672,6 +688,9 @@ fn search_axis(
         searched
     };
     t.search += crate::plan::timings::ms(t0);
+    if pushed_out > 0 {
+        rejections.insert(plan::search::Rejection::NetPush, pushed_out);
+    }
     AxisPlan {
         aligned,
         rules,
@@ -829,19 +848,27 @@ mod tests {
     /// The D40's candidates planned without a check, `plan_reach` as given.
     fn planned(reach: usize) -> (Selection, Vec<RuleSet>) {
         let mesh = crate::mesh::primitives::cylinder(40.0, 124.0);
-        let props = crate::mesh::mass_properties(&mesh);
+        planned_with(&mesh, PlannerParams::default(), reach)
+    }
+
+    /// `mesh`'s candidates planned without a check under `planner`, `plan_reach` as given.
+    fn planned_with(
+        mesh: &Mesh,
+        planner: PlannerParams,
+        reach: usize,
+    ) -> (Selection, Vec<RuleSet>) {
+        let props = crate::mesh::mass_properties(mesh);
         let hand = crate::hand::thesis_for_tests();
-        let planner = PlannerParams::default();
         let no_check = |_: &AlignedObject, _: &Grasp| -> SimOutcome {
             unreachable!("planned without a check")
         };
         let sel = select(
-            &mesh,
+            mesh,
             &props,
             &SelectParams {
                 hand: &hand,
                 planner: &planner,
-                friction: 0.5,
+                friction: 0.3,
                 collect: 100_000,
                 max_checked: None,
                 check: &no_check,
@@ -881,6 +908,45 @@ mod tests {
             assert_eq!(a.grasp.elevation_index, b.grasp.elevation_index);
             assert_eq!(a.grasp.approach_angle_deg, b.grasp.approach_angle_deg);
             assert_eq!(a.thesis_place, b.thesis_place);
+        }
+    }
+
+    #[test]
+    fn the_net_push_cone_rejects_the_extended_rules_grasps_that_push_a_cone_out() {
+        // A cone whose side leans 30 degrees from its axis, past the friction cone (17 degrees
+        // at mu = 0.3): the thesis's rules grade its side ungraspable, the extended rules plan
+        // on it.
+        let cone = crate::mesh::primitives::frustum(95.0, 25.0, 60.6);
+        let lean = |sel: &Selection, c: &Candidate| {
+            let aligned = &sel.axes[c.axis_plan].aligned;
+            let contacts =
+                plan::contacts::planned_contacts(&c.grasp, &crate::hand::thesis_for_tests());
+            plan::squeeze::net_push_lean(&plan::squeeze::Surface::new(&aligned.mesh), &contacts)
+                .unwrap()
+        };
+        let rejected = |sel: &Selection| -> usize {
+            sel.axes
+                .iter()
+                .filter_map(|a| a.rejections.get(&Rejection::NetPush))
+                .sum()
+        };
+        let (off, _) = planned_with(&cone, PlannerParams::default(), 100_000);
+        let pushing = off
+            .candidates
+            .iter()
+            .filter(|c| c.grasp.rules.is_extended() && lean(&off, c) > 0.3)
+            .count();
+        assert!(pushing > 0, "no extended grasp pushes the cone out");
+        assert_eq!(rejected(&off), 0);
+        let on = PlannerParams {
+            net_push_cone: true,
+            ..PlannerParams::default()
+        };
+        let (on, _) = planned_with(&cone, on, 100_000);
+        assert!(rejected(&on) >= pushing, "{} < {pushing}", rejected(&on));
+        for c in on.candidates.iter().filter(|c| c.grasp.rules.is_extended()) {
+            let l = lean(&on, c);
+            assert!(l <= 0.3, "kept a grasp whose net push leans {l}");
         }
     }
 }

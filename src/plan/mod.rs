@@ -26,6 +26,7 @@ pub mod palm_grade;
 pub mod params;
 pub mod refine;
 pub mod search;
+pub mod squeeze;
 pub mod timings;
 
 pub use curvature::{CurvatureParams, SideGrade};

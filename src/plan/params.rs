@@ -31,6 +31,12 @@ pub struct PlannerParams {
     /// nothing (or, with the physics check, nothing that holds); `false`: the thesis's rules
     /// only, as the thesis plans.
     pub extended_rules: bool,
+    /// Under the rules beyond the thesis, reject a grasp whose planned contacts together push
+    /// the object along the grasp axis beyond the friction cone ([`super::squeeze`]): the
+    /// thesis's cone, which its rules apply to each finger, applied to the net push of the
+    /// grasp. Off by default: on, the first candidate's hold probability fell on two of three
+    /// sets (docs/studies/2026-12-07-net-push-cone.md).
+    pub net_push_cone: bool,
     /// The search's budget (beyond the thesis, issue 30): each rule set (the thesis's, the
     /// extended rules, the fingertip pinch) tries at most this many candidates over all its
     /// axes, each axis at most an equal share of what is left of it, so a run's cost is bounded
@@ -87,6 +93,7 @@ impl Default for PlannerParams {
             joint_deviation_theta2_deg: 5.0,
             pitch_range_deg: 20.0,
             extended_rules: true,
+            net_push_cone: false,
             candidate_budget: DEFAULT_CANDIDATE_BUDGET,
             sf_centred: 0.0,
             sf_opposed: 0.0,

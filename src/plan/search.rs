@@ -50,6 +50,9 @@ pub enum Rejection {
     Palm(PalmRejection),
     /// A finger failed (its index in the hand).
     Finger(usize, FingerRejection),
+    /// Under the rules beyond the thesis, the planned contacts together push the object along
+    /// the axis beyond the friction cone ([`crate::plan::squeeze`]).
+    NetPush,
 }
 
 /// The outcome of the search.
@@ -71,6 +74,9 @@ impl Rejection {
             Rejection::Palm(PalmRejection::PitchOutOfRange) => "palm pitch out of range".into(),
             Rejection::Palm(PalmRejection::Penetration) => {
                 "palm penetrates the object (vertical plane)".into()
+            }
+            Rejection::NetPush => {
+                "the contacts' net push along the axis leaves the friction cone".into()
             }
             Rejection::Finger(k, r) => {
                 let name = &hand.finger_list[*k].name;
