@@ -644,18 +644,7 @@ fn search_axis(
     // The planner sees the arc of a ring; the check, the whole object in the arc's frame.
     let planned_on = arc.as_ref().unwrap_or(&aligned);
     let factors = OrderFactors::of(p.planner);
-    // Under the rules beyond the thesis, a grasp whose net push along the axis leaves the
-    // friction cone is rejected ([`plan::squeeze`]).
-    let surface = plan::squeeze::Surface::new(&planned_on.mesh);
-    let mut pushed_out = 0usize;
-    let mut pushes_out = |g: &Grasp| {
-        let out = p.planner.net_push_cone
-            && rules.is_extended()
-            && plan::squeeze::net_push_lean(&surface, &plan::contacts::planned_contacts(g, p.hand))
-                .is_some_and(|lean| lean > p.friction);
-        pushed_out += usize::from(out);
-        out
-    };
+    let mut push = NetPush::new(p, rules, planned_on);
     let (tried, mut rejections) = if factors.is_thesis() {
         search_with(
             &planned_on.mesh,
@@ -665,7 +654,7 @@ fn search_axis(
             rules,
             budget,
             |g| {
-                if pushes_out(&g) {
+                if push.pushes_out(&g) {
                     return true;
                 }
                 found += 1;
@@ -674,22 +663,15 @@ fn search_axis(
             },
         )
     } else {
-        // Issue 58: the axis's feasible grasps in the thesis's order, then taken by falling
-        // score ([`crate::plan::order`]); the candidate budget bounds the search as before.
-        let (mut all, searched) = all_feasible(p, planned_on, &graded, rules, budget);
-        all.retain(|g| !pushes_out(g));
-        found = all.len();
-        let order = crate::plan::order::reorder(&all, planned_on, p.hand, &factors);
-        let mut slots: Vec<Option<Grasp>> = all.into_iter().map(Some).collect();
-        stopped = order
-            .into_iter()
-            .filter_map(|i| Some((slots[i].take()?, i)))
-            .any(|(g, i)| !take(sel, g, i));
+        let taken = |g, i| take(sel, g, i);
+        let searched;
+        (found, stopped, searched) =
+            reordered(p, (planned_on, &graded, rules), budget, &mut push, taken);
         searched
     };
     t.search += crate::plan::timings::ms(t0);
-    if pushed_out > 0 {
-        rejections.insert(plan::search::Rejection::NetPush, pushed_out);
+    if push.rejected > 0 {
+        rejections.insert(plan::search::Rejection::NetPush, push.rejected);
     }
     AxisPlan {
         aligned,
@@ -701,6 +683,62 @@ fn search_axis(
         exhausted: !stopped && tried == available,
         candidates_available: available,
         budget_stopped: !stopped && tried < available,
+    }
+}
+
+/// Issue 58's order: the axis's feasible grasps (those `push` keeps) in the thesis's order,
+/// then given to `take` with their thesis place by falling score ([`crate::plan::order`]) until
+/// it returns false; the candidate budget bounds the search as before. Returns the grasps
+/// found, whether `take` stopped the search, and the candidates tried and the rejections.
+fn reordered(
+    p: &SelectParams,
+    (planned_on, graded, rules): (&AlignedObject, &plan::GradedDomain, RuleSet),
+    budget: usize,
+    push: &mut NetPush,
+    mut take: impl FnMut(Grasp, usize) -> bool,
+) -> (usize, bool, (usize, BTreeMap<Rejection, usize>)) {
+    let (mut all, searched) = all_feasible(p, planned_on, graded, rules, budget);
+    all.retain(|g| !push.pushes_out(g));
+    let found = all.len();
+    let order = crate::plan::order::reorder(&all, planned_on, p.hand, &OrderFactors::of(p.planner));
+    let mut slots: Vec<Option<Grasp>> = all.into_iter().map(Some).collect();
+    let stopped = order
+        .into_iter()
+        .filter_map(|i| Some((slots[i].take()?, i)))
+        .any(|(g, i)| !take(g, i));
+    (found, stopped, searched)
+}
+
+/// `[planner] net_push_cone` over one axis's search: under the rules beyond the thesis, a grasp
+/// whose net push along the axis leaves the friction cone is rejected ([`plan::squeeze`]).
+struct NetPush<'a> {
+    on: bool,
+    surface: plan::squeeze::Surface<'a>,
+    hand: &'a Hand,
+    friction: f64,
+    /// The grasps rejected so far.
+    rejected: usize,
+}
+
+impl<'a> NetPush<'a> {
+    fn new(p: &SelectParams<'a>, rules: RuleSet, planned_on: &'a AlignedObject) -> NetPush<'a> {
+        NetPush {
+            on: p.planner.net_push_cone && rules.is_extended(),
+            surface: plan::squeeze::Surface::new(&planned_on.mesh),
+            hand: p.hand,
+            friction: p.friction,
+            rejected: 0,
+        }
+    }
+
+    /// Whether the rule rejects `g` (counted).
+    fn pushes_out(&mut self, g: &Grasp) -> bool {
+        let contacts = || plan::contacts::planned_contacts(g, self.hand);
+        let out = self.on
+            && plan::squeeze::net_push_lean(&self.surface, &contacts())
+                .is_some_and(|lean| lean > self.friction);
+        self.rejected += usize::from(out);
+        out
     }
 }
 

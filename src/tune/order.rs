@@ -511,6 +511,27 @@ pub fn run(
         );
     }
     let t = tune(&l, objective, folds, order);
+    print_table(labels, &l, &t, (objective, order));
+    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
+    crate::batch::journal::write_atomically(
+        &out.join("tune.json"),
+        format!("{}\n", crate::report::to_rounded_json(&t)?).as_bytes(),
+    )?;
+    crate::batch::journal::write_atomically(
+        &out.join("planner.toml"),
+        planner_toml(&t).as_bytes(),
+    )?;
+    eprintln!(
+        "tune: wrote {} and {}",
+        out.join("tune.json").display(),
+        out.join("planner.toml").display()
+    );
+    Ok(0)
+}
+
+/// Prints [`run`]'s table: per fold, the tuned and the thesis's order on the folds tuned on and
+/// on the one held out, then the held-out estimate over every object.
+fn print_table(labels: &Path, l: &Labels, t: &OrderTuning, (objective, order): (Objective, Order)) {
     let m = |m: &Measures| format!("{:>6.3} {:>6.2} {:>6.3}", m.first, m.checks, m.auc);
     println!(
         "order tuned on {} ({} objects, {} candidates), objective {objective:?}, {} folds, measured in the {} order",
@@ -559,21 +580,6 @@ pub fn run(
             "the tuned order does not beat the thesis's on objects it did not see: keep the thesis's"
         }
     );
-    std::fs::create_dir_all(out).with_context(|| format!("{}: cannot create", out.display()))?;
-    crate::batch::journal::write_atomically(
-        &out.join("tune.json"),
-        format!("{}\n", crate::report::to_rounded_json(&t)?).as_bytes(),
-    )?;
-    crate::batch::journal::write_atomically(
-        &out.join("planner.toml"),
-        planner_toml(&t).as_bytes(),
-    )?;
-    eprintln!(
-        "tune: wrote {} and {}",
-        out.join("tune.json").display(),
-        out.join("planner.toml").display()
-    );
-    Ok(0)
 }
 
 #[cfg(test)]
