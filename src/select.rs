@@ -886,13 +886,15 @@ mod tests {
     /// The D40's candidates planned without a check, `plan_reach` as given.
     fn planned(reach: usize) -> (Selection, Vec<RuleSet>) {
         let mesh = crate::mesh::primitives::cylinder(40.0, 124.0);
-        planned_with(&mesh, PlannerParams::default(), reach)
+        planned_with(&mesh, PlannerParams::default(), 0.5, reach)
     }
 
-    /// `mesh`'s candidates planned without a check under `planner`, `plan_reach` as given.
+    /// `mesh`'s candidates planned without a check under `planner` and `friction`, `plan_reach`
+    /// as given.
     fn planned_with(
         mesh: &Mesh,
         planner: PlannerParams,
+        friction: f64,
         reach: usize,
     ) -> (Selection, Vec<RuleSet>) {
         let props = crate::mesh::mass_properties(mesh);
@@ -906,7 +908,7 @@ mod tests {
             &SelectParams {
                 hand: &hand,
                 planner: &planner,
-                friction: 0.3,
+                friction,
                 collect: 100_000,
                 max_checked: None,
                 check: &no_check,
@@ -968,7 +970,7 @@ mod tests {
                 .filter_map(|a| a.rejections.get(&Rejection::NetPush))
                 .sum()
         };
-        let (off, _) = planned_with(&cone, PlannerParams::default(), 100_000);
+        let (off, _) = planned_with(&cone, PlannerParams::default(), 0.3, 100_000);
         let pushing = off
             .candidates
             .iter()
@@ -980,7 +982,7 @@ mod tests {
             net_push_cone: true,
             ..PlannerParams::default()
         };
-        let (on, _) = planned_with(&cone, on, 100_000);
+        let (on, _) = planned_with(&cone, on, 0.3, 100_000);
         assert!(rejected(&on) >= pushing, "{} < {pushing}", rejected(&on));
         for c in on.candidates.iter().filter(|c| c.grasp.rules.is_extended()) {
             let l = lean(&on, c);

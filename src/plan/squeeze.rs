@@ -64,9 +64,8 @@ impl<'a> Surface<'a> {
             if triangle.distance_to_local_point(q, false) > reach {
                 continue;
             }
-            let [a, b, c] = self.mesh.corners(t as usize);
             // Twice the area along the normal, so the sum weighs each triangle by its area.
-            sum += (b - a).cross(&(c - a));
+            sum += self.mesh.area_normal(t as usize);
         }
         let n = sum.try_normalize(1e-12)?;
         Some(if n.dot(push) > 0.0 { -n } else { n })
