@@ -3,9 +3,11 @@
 
 A block may carry a `<!-- headline: KEY=VALUE ... -->` line: the figures `scripts/headline.py`
 copies into the README's headline block (and `cargo test --test it repository` checks there).
+Writing such a block rewrites the README's headline block as well.
 """
 import pathlib
 import subprocess
+import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
 END = "<!-- END GENERATED -->"
@@ -22,6 +24,12 @@ def replace(path, script, text):
     start = doc.index(begin(script)) + len(begin(script))
     end = doc.index(END, start)
     path.write_text(doc[:start] + "\n" + text.rstrip("\n") + "\n" + doc[end:])
+    # A block with a headline line feeds the README's headline block: rewrite that too, so the
+    # two cannot be committed apart.
+    if "<!-- headline:" in text and script != "scripts/headline.py":
+        import headline  # noqa: E402 (headline imports this module)
+        replace(ROOT / "README.md", headline.SCRIPT, headline.block())
+        print("README.md: headline block rewritten (scripts/headline.py)", file=sys.stderr)
 
 
 def block(path, script):

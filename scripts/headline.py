@@ -15,8 +15,9 @@ block another script writes (scripts/docblock.py), so the README cannot drift fr
 - MuJoCo on the bundled and tuning sets: docs/MUJOCO.md, scripts/compare_engines.py (its
   headline line).
 
-Run it after any of those scripts' `--write-doc`. `cargo test --test it repository` builds the
-same block from the same sources (tests/it/repository.rs) and fails when the README's differs.
+Each of those scripts' `--write-doc` rewrites the README's block too (scripts/docblock.py);
+run it by hand after editing a block. `cargo test --test it repository` builds the same block
+from the same sources (tests/it/repository.rs) and fails when the README's differs.
 """
 import argparse
 import pathlib
