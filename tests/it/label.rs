@@ -454,11 +454,13 @@ fn a_finger_that_still_creeps_keeps_a_direction_open_until_the_slip() {
     // stays still for the rest rule's first window while a finger whose motor gave way
     // creeps on, and then it slips (5.3 mm, 5.5°). The full-length reference says `slip`;
     // the fast protocol waits for the fingers to settle (`rest_joint_deg`) and says `slip`
-    // too; without that test it would decide `hold` at once.
+    // too; without that test it would decide `hold` at once. The hold at 8 substeps, where
+    // the motor gives way: at 12 (the default) the finger does not creep and the grasp holds.
     let dir = tempfile::tempdir().unwrap();
     let scenario = crate::real_scenario_text("mw_mug");
     let verdicts = |name: &str, sim: &str| -> (String, Vec<String>) {
         let path = dir.path().join(format!("{name}.toml"));
+        let sim = format!("hold_solver_iterations = 8\n{sim}");
         std::fs::write(&path, format!("{scenario}\n[sim]\n{sim}\n")).unwrap();
         let out = dir.path().join(format!("{name}.jsonl"));
         let args = ["--grasps", "4", "--samples", "1", "--gravity", "six"];

@@ -308,12 +308,15 @@ fn tune_ranks_settings_by_the_mean_hold_probability_first() {
     // do in 7 of 8. By the payload margin and the translation alone 0.3 would come before 0.7
     // (the same margin, less translation); ranked by the probability of a hold as planned
     // first it comes last. In the search order (`order_by_closing = 0`), as the ranking is
-    // what this tests.
+    // what this tests. The hold at 8 substeps, where the translations differ as said (at 12
+    // they differ by 0.005 µm the other way).
     use grasp_sim::batch::{default_template, expand};
     use grasp_sim::tune::{parse_sweep, rank, tune};
     let (dir, _s) = variant(
         "chapter4",
-        &format!("samples = 8\norder_by_closing = 0\n{SQUEEZE_CLOSING}"),
+        &format!(
+            "samples = 8\norder_by_closing = 0\nhold_solver_iterations = 8\n{SQUEEZE_CLOSING}"
+        ),
         "",
     );
     let items = expand(&[dir.path().join("chapter4.toml")]).unwrap();
