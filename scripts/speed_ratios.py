@@ -280,8 +280,13 @@ def main():
             six_ms=f"{statistics.median(o['six_ms']):.1f}",
             checks_per_s=f"{x['rate']:.2f}", checks_per_cpu_s=f"{x['per_cpu_s']:.2f}",
             load=f"{float(start_load.split()[0]):.1f}–{float(load().split()[0]):.1f}")
+        # The command as a reader would type it: a binary's path names a folder of this machine.
+        args = sys.argv[1:]
+        args = [x for i, x in enumerate(args)
+                if x != "--binary" and not x.startswith("--binary=")
+                and (i == 0 or args[i - 1] != "--binary")]
         intro = (f"Run at {docblock.revision()} on {datetime.date.today()} "
-                 f"(`{' '.join(['python3', 'scripts/speed_ratios.py'] + sys.argv[1:])}`), "
+                 f"(`{' '.join(['python3', 'scripts/speed_ratios.py'] + args)}`), "
                  f"{a.rounds} rounds on {pathlib.Path(a.scenario).stem}:")
         docblock.replace(ROOT / "BENCHMARKS.md", "scripts/speed_ratios.py",
                          "\n".join([head, "", intro, ""] + lines))
