@@ -113,6 +113,7 @@ fn bench_plan(c: &mut Criterion) {
                         domains: None,
                         frame: grasp_sim::mesh::FrameRule::File,
                         order_by_closing: None,
+                        order_samples: None,
                         plan_reach: 0,
                     },
                     &mut t,

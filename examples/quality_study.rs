@@ -102,6 +102,7 @@ fn plan_one(path: &Path, collect: usize) -> Result<Planned, String> {
             domains: None,
             frame: sc.object.frame,
             order_by_closing: None,
+            order_samples: None,
             plan_reach: 0,
         },
         &mut grasp_sim::report::StageTimings::default(),

@@ -985,6 +985,7 @@ mod tests {
                     domains: None,
                     frame: sc.object.frame,
                     order_by_closing: None,
+                    order_samples: None,
                     plan_reach: 0,
                 },
                 &mut crate::report::StageTimings::default(),

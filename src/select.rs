@@ -78,10 +78,15 @@ pub struct Preclosed {
     pub as_planned: bool,
     /// How far it pushed the object `[mm]`.
     pub shift_mm: f64,
+    /// Under `[sim] order_samples`, how many of its perturbed closings kept the plan.
+    pub sampled_on_plan: Option<usize>,
 }
 
 /// A closing with gravity off of a grasp about an axis (`[sim] order_by_closing`).
 pub type CloseFn<'a> = &'a (dyn Fn(&AlignedObject, &Grasp) -> Preclosed + Sync);
+
+/// `[sim] order_samples`: how many of a grasp's perturbed closings, gravity off, kept the plan.
+pub type SampledFn<'a> = &'a (dyn Fn(&AlignedObject, &Grasp) -> usize + Sync);
 
 /// Everything the selection did.
 #[derive(Debug, Clone)]
@@ -181,6 +186,11 @@ pub struct SelectParams<'a> {
     /// candidates picked for diversity are closed first and checked in the order their closings
     /// give ([`select`]). `None` or 0: the search order.
     pub order_by_closing: Option<(usize, CloseFn<'a>)>,
+    /// `[sim] order_samples` and the perturbed closings it runs: under `order_by_closing`, the
+    /// first candidate is checked first only if all that many kept the plan, and the closed
+    /// candidates are ranked by how many of their closings, the nominal one with them, kept
+    /// it. `None` or 0: the nominal closing alone.
+    pub order_samples: Option<(usize, SampledFn<'a>)>,
     /// Without the check (`max_checked` `None`), the rule sets beyond the thesis's are planned
     /// while fewer than this many candidates have been found: the candidates a search that
     /// checks this many could reach (it goes on to the next rule set when none of them held).
@@ -212,6 +222,9 @@ pub fn select(
     // kept did not hold (that check counts, [`select_by_closing`]).
     let left = std::cell::Cell::new(false);
     let first_call = std::cell::Cell::new(true);
+    // Under `order_samples`, how many of the first's perturbed closings kept the plan, when its
+    // own did.
+    let first_sampled = std::cell::Cell::new(None);
     let check = |a: &AlignedObject, g: &Grasp| -> SimOutcome {
         let first = first_call.replace(false);
         let out = match p.probe {
@@ -220,6 +233,13 @@ pub fn select(
         };
         if first && !out.succeeded() && (max > 1 || !out.fidelity.as_planned) {
             left.set(true);
+        }
+        if let Some((m @ 1.., sampled)) = p.order_samples.filter(|_| first && !left.get()) {
+            let on_plan = sampled(a, g);
+            first_sampled.set(Some(on_plan));
+            if on_plan < m {
+                left.set(true);
+            }
         }
         out
     };
@@ -233,7 +253,10 @@ pub fn select(
     }
     let first = sel.candidates.into_iter().find_map(|c| c.check);
     first
-        .and_then(|first| select_by_closing(mesh, props, p, (max, n, close), first, timings))
+        .and_then(|first| {
+            let closings = (max, n, close, first_sampled.get());
+            select_by_closing(mesh, props, p, closings, first, timings)
+        })
         .unwrap_or_else(|| select_in(mesh, props, p, None, timings))
 }
 
@@ -346,7 +369,7 @@ fn select_by_closing(
     mesh: &Mesh,
     props: &MassProperties,
     p: &SelectParams,
-    (max, n, close): (usize, usize, CloseFn<'_>),
+    (max, n, close, first_sampled): (usize, usize, CloseFn<'_>, Option<usize>),
     first_check: SimOutcome,
     timings: &mut StageTimings,
 ) -> Option<Selection> {
@@ -356,15 +379,18 @@ fn select_by_closing(
         recheck: None,
         probe: None,
         order_by_closing: None,
+        order_samples: None,
         plan_reach: max,
         ..*p
     };
     let first = Preclosed {
         as_planned: first_check.fidelity.as_planned,
         shift_mm: first_check.fidelity.shift_mm,
+        sampled_on_plan: first_sampled,
     };
     let mut sel = select_in(mesh, props, &plan_all, None, timings);
-    let ranked = ranked_by_closing(&sel, p.hand, (n, close), first);
+    let sampled = p.order_samples.filter(|(m, _)| *m > 0);
+    let ranked = ranked_by_closing(&sel, p.hand, (n, close, sampled), first);
     let places = put_first(&mut sel, &ranked, p.collect);
     let mut first_check = Some(first_check);
     let mut settled = false;
@@ -416,12 +442,20 @@ fn held_and_none_left_can_succeed(sel: &Selection, k: usize, places: &[usize]) -
 /// order they are checked in. The first, checked already, comes first where its closing kept
 /// the plan (its hold judged it: that check counts from the start); where its closing left the
 /// plan it was judged by the closing alone, as every pick is, and goes among them. Then as
-/// planned first, then the shift in whole millimetres, then the search order. The closings run
-/// in parallel; the order does not depend on the threads.
+/// planned first, then the shift in whole millimetres, then the search order.
+///
+/// Under `[sim] order_samples` (`sampled`: `m` perturbed closings), the first comes first only
+/// if its perturbed closings kept the plan too, and "as planned" is the count of a pick's
+/// closings, the nominal one and the perturbed, that kept it (the nominal one's breaking a
+/// tie). The perturbed closings run pick by pick in the order above until one pick has all
+/// `m + 1` on plan: it comes first, as it would were every pick closed perturbed; the picks
+/// not reached keep their nominal count alone, so a search that checks on after it follows
+/// what is known, at the cost of the closings that found it. The closings run in parallel;
+/// the order does not depend on the threads.
 fn ranked_by_closing(
     sel: &Selection,
     hand: &Hand,
-    (n, close): (usize, CloseFn<'_>),
+    (n, close, sampled): (usize, CloseFn<'_>, Option<(usize, SampledFn<'_>)>),
     first: Preclosed,
 ) -> Vec<(usize, Preclosed)> {
     use rayon::prelude::*;
@@ -444,14 +478,35 @@ fn ranked_by_closing(
         })
         .collect();
     let mut ranked: Vec<(usize, Preclosed)> = picks.into_iter().zip(closed).collect();
-    // (checked first, kept the plan): the first comes first where its closing kept the plan.
-    let key = |i: usize, f: &Preclosed| (i == 0 && f.as_planned, f.as_planned);
-    ranked.sort_by(|(i, a), (j, b)| {
-        key(*j, b)
-            .cmp(&key(*i, a))
-            .then(a.shift_mm.floor().total_cmp(&b.shift_mm.floor()))
-            .then(i.cmp(j))
-    });
+    // (checked first, closings on plan, nominal on plan): the first comes first where its
+    // closings kept the plan; then the closings that kept it (the nominal one alone without
+    // `order_samples`), the nominal one's breaking a tie.
+    let m = sampled.map_or(0, |(m, _)| m);
+    let sort = |ranked: &mut Vec<(usize, Preclosed)>| {
+        let key = |i: usize, f: &Preclosed| {
+            let on = usize::from(f.as_planned) + f.sampled_on_plan.unwrap_or(0);
+            (i == 0 && on == m + 1, on, f.as_planned)
+        };
+        ranked.sort_by(|(i, a), (j, b)| {
+            key(*j, b)
+                .cmp(&key(*i, a))
+                .then(a.shift_mm.floor().total_cmp(&b.shift_mm.floor()))
+                .then(i.cmp(j))
+        });
+    };
+    sort(&mut ranked);
+    if let Some((m @ 1.., sampled)) = sampled {
+        for (i, f) in &mut ranked {
+            let c = &sel.candidates[*i];
+            let on = *f
+                .sampled_on_plan
+                .get_or_insert_with(|| sampled(&sel.axes[c.axis_plan].aligned, &c.grasp));
+            if f.as_planned && on == m {
+                break;
+            }
+        }
+        sort(&mut ranked);
+    }
     ranked
 }
 
@@ -917,6 +972,7 @@ mod tests {
                 domains: None,
                 frame: FrameRule::default(),
                 order_by_closing: None,
+                order_samples: None,
                 plan_reach: reach,
             },
             &mut StageTimings::default(),

@@ -424,6 +424,7 @@ fn plan_candidates(
             domains: None,
             frame: scenario.object.frame,
             order_by_closing: None,
+            order_samples: None,
             plan_reach: scenario.sim.selection.max_checked,
         },
         timings,

@@ -278,6 +278,7 @@ fn candidate_report(
         closing_order: c.preclosed.map(|f| report::ClosingOrder {
             as_planned: f.as_planned,
             shift_mm: f.shift_mm,
+            sampled_on_plan: f.sampled_on_plan,
         }),
         ..grasp_report(&c.grasp, aligned, c.check.as_ref())
     }

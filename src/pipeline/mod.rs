@@ -543,6 +543,10 @@ fn select_grasps(
     let close = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> select::Preclosed {
         preclosed(scenario, object, a, g)
     };
+    // `[sim] order_samples`: the perturbed closings, gravity off.
+    let sampled = |a: &mesh::AlignedObject, g: &plan::search::Grasp| -> usize {
+        sampled_closings_on_plan(scenario, object, a, g)
+    };
     // The physics check chooses among candidates only when it runs on the planner's grasps.
     let checks_candidates =
         !options.no_sim && scenario.sim.input.override_angles.is_none() && options.given.is_none();
@@ -564,6 +568,7 @@ fn select_grasps(
             domains: None,
             frame: scenario.object.frame,
             order_by_closing: Some((scenario.sim.selection.order_by_closing, &close)),
+            order_samples: Some((scenario.sim.selection.order_samples, &sampled)),
             plan_reach: 0,
         },
         timings,
@@ -584,7 +589,22 @@ pub(crate) fn preclosed(
     select::Preclosed {
         as_planned: f.as_planned,
         shift_mm: f.shift_mm,
+        sampled_on_plan: None,
     }
+}
+
+/// How many of grasp `g`'s `[sim] order_samples` perturbed closings on `a` kept the plan, as a
+/// run and a `tune` sweep rank it.
+pub(crate) fn sampled_closings_on_plan(
+    scenario: &Scenario,
+    object: &PreparedObject,
+    a: &mesh::AlignedObject,
+    g: &plan::search::Grasp,
+) -> usize {
+    let pose = sim::SimHand::from_grasp(g, &scenario.hand);
+    let shape = object.shape(a, &pose, &scenario.hand);
+    let case = object.case(scenario, &pose, &shape);
+    sim::entry::sampled_closings_on_plan(&case, scenario.sim.selection.order_samples)
 }
 
 /// The analytic quality of every candidate when `--quality` asks for it.

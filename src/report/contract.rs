@@ -235,6 +235,9 @@ pub struct ClosingOrder {
     pub as_planned: bool,
     /// How far it pushed the object `[mm]`.
     pub shift_mm: f64,
+    /// Under `[sim] order_samples`, how many of its perturbed closings kept the plan.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sampled_on_plan: Option<usize>,
 }
 
 /// A candidate grasp's analytic quality in brief.

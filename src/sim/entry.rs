@@ -57,6 +57,25 @@ pub fn closing_fidelity(case: &Case) -> super::outcome::Fidelity {
     super::protocol::Closed::new(case).fidelity().clone()
 }
 
+/// Where `[sim] order_samples`'s perturbations are drawn from: sample indices this far past any
+/// the hold probability draws (`[sim] samples` is at most a few hundred), so that the closings
+/// that order a search never see the samples that then judge its grasp.
+pub const ORDER_SAMPLE_BASE: usize = 1 << 30;
+
+/// How many of `m` perturbed closings of `case` (`[sim] order_samples`), gravity off, kept the
+/// plan: sample `ORDER_SAMPLE_BASE + j`'s perturbation for `j` in `0..m`.
+pub fn sampled_closings_on_plan(case: &Case, m: usize) -> usize {
+    use rayon::prelude::*;
+    (0..m)
+        .into_par_iter()
+        .filter(|&j| {
+            let p = Perturbation::draw(&case.params.robust, ORDER_SAMPLE_BASE + j);
+            let perturbed = Perturbed::of(case, &p);
+            closing_fidelity(&perturbed.case(case)).as_planned
+        })
+        .count()
+}
+
 /// The check of a chosen grasp as reported.
 #[derive(Debug, Clone)]
 pub struct Reported {

@@ -726,6 +726,9 @@ fn run_planned(
     let close = |a: &AlignedObject, g: &plan::search::Grasp| -> crate::select::Preclosed {
         crate::pipeline::preclosed(&p.scenario, &p.object, a, g)
     };
+    let sampled_closings = |a: &AlignedObject, g: &plan::search::Grasp| -> usize {
+        crate::pipeline::sampled_closings_on_plan(&p.scenario, &p.object, a, g)
+    };
     let mut t = StageTimings::default();
     let selection = crate::select::select(
         p.object.mesh(),
@@ -742,6 +745,7 @@ fn run_planned(
             domains: Some(&shared.select_domains),
             frame: p.scenario.object.frame,
             order_by_closing: Some((p.scenario.sim.selection.order_by_closing, &close)),
+            order_samples: Some((p.scenario.sim.selection.order_samples, &sampled_closings)),
             plan_reach: 0,
         },
         &mut t,

@@ -539,8 +539,9 @@ fn the_robosuite_bottle_is_held_at_its_neck_by_its_decomposition() {
     // elevation is its neck, which the hull bridges from shoulder to cap, and every phalanx 1
     // stopped on the bridge 5.8-8.4° short of its plan (3 of 6 phalanges on plan). Four
     // phalanges have every planned contact 1.6-1.8 mm inside the hull, so the check takes the
-    // decomposition, and all six end within 5° of their plan.
-    let j = real_object_run("rs_bottle");
+    // decomposition, and all six end within 5° of their plan. (The thesis's first grasp: with
+    // the order's perturbed closings the search takes another, on the axis turned round.)
+    let j = real_object_run_with("rs_bottle", "[sim]\norder_samples = 0\n");
     let sim = &j["sim"];
     let collider = sim["collider"].as_str().unwrap();
     assert!(
@@ -557,7 +558,18 @@ fn the_robosuite_bottle_is_held_at_its_neck_by_its_decomposition() {
 
 /// The JSON report of the real-object scenario `name` run by the binary.
 fn real_object_run(name: &str) -> serde_json::Value {
-    let scenario = crate::root().join(format!("assets/real/scenarios/{name}.toml"));
+    real_object_run_with(name, "")
+}
+
+/// [`real_object_run`] with `extra` appended to the scenario.
+fn real_object_run_with(name: &str, extra: &str) -> serde_json::Value {
+    let dir = tempfile::tempdir().unwrap();
+    let scenario = dir.path().join(format!("{name}.toml"));
+    std::fs::write(
+        &scenario,
+        format!("{}\n{extra}", crate::real_scenario_text(name)),
+    )
+    .unwrap();
     let out = crate::grasp_sim()
         .args(["--json", scenario.to_str().unwrap()])
         .output()

@@ -201,3 +201,57 @@ fn the_closing_order_checks_first_a_grasp_whose_closing_stays_near_its_plan() {
     assert_eq!(default["plan"]["grasp"], ordered["plan"]["grasp"]);
     assert_eq!(default["sim"]["fidelity"], ordered["sim"]["fidelity"]);
 }
+
+/// The prism of the random shapes (`scripts/random_shapes.py --seed 9`, shape 44) with `sim`
+/// added to a one-check `[sim]` table with 8 samples.
+fn prism(dir: &std::path::Path, sim: &str) -> Value {
+    let mesh = root().join("tests/fixtures/random_prism_seed9_044.stl");
+    let p = dir.join(format!("prism_{}.toml", sim.len()));
+    let text = format!(
+        "[object]\nmesh = {:?}\n\n[sim]\nsamples = 8\nmax_checked = 1\n{sim}\n",
+        mesh.to_str().unwrap()
+    );
+    std::fs::write(&p, text).unwrap();
+    let o = grasp_sim().arg("--json").arg(&p).output().unwrap();
+    crate::assert_success(&o);
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
+#[test]
+fn perturbed_closings_check_first_a_grasp_that_keeps_its_plan_off_its_nominal_pose() {
+    // The prism's first candidate closes as planned from its nominal pose, so the order by
+    // the nominal closing alone (`order_samples = 0`) keeps it first, and it drops in every
+    // perturbed sample. With `order_samples = 4` (the default) its four perturbed closings are
+    // run too, two of them leave the plan, and the search checks first a grasp whose five
+    // closings all kept it: it holds in every sample.
+    let dir = tempfile::tempdir().unwrap();
+    let nominal = prism(dir.path(), "order_samples = 0");
+    let first = nominal["plan"]["grasp"].clone();
+    assert_eq!(nominal["sim"]["fidelity"]["as_planned"], true);
+    let p0 = nominal["sim"]["robust"]["hold_probability"]
+        .as_f64()
+        .unwrap();
+    assert!(p0 <= 0.25, "{p0}");
+    assert!(first.get("closing_order").is_none());
+
+    let sampled = prism(dir.path(), "");
+    assert_eq!(sampled["plan"]["candidates_checked"], 1);
+    let p4 = sampled["sim"]["robust"]["hold_probability"]
+        .as_f64()
+        .unwrap();
+    assert!(p4 >= 0.75, "{p4}");
+    let chosen = &sampled["plan"]["grasp"];
+    assert_ne!(chosen["palm_pose"], first["palm_pose"]);
+    assert_eq!(chosen["closing_order"]["as_planned"], true);
+    assert_eq!(chosen["closing_order"]["sampled_on_plan"], 4);
+    // The first is among the closed picks, its perturbed closings counted: not all on plan.
+    let grasps = sampled["plan"]["grasps"].as_array().unwrap();
+    let thesis_first = grasps
+        .iter()
+        .find(|g| g["palm_pose"] == first["palm_pose"])
+        .expect("the first candidate among the picks");
+    let on = thesis_first["closing_order"]["sampled_on_plan"]
+        .as_u64()
+        .unwrap();
+    assert!(on < 4, "{on}");
+}
