@@ -177,10 +177,12 @@ fn study_grasp(p: &Planned, k: usize, six: bool) -> Row {
         scenario: sc.name.clone(),
         candidate: k + 1,
         axis: axis.aligned.axis.name(),
-        rules: match axis.rules {
-            plan::RuleSet::Thesis => "thesis".to_string(),
-            plan::RuleSet::Extended | plan::RuleSet::Pinch => "extended".to_string(),
-        },
+        rules: if axis.rules.is_extended() {
+            "extended"
+        } else {
+            "thesis"
+        }
+        .to_string(),
         grade,
         eps_sim: q_sim.epsilon,
         vol_sim: q_sim.volume,

@@ -36,6 +36,7 @@ RELAXATIONS = [
     "als_off_object",
     "joint_deviation_recorded",
     "palm_backed_off",
+    "palm_pitch_clamped",
     "distal_contact_only",
 ]
 

@@ -7,7 +7,8 @@
 //! thesis's grasp; the other axes follow ([`GraspAxis::SEARCH_ORDER`] says why in that order);
 //! the extended rules ([`RuleSet::Extended`]) only when the thesis's rules found no grasp on any
 //! axis, or, with the physics check, when none of their grasps held and checks remain; the
-//! fingertip pinch ([`RuleSet::Pinch`]) last, on the same terms after the extended rules.
+//! fingertip pinch ([`RuleSet::Pinch`]) on the same terms after the extended rules, and the palm
+//! leaning on one contact ([`RuleSet::Leaning`]) last.
 //!
 //! Without the physics check the first feasible grasp is the answer, as in the thesis
 //! (`--candidates N` collects N). With it, candidates are checked one by one until one holds as
@@ -135,6 +136,7 @@ impl Selection {
                     RuleSet::Thesis => "thesis",
                     RuleSet::Extended => "extended",
                     RuleSet::Pinch => "pinch",
+                    RuleSet::Leaning => "leaning",
                 };
                 format!(
                     "{} {rules} ({} of {})",
@@ -292,7 +294,12 @@ fn select_in(
     };
     // Per axis: the object in its frame, and for an arc the arc in it, which the planner sees.
     let mut aligned_cache: Vec<Option<Option<Frames>>> = vec![None; axes.len()];
-    for rules in [RuleSet::Thesis, RuleSet::Extended, RuleSet::Pinch] {
+    for rules in [
+        RuleSet::Thesis,
+        RuleSet::Extended,
+        RuleSet::Pinch,
+        RuleSet::Leaning,
+    ] {
         if rules.is_extended() && (!p.planner.extended_rules || !wants_extended(&sel, p)) {
             break;
         }
@@ -619,7 +626,7 @@ fn graded_for(
         .axes
         .iter()
         .find(|a| a.rules == RuleSet::Extended && a.aligned.axis == axis)
-        .filter(|_| rules == RuleSet::Pinch)
+        .filter(|_| rules.pinches())
         .map(|a| a.graded.clone());
     // Another rule set's domain of this axis: its vertical slices are this one's.
     let sliced = sel

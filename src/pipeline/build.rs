@@ -251,6 +251,7 @@ fn axis_report(a: &select::AxisPlan) -> report::AxisReport {
         axis_name: a.aligned.axis.name(),
         rules: a.rules,
         pinch: a.rules == plan::RuleSet::Pinch,
+        leaning: a.rules == plan::RuleSet::Leaning,
         indexed_elevations: a.graded.domain.elevations.len(),
         sorted_indices: a.graded.sorted_indices.len(),
         candidates_tried: a.candidates_tried,

@@ -125,7 +125,7 @@ pub fn place_finger(
     let plane = |dz: f64| FingerPlane::new(&slice(dz), hand, mirror);
     let als = |plane: &FingerPlane| -> Result<AlsAngles, FingerRejection> {
         match als_on(plane, hand) {
-            Err(e) if rules == RuleSet::Pinch => als_distal_on(plane, hand).map_err(|_| e),
+            Err(e) if rules.pinches() => als_distal_on(plane, hand).map_err(|_| e),
             placed => placed,
         }
     };

@@ -58,6 +58,13 @@ pub enum RuleSet {
     /// Reported as `extended` (its grasps list `distal_contact_only`).
     #[serde(rename = "extended")]
     Pinch,
+    /// The pinch's rules with the palm leaning at the Pitch Range's limit where its second
+    /// contact needs more ([`Relaxation::PalmPitchClamped`]), tried after the pinch on the same
+    /// terms, on those candidates alone (the others were the pinch's): a diamond or a star has
+    /// no other grasp, but where a grasp with the palm on two contacts exists it is preferred.
+    /// Reported as `extended` (its grasps list `palm_pitch_clamped`).
+    #[serde(rename = "extended")]
+    Leaning,
 }
 
 impl RuleSet {
@@ -70,9 +77,14 @@ impl RuleSet {
     /// how a finger is placed).
     pub fn domain_rules(self) -> RuleSet {
         match self {
-            RuleSet::Pinch => RuleSet::Extended,
+            RuleSet::Pinch | RuleSet::Leaning => RuleSet::Extended,
             r => r,
         }
+    }
+
+    /// True for the rule sets whose fingers may pinch ([`Relaxation::DistalContactOnly`]).
+    pub fn pinches(self) -> bool {
+        matches!(self, RuleSet::Pinch | RuleSet::Leaning)
     }
 }
 
@@ -97,6 +109,11 @@ pub enum Relaxation {
     /// wider than the elevation the palm was placed at): the palm is moved back along its
     /// normal until it only touches, and the fingers reach round from there.
     PalmBackedOff,
+    /// The palm's second contact needs more pitch than the Pitch Range (a rounded profile
+    /// curving away from the palm's first contact: an egg's shoulder, a star-shaped
+    /// superellipsoid): the palm leans at the range's limit on its first contact alone, which a
+    /// real palm does on any convex bulge, and the fingers close from there.
+    PalmPitchClamped,
     /// An ALS of a finger meets nothing (the finger's edge is off the object) while another ALS
     /// of the finger touches: the finger closes until its first ALS touches.
     AlsOffObject,
@@ -170,7 +187,9 @@ fn stage1_shrink(hand: &Hand, rules: RuleSet) -> f64 {
         RuleSet::Thesis => hand.fingers.offset_mm,
         // An outer finger's centreline may lie beyond the object's end by up to the finger
         // offset less EXTENDED_MIN_OVERLAP_MM: its inner edge still overlaps the object.
-        RuleSet::Extended | RuleSet::Pinch => EXTENDED_MIN_OVERLAP_MM - hand.fingers.offset_mm,
+        RuleSet::Extended | RuleSet::Pinch | RuleSet::Leaning => {
+            EXTENDED_MIN_OVERLAP_MM - hand.fingers.offset_mm
+        }
     }
 }
 

@@ -23,6 +23,7 @@
 //!   take in any piece of the slice contour.
 
 use super::geom2::ConvexPolygon;
+use super::RuleSet;
 use crate::hand::Hand;
 use crate::mesh::Mesh;
 use crate::slice::{slice, Plane, Slice, SliceOptions};
@@ -54,6 +55,10 @@ pub struct PalmPlacement {
     /// How far the palm stands off the object beyond that, the object held between the
     /// phalanges (issue 37: a hand with `palm.standoff_max_mm`; else 0) `[mm]`.
     pub standoff_mm: f64,
+    /// The second contact needed more pitch than the pitch range, and the palm leans as far as
+    /// the range allows on its first contact alone (extended rules only;
+    /// [`super::Relaxation::PalmPitchClamped`]).
+    pub pitch_clamped: bool,
 }
 
 /// Why a palm placement failed.
@@ -65,6 +70,9 @@ pub enum PalmRejection {
     PitchOutOfRange,
     /// The palm outline takes in part of the object in the vertical plane.
     Penetration,
+    /// Under [`RuleSet::Leaning`]: the palm's second contact is within the pitch range, a
+    /// placement the rule sets before it tried.
+    WithinPitchRange,
 }
 
 /// Places the palm with Finger_1 at elevation `z1` and approach angle `approach_rad`.
@@ -76,7 +84,14 @@ pub fn place_palm(
     pitch_range_rad: f64,
 ) -> Result<PalmPlacement, PalmRejection> {
     let vslice = vertical_slice(mesh, hand, approach_rad);
-    place_palm_on(&vslice, hand, z1, approach_rad, pitch_range_rad, false)
+    place_palm_on(
+        &vslice,
+        hand,
+        z1,
+        approach_rad,
+        pitch_range_rad,
+        RuleSet::Thesis,
+    )
 }
 
 /// The vertical slice the palm is placed in at approach angle `approach_rad`, bridged to the
@@ -91,18 +106,22 @@ pub fn vertical_slice(mesh: &Mesh, hand: &Hand, approach_rad: f64) -> Slice {
     .bridged_within(hand.finger_width_mm(), hand.relief_mm())
 }
 
-/// [`place_palm`] in `vslice`, the [`vertical_slice`] at `approach_rad`; with `back_off`, a
-/// palm outline that takes in part of the object in the vertical plane is moved back along its
-/// normal until it only touches (the extended rules' [`super::Relaxation::PalmBackedOff`])
-/// instead of being rejected.
+/// [`place_palm`] in `vslice`, the [`vertical_slice`] at `approach_rad`, under `rules`. Under
+/// the extended rules a palm outline that takes in part of the object in the vertical plane is
+/// moved back along its normal until it only touches ([`super::Relaxation::PalmBackedOff`])
+/// instead of being rejected. Under [`RuleSet::Leaning`] a second contact beyond the pitch
+/// range leaves the palm leaning at the range's limit on its first contact alone
+/// ([`super::Relaxation::PalmPitchClamped`]), and a palm within the range is not placed (the
+/// rule sets before it placed it).
 pub fn place_palm_on(
     vslice: &Slice,
     hand: &Hand,
     z1: f64,
     approach_rad: f64,
     pitch_range_rad: f64,
-    back_off: bool,
+    rules: RuleSet,
 ) -> Result<PalmPlacement, PalmRejection> {
+    let extended = rules.is_extended();
     let plane = Plane::vertical(approach_rad);
     let h1 = hand.finger_list[0].height_mm;
     let (h_lo, h_hi) = hand.finger_height_span();
@@ -115,11 +134,22 @@ pub fn place_palm_on(
     let first = outermost(domain.iter()).ok_or(PalmRejection::NoContact)?;
 
     let (second, pitch) = second_contact(&domain, first, centre_z);
+    let mut pitch_clamped = false;
     let (second, pitch) = if pitch.abs() > pitch_range_rad + 1e-12 {
         if second.is_some() && domain.len() > 1 {
-            return Err(PalmRejection::PitchOutOfRange);
+            if rules != RuleSet::Leaning {
+                return Err(PalmRejection::PitchOutOfRange);
+            }
+            // A rounded profile curves away from its outermost point faster than the range
+            // lets the palm follow (an egg's or a star's shoulder): a palm turned less than the
+            // second contact needs reaches no point of the other half, and rests on the first.
+            pitch_clamped = true;
+            (None, pitch_range_rad.copysign(pitch))
+        } else {
+            (None, 0.0)
         }
-        (None, 0.0)
+    } else if rules == RuleSet::Leaning {
+        return Err(PalmRejection::WithinPitchRange);
     } else {
         (second, pitch)
     };
@@ -132,7 +162,7 @@ pub fn place_palm_on(
     let p1 = first + up * t;
     let mut centre = p1 - up * h1;
     let mut backed_off_mm = 0.0;
-    if back_off {
+    if extended {
         let depth = penetration_depth(vslice, centre, up, back, hand.palm_z_range_mm());
         if depth > PENETRATION_TOL_MM {
             centre += back * depth;
@@ -166,6 +196,7 @@ pub fn place_palm_on(
         slice: vslice.clone(),
         backed_off_mm,
         standoff_mm: 0.0,
+        pitch_clamped,
     })
 }
 
@@ -431,6 +462,22 @@ mod tests {
                 "{z1} {range}"
             );
         }
+        // The leaning rules lean the palm by the whole 1° instead, on the first contact alone,
+        // and take in nothing of the cup; the extended rules reject it as the thesis does.
+        // Within the range the extended rules place the thesis's palm, the leaning rules none.
+        let vslice = vertical_slice(&cup, &hand, 0.0);
+        let place =
+            |range: f64, rules| place_palm_on(&vslice, &hand, 80.0, 0.0, range.to_radians(), rules);
+        let clamped = place(1.0, RuleSet::Leaning).unwrap();
+        assert!((clamped.pitch_rad + 1f64.to_radians()).abs() < 1e-12);
+        assert!(clamped.pitch_clamped);
+        assert_eq!(clamped.contacts.len(), 1);
+        assert_eq!(clamped.backed_off_mm, 0.0);
+        let rejected = Err(PalmRejection::PitchOutOfRange);
+        assert_eq!(place(1.0, RuleSet::Extended), rejected);
+        assert_eq!(place(10.0, RuleSet::Extended), Ok(p));
+        let within = Err(PalmRejection::WithinPitchRange);
+        assert_eq!(place(10.0, RuleSet::Leaning), within);
     }
 
     #[test]

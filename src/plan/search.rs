@@ -72,6 +72,9 @@ impl Rejection {
         match self {
             Rejection::Palm(PalmRejection::NoContact) => "palm finds no contact".into(),
             Rejection::Palm(PalmRejection::PitchOutOfRange) => "palm pitch out of range".into(),
+            Rejection::Palm(PalmRejection::WithinPitchRange) => {
+                "palm within the pitch range (tried by the rules before)".into()
+            }
             Rejection::Palm(PalmRejection::Penetration) => {
                 "palm penetrates the object (vertical plane)".into()
             }
@@ -243,6 +246,8 @@ fn search_scheduled(
                         return (tried, rejections);
                     }
                 }
+                // The leaning pass's own skip: the rule sets before it placed that palm.
+                Err(Rejection::Palm(PalmRejection::WithinPitchRange)) => {}
                 Err(r) => *rejections.entry(r).or_insert(0) += 1,
             }
         }
@@ -274,6 +279,9 @@ fn relaxations_of(
     }
     if palm.backed_off_mm > 0.0 {
         relaxations.push(Relaxation::PalmBackedOff);
+    }
+    if palm.pitch_clamped {
+        relaxations.push(Relaxation::PalmPitchClamped);
     }
     if rules.is_extended() && uses_outer_elevation(graded, index, hand) {
         relaxations.push(Relaxation::OuterFingerBeyondElevation);
@@ -322,7 +330,7 @@ fn try_candidate(
         candidate.z1,
         candidate.approach_deg.to_radians(),
         params.pitch_range_deg.to_radians(),
-        extended,
+        rules,
     )
     .map_err(Rejection::Palm)?;
     if extended {

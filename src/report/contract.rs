@@ -332,6 +332,10 @@ pub struct AxisReport {
     /// (`distal_contact_only`); absent otherwise.
     #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub pinch: bool,
+    /// True for the last pass, the palm leaning at the Pitch Range's limit on one contact
+    /// (`palm_pitch_clamped`); absent otherwise.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub leaning: bool,
     /// Indexed elevations about this axis.
     pub indexed_elevations: usize,
     /// Candidate palm elevations after stage 3.

@@ -483,6 +483,36 @@ fn a_bar_with_bosses_is_held_with_the_palm_backed_off() {
 }
 
 #[test]
+fn a_diamond_is_held_with_the_palm_leaning_on_its_corner() {
+    // An octahedron 48 x 66 x 102 mm (semi-axes 24, 33, 51): every vertical profile is a
+    // rhombus whose faces leave its corner at 25-33° from the vertical, more than the 20° Pitch
+    // Range, so the thesis's palm, turned about its outermost point onto a second contact,
+    // is rejected at every candidate of every rule set (2,718 "palm pitch out of range"). A
+    // real palm rests on the corner: leaning at the range's limit, it touches nothing else.
+    let (a, b, c) = (24.0, 33.0, 51.0);
+    let mut diamond = Vec::new();
+    for sx in [1.0, -1.0] {
+        for sy in [1.0, -1.0] {
+            for sz in [1.0, -1.0] {
+                let (p, q, r) = (
+                    Point3::new(sx * a, 0.0, 0.0),
+                    Point3::new(0.0, sy * b, 0.0),
+                    Point3::new(0.0, 0.0, sz * c),
+                );
+                // Counter-clockwise seen from outside: the normal points along (sx, sy, sz).
+                let outward = (q - p).cross(&(r - p)).dot(&Vector3::new(sx, sy, sz)) > 0.0;
+                diamond.push(if outward { [p, q, r] } else { [p, r, q] });
+            }
+        }
+    }
+    let r = run_soup(&diamond, true);
+    let g = held_beyond_the_thesis(&r, RuleSet::Leaning, &[Relaxation::PalmPitchClamped]);
+    // The palm leans by the whole range, one way or the other.
+    let pitch = g.palm_pitch_deg.abs();
+    assert!((pitch - 20.0).abs() < 1e-9, "pitch {pitch}");
+}
+
+#[test]
 fn a_flat_box_is_pinched_by_the_fingertips_with_the_palm_on_its_narrow_face() {
     // A 100 x 30 x 150 mm box (a cereal box). With the palm on a broad face, the joints 36.7 mm
     // either side of the palm's centre put phalanx 1 into the 100 mm face, and on the 30 mm
