@@ -55,10 +55,6 @@ pub struct PalmPlacement {
     /// How far the palm stands off the object beyond that, the object held between the
     /// phalanges (issue 37: a hand with `palm.standoff_max_mm`; else 0) `[mm]`.
     pub standoff_mm: f64,
-    /// The second contact needed more pitch than the pitch range, and the palm leans as far as
-    /// the range allows on its first contact alone (extended rules only;
-    /// [`super::Relaxation::PalmPitchClamped`]).
-    pub pitch_clamped: bool,
 }
 
 /// Why a palm placement failed.
@@ -134,7 +130,6 @@ pub fn place_palm_on(
     let first = outermost(domain.iter()).ok_or(PalmRejection::NoContact)?;
 
     let (second, pitch) = second_contact(&domain, first, centre_z);
-    let mut pitch_clamped = false;
     let (second, pitch) = if pitch.abs() > pitch_range_rad + 1e-12 {
         if second.is_some() && domain.len() > 1 {
             if rules != RuleSet::Leaning {
@@ -143,7 +138,6 @@ pub fn place_palm_on(
             // A rounded profile curves away from its outermost point faster than the range
             // lets the palm follow (an egg's or a star's shoulder): a palm turned less than the
             // second contact needs reaches no point of the other half, and rests on the first.
-            pitch_clamped = true;
             (None, pitch_range_rad.copysign(pitch))
         } else {
             (None, 0.0)
@@ -196,7 +190,6 @@ pub fn place_palm_on(
         slice: vslice.clone(),
         backed_off_mm,
         standoff_mm: 0.0,
-        pitch_clamped,
     })
 }
 
@@ -470,7 +463,6 @@ mod tests {
             |range: f64, rules| place_palm_on(&vslice, &hand, 80.0, 0.0, range.to_radians(), rules);
         let clamped = place(1.0, RuleSet::Leaning).unwrap();
         assert!((clamped.pitch_rad + 1f64.to_radians()).abs() < 1e-12);
-        assert!(clamped.pitch_clamped);
         assert_eq!(clamped.contacts.len(), 1);
         assert_eq!(clamped.backed_off_mm, 0.0);
         let rejected = Err(PalmRejection::PitchOutOfRange);

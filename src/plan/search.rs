@@ -280,7 +280,8 @@ fn relaxations_of(
     if palm.backed_off_mm > 0.0 {
         relaxations.push(Relaxation::PalmBackedOff);
     }
-    if palm.pitch_clamped {
+    if rules == RuleSet::Leaning {
+        // The only palms the leaning pass places.
         relaxations.push(Relaxation::PalmPitchClamped);
     }
     if rules.is_extended() && uses_outer_elevation(graded, index, hand) {
