@@ -115,6 +115,7 @@ fn bench_plan(c: &mut Criterion) {
                         order_by_closing: None,
                         order_samples: None,
                         plan_reach: 0,
+                        order_reach: 0,
                     },
                     &mut t,
                 )

@@ -104,6 +104,7 @@ fn plan_one(path: &Path, collect: usize) -> Result<Planned, String> {
             order_by_closing: None,
             order_samples: None,
             plan_reach: 0,
+            order_reach: 0,
         },
         &mut grasp_sim::report::StageTimings::default(),
     );

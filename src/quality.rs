@@ -987,6 +987,7 @@ mod tests {
                     order_by_closing: None,
                     order_samples: None,
                     plan_reach: 0,
+                    order_reach: 0,
                 },
                 &mut crate::report::StageTimings::default(),
             );

@@ -198,6 +198,11 @@ pub struct SelectParams<'a> {
     /// checks this many could reach (it goes on to the next rule set when none of them held).
     /// 0 or 1: only when the thesis's rules found none.
     pub plan_reach: usize,
+    /// `[sim] order_reach`: under `order_by_closing = n`, while none of the first rule set's
+    /// picks keeps its plan the order picks on, `n` more, then `2n` more, until this many have
+    /// been closed; a further pick joins only if most of its closings keep the plan
+    /// ([`ranked_by_closing`]). At most `n`: no further picks.
+    pub order_reach: usize,
 }
 
 /// Stage-1 domains by (axis, rule set, AngularStep bits, HeightStep bits).
@@ -397,7 +402,7 @@ fn select_by_closing(
     };
     let mut sel = select_in(mesh, props, &plan_all, None, timings);
     let sampled = p.order_samples.filter(|(m, _)| *m > 0);
-    let ranked = ranked_by_closing(&sel, p.hand, (n, close, sampled), first);
+    let ranked = ranked_by_closing(&sel, p.hand, (n, p.order_reach, close, sampled), first);
     let places = put_first(&mut sel, &ranked, p.collect);
     let mut first_check = Some(first_check);
     let mut settled = false;
@@ -459,10 +464,15 @@ fn held_and_none_left_can_succeed(sel: &Selection, k: usize, places: &[usize]) -
 /// not reached keep their nominal count alone, so a search that checks on after it follows
 /// what is known, at the cost of the closings that found it. The closings run in parallel;
 /// the order does not depend on the threads.
+///
+/// While no pick's nominal closing keeps the plan, the first rule set's candidates are picked
+/// on (`reach`, `[sim] order_reach`: `n` more, then twice as many, until `reach` have been
+/// picked), and a further pick joins only if more than half of its closings (the nominal one
+/// and, under `order_samples`, the perturbed) keep the plan.
 fn ranked_by_closing(
     sel: &Selection,
     hand: &Hand,
-    (n, close, sampled): (usize, CloseFn<'_>, Option<(usize, SampledFn<'_>)>),
+    (n, reach, close, sampled): (usize, usize, CloseFn<'_>, Option<(usize, SampledFn<'_>)>),
     first: Preclosed,
 ) -> Vec<(usize, Preclosed)> {
     use rayon::prelude::*;
@@ -471,24 +481,66 @@ fn ranked_by_closing(
         .iter()
         .map(|c| crate::pick::feature_of(&c.grasp, &sel.axes[c.axis_plan].aligned, hand))
         .collect();
-    let picks = picks_by_rule_set(sel, &features, n);
+    let mut picks = picks_by_rule_set(sel, &features, n);
     // The first is among the picks (`farthest_points` starts from it).
-    let closed: Vec<Preclosed> = picks
-        .par_iter()
-        .map(|&i| {
-            let c = &sel.candidates[i];
-            if i == 0 {
-                first
-            } else {
-                close(&sel.axes[c.axis_plan].aligned, &c.grasp)
+    let close_all = |picks: &[usize]| -> Vec<Preclosed> {
+        picks
+            .par_iter()
+            .map(|&i| {
+                let c = &sel.candidates[i];
+                if i == 0 {
+                    first
+                } else {
+                    close(&sel.axes[c.axis_plan].aligned, &c.grasp)
+                }
+            })
+            .collect()
+    };
+    let mut closed = close_all(&picks);
+    let m = sampled.map_or(0, |(m, _)| m);
+    // None keeps its plan: pick on among the first rule set's candidates (the farthest points
+    // of a larger set start with the smaller's), keeping the picks most of whose closings,
+    // the nominal one and the perturbed, keep the plan: a further pick off its plan, or on it
+    // by chance, would only add draws to the picks that left it.
+    let mut picked = n;
+    let mut tried: std::collections::HashSet<usize> = picks.iter().copied().collect();
+    while picked < reach && !closed.iter().any(|f| f.as_planned) {
+        picked = (2 * picked).min(reach);
+        let (own, _) = by_first_rule_set(sel);
+        let fresh: Vec<usize> = crate::pick::farthest_among(&features, &own, picked)
+            .into_iter()
+            .filter(|i| tried.insert(*i))
+            .collect();
+        if fresh.is_empty() {
+            break;
+        }
+        let mut fresh_closed = close_all(&fresh);
+        if let Some((1.., sampled)) = sampled {
+            let counts: Vec<Option<usize>> = fresh
+                .par_iter()
+                .zip(&fresh_closed)
+                .map(|(&i, f)| {
+                    let c = &sel.candidates[i];
+                    f.as_planned
+                        .then(|| sampled(&sel.axes[c.axis_plan].aligned, &c.grasp))
+                })
+                .collect();
+            for (f, on) in fresh_closed.iter_mut().zip(counts) {
+                f.sampled_on_plan = on;
             }
-        })
-        .collect();
+        }
+        for (i, f) in fresh.into_iter().zip(fresh_closed) {
+            let on = usize::from(f.as_planned) + f.sampled_on_plan.unwrap_or(0);
+            if f.as_planned && 2 * on > m + 1 {
+                picks.push(i);
+                closed.push(f);
+            }
+        }
+    }
     let mut ranked: Vec<(usize, Preclosed)> = picks.into_iter().zip(closed).collect();
     // (checked first, closings on plan, nominal on plan): the first comes first where its
     // closings kept the plan; then the closings that kept it (the nominal one alone without
     // `order_samples`), the nominal one's breaking a tie.
-    let m = sampled.map_or(0, |(m, _)| m);
     let sort = |ranked: &mut Vec<(usize, Preclosed)>| {
         let key = |i: usize, f: &Preclosed| {
             let on = usize::from(f.as_planned) + f.sampled_on_plan.unwrap_or(0);
@@ -981,6 +1033,7 @@ mod tests {
                 order_by_closing: None,
                 order_samples: None,
                 plan_reach: reach,
+                order_reach: 0,
             },
             &mut StageTimings::default(),
         );

@@ -426,6 +426,7 @@ fn plan_candidates(
             order_by_closing: None,
             order_samples: None,
             plan_reach: scenario.sim.selection.max_checked,
+            order_reach: 0,
         },
         timings,
     )

@@ -570,6 +570,7 @@ fn select_grasps(
             order_by_closing: Some((scenario.sim.selection.order_by_closing, &close)),
             order_samples: Some((scenario.sim.selection.order_samples, &sampled)),
             plan_reach: 0,
+            order_reach: scenario.sim.selection.order_reach,
         },
         timings,
     )

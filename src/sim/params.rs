@@ -424,7 +424,27 @@ pub struct SelectionParams {
     /// check on five of six object sets and as often on the sixth (docs/studies/2026-12-07-order-samples.md).
     #[serde(skip_serializing_if = "is_default_order_samples")]
     pub order_samples: usize,
+    /// Under `order_by_closing`, while none of the candidates it closed keeps its plan, it
+    /// picks on among the first rule set's candidates, as many again and then twice as many,
+    /// until this many have been picked, and a further pick joins the order only if most of its
+    /// closings (the nominal one and the `order_samples` perturbed) keep the plan: on an object
+    /// whose first picks all leave their plan, a grasp that keeps it is what holds (the closing
+    /// study, docs/studies/2026-12-06-order-ceiling.md). At most `order_by_closing`: no further
+    /// picks.
+    #[serde(skip_serializing_if = "is_default_order_reach")]
+    pub order_reach: usize,
 }
+
+/// True at the default (a field serialised only when set otherwise).
+fn is_default_order_reach(n: &usize) -> bool {
+    *n == DEFAULT_ORDER_REACH
+}
+
+/// `order_reach`'s default: four times `order_by_closing`'s.
+pub const DEFAULT_ORDER_REACH: usize = 64;
+
+/// The most candidates `order_reach` may pick.
+pub const MAX_ORDER_REACH: usize = 1024;
 
 /// True at the default (a field serialised only when set otherwise).
 fn is_default_order_samples(n: &usize) -> bool {
@@ -454,6 +474,7 @@ impl Default for SelectionParams {
             max_checked: crate::DEFAULT_MAX_CHECKED,
             order_by_closing: DEFAULT_ORDER_BY_CLOSING,
             order_samples: DEFAULT_ORDER_SAMPLES,
+            order_reach: DEFAULT_ORDER_REACH,
         }
     }
 }
@@ -612,6 +633,7 @@ sim_table! {
     rest_joint_deg: f64 => early,
     order_by_closing: usize => selection,
     order_samples: usize => selection,
+    order_reach: usize => selection,
 }
 
 /// `[("sim.<field>", s.<group>.<field>), ...]`: each grouped value with its `[sim]` key.
@@ -758,6 +780,13 @@ impl SimParams {
             return Err((
                 "sim.order_by_closing",
                 format!("must be in 0..={MAX_ORDER_BY_CLOSING}, got {n}"),
+            ));
+        }
+        let r = s.selection.order_reach;
+        if r > MAX_ORDER_REACH {
+            return Err((
+                "sim.order_reach",
+                format!("must be in 0..={MAX_ORDER_REACH}, got {r}"),
             ));
         }
         let m = s.selection.order_samples;
@@ -1030,6 +1059,8 @@ mod tests {
         assert_eq!(check("order_by_closing = 257"), Err("sim.order_by_closing"));
         assert_eq!(check("order_samples = 64"), Ok(()));
         assert_eq!(check("order_samples = 65"), Err("sim.order_samples"));
+        assert_eq!(check("order_reach = 1024"), Ok(()));
+        assert_eq!(check("order_reach = 1025"), Err("sim.order_reach"));
         let mut p = SimParams::default();
         p.solver.timestep_s = 0.5;
         assert_eq!(
@@ -1084,6 +1115,7 @@ mod tests {
         p.early.rest_joint_deg = 2.5;
         p.selection.order_by_closing = 0;
         p.selection.order_samples = 0;
+        p.selection.order_reach = 0;
         p.selection.max_checked = 4;
         p.input.override_angles = Some(vec![[90.0, 80.5], [45.0, 30.0]]);
         p.input.override_index = Some(7);
@@ -1117,7 +1149,7 @@ mod tests {
             pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
             mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: None, \
             choose: First, choose_min_lower_bound: 0.8, \
-            rest_joint_deg: 1.0, order_by_closing: 16, order_samples: 4 }"
+            rest_joint_deg: 1.0, order_by_closing: 16, order_samples: 4, order_reach: 64 }"
         );
         assert_eq!(
             format!("{:?}", non_default()),
@@ -1139,7 +1171,7 @@ mod tests {
             seed: 0, pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
             mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: Some(3), \
             choose: Robust, choose_min_lower_bound: 0.8, \
-            rest_joint_deg: 2.5, order_by_closing: 0, order_samples: 0 }"
+            rest_joint_deg: 2.5, order_by_closing: 0, order_samples: 0, order_reach: 0 }"
         );
     }
 
@@ -1194,7 +1226,7 @@ mod tests {
                 r#""closing_decides":true},"#,
                 r#""early":{"rest_window_s":0.05,"rest_safety":2.0,"rest_margin":0.75,"#,
                 r#""rest_joint_deg":2.5},"#,
-                r#""selection":{"max_checked":4,"order_by_closing":0,"order_samples":0},"#,
+                r#""selection":{"max_checked":4,"order_by_closing":0,"order_samples":0,"order_reach":0},"#,
                 r#""input":{"override_angles":[[90.0,80.5],[45.0,30.0]],"override_index":7},"#,
                 r#""robust":{"samples":8,"seed":0,"pose_offset_mm":2.0,"pose_rotation_deg":3.0,"#,
                 r#""friction_range_pct":15.0,"mass_range_pct":15.0,"torque_range_pct":10.0,"#,
@@ -1254,7 +1286,7 @@ mod tests {
                 `samples`, `seed`, `pose_offset_mm`, `pose_rotation_deg`, \
                 `friction_range_pct`, `mass_range_pct`, `torque_range_pct`, `replay_sample`, \
                 `choose`, `choose_min_lower_bound`, `rest_joint_deg`, `order_by_closing`, \
-                `order_samples`\n"
+                `order_samples`, `order_reach`\n"
             ),
             "{err}"
         );

@@ -747,6 +747,7 @@ fn run_planned(
             order_by_closing: Some((p.scenario.sim.selection.order_by_closing, &close)),
             order_samples: Some((p.scenario.sim.selection.order_samples, &sampled_closings)),
             plan_reach: 0,
+            order_reach: p.scenario.sim.selection.order_reach,
         },
         &mut t,
     );
