@@ -475,7 +475,6 @@ fn ranked_by_closing(
     (n, reach, close, sampled): (usize, usize, CloseFn<'_>, Option<(usize, SampledFn<'_>)>),
     first: Preclosed,
 ) -> Vec<(usize, Preclosed)> {
-    use rayon::prelude::*;
     let features: Vec<_> = sel
         .candidates
         .iter()
@@ -483,60 +482,17 @@ fn ranked_by_closing(
         .collect();
     let mut picks = picks_by_rule_set(sel, &features, n);
     // The first is among the picks (`farthest_points` starts from it).
-    let close_all = |picks: &[usize]| -> Vec<Preclosed> {
-        picks
-            .par_iter()
-            .map(|&i| {
-                let c = &sel.candidates[i];
-                if i == 0 {
-                    first
-                } else {
-                    close(&sel.axes[c.axis_plan].aligned, &c.grasp)
-                }
-            })
-            .collect()
-    };
-    let mut closed = close_all(&picks);
-    let m = sampled.map_or(0, |(m, _)| m);
-    // None keeps its plan: pick on among the first rule set's candidates (the farthest points
-    // of a larger set start with the smaller's), keeping the picks most of whose closings,
-    // the nominal one and the perturbed, keep the plan: a further pick off its plan, or on it
-    // by chance, would only add draws to the picks that left it.
-    let mut picked = n;
-    let mut tried: std::collections::HashSet<usize> = picks.iter().copied().collect();
-    while picked < reach && !closed.iter().any(|f| f.as_planned) {
-        picked = (2 * picked).min(reach);
-        let (own, _) = by_first_rule_set(sel);
-        let fresh: Vec<usize> = crate::pick::farthest_among(&features, &own, picked)
-            .into_iter()
-            .filter(|i| tried.insert(*i))
-            .collect();
-        if fresh.is_empty() {
-            break;
-        }
-        let mut fresh_closed = close_all(&fresh);
-        if let Some((1.., sampled)) = sampled {
-            let counts: Vec<Option<usize>> = fresh
-                .par_iter()
-                .zip(&fresh_closed)
-                .map(|(&i, f)| {
-                    let c = &sel.candidates[i];
-                    f.as_planned
-                        .then(|| sampled(&sel.axes[c.axis_plan].aligned, &c.grasp))
-                })
-                .collect();
-            for (f, on) in fresh_closed.iter_mut().zip(counts) {
-                f.sampled_on_plan = on;
-            }
-        }
-        for (i, f) in fresh.into_iter().zip(fresh_closed) {
-            let on = usize::from(f.as_planned) + f.sampled_on_plan.unwrap_or(0);
-            if f.as_planned && 2 * on > m + 1 {
-                picks.push(i);
-                closed.push(f);
-            }
-        }
+    let mut closed = close_picks(sel, &picks, first, close);
+    if !closed.iter().any(|f| f.as_planned) {
+        pick_on(
+            sel,
+            &features,
+            (n, reach),
+            (first, close, sampled),
+            (&mut picks, &mut closed),
+        );
     }
+    let m = sampled.map_or(0, |(m, _)| m);
     let mut ranked: Vec<(usize, Preclosed)> = picks.into_iter().zip(closed).collect();
     // (checked first, closings on plan, nominal on plan): the first comes first where its
     // closings kept the plan; then the closings that kept it (the nominal one alone without
@@ -567,6 +523,80 @@ fn ranked_by_closing(
         sort(&mut ranked);
     }
     ranked
+}
+
+/// The closings of `sel`'s candidates `picks` by `close`, in parallel (the first candidate's
+/// is `first`, closed already).
+fn close_picks(
+    sel: &Selection,
+    picks: &[usize],
+    first: Preclosed,
+    close: CloseFn<'_>,
+) -> Vec<Preclosed> {
+    use rayon::prelude::*;
+    picks
+        .par_iter()
+        .map(|&i| {
+            let c = &sel.candidates[i];
+            if i == 0 {
+                first
+            } else {
+                close(&sel.axes[c.axis_plan].aligned, &c.grasp)
+            }
+        })
+        .collect()
+}
+
+/// None of the `n` picks kept its plan: picks on among the first rule set's candidates (the
+/// farthest points of a larger set start with the smaller's), `n` more, then twice as many,
+/// until `reach` have been picked or one taken in keeps its plan, and takes in, with their
+/// closings, those that kept it in more than half of their closings (the nominal one and, under
+/// `sampled`, the perturbed, run only where the nominal one kept it): a further pick off its
+/// plan, or on it by chance, would only add draws to the picks that left it.
+fn pick_on(
+    sel: &Selection,
+    features: &[crate::pick::Feature],
+    (n, reach): (usize, usize),
+    (first, close, sampled): (Preclosed, CloseFn<'_>, Option<(usize, SampledFn<'_>)>),
+    (picks, closed): (&mut Vec<usize>, &mut Vec<Preclosed>),
+) {
+    use rayon::prelude::*;
+    let m = sampled.map_or(0, |(m, _)| m);
+    let (own, _) = by_first_rule_set(sel);
+    let mut tried: std::collections::HashSet<usize> = picks.iter().copied().collect();
+    let mut picked = n;
+    while picked < reach && !closed.iter().any(|f| f.as_planned) {
+        picked = (2 * picked).min(reach);
+        let fresh: Vec<usize> = crate::pick::farthest_among(features, &own, picked)
+            .into_iter()
+            .filter(|i| tried.insert(*i))
+            .collect();
+        if fresh.is_empty() {
+            break;
+        }
+        let mut fresh_closed = close_picks(sel, &fresh, first, close);
+        if let Some((1.., sampled)) = sampled {
+            let counts: Vec<Option<usize>> = fresh
+                .par_iter()
+                .zip(&fresh_closed)
+                .map(|(&i, f)| {
+                    let c = &sel.candidates[i];
+                    f.as_planned
+                        .then(|| sampled(&sel.axes[c.axis_plan].aligned, &c.grasp))
+                })
+                .collect();
+            for (f, on) in fresh_closed.iter_mut().zip(counts) {
+                f.sampled_on_plan = on;
+            }
+        }
+        for (i, f) in fresh.into_iter().zip(fresh_closed) {
+            let on = usize::from(f.as_planned) + f.sampled_on_plan.unwrap_or(0);
+            if f.as_planned && 2 * on > m + 1 {
+                picks.push(i);
+                closed.push(f);
+            }
+        }
+    }
 }
 
 /// `n` candidates of `sel` picked for diversity ([`crate::pick::farthest_among`] over

@@ -129,24 +129,7 @@ pub fn place_palm_on(
     let domain = palm_domain(vslice, z_lo, z_hi);
     let first = outermost(domain.iter()).ok_or(PalmRejection::NoContact)?;
 
-    let (second, pitch) = second_contact(&domain, first, centre_z);
-    let (second, pitch) = if pitch.abs() > pitch_range_rad + 1e-12 {
-        if second.is_some() && domain.len() > 1 {
-            if rules != RuleSet::Leaning {
-                return Err(PalmRejection::PitchOutOfRange);
-            }
-            // A rounded profile curves away from its outermost point faster than the range
-            // lets the palm follow (an egg's or a star's shoulder): a palm turned less than the
-            // second contact needs reaches no point of the other half, and rests on the first.
-            (None, pitch_range_rad.copysign(pitch))
-        } else {
-            (None, 0.0)
-        }
-    } else if rules == RuleSet::Leaning {
-        return Err(PalmRejection::WithinPitchRange);
-    } else {
-        (second, pitch)
-    };
+    let (second, pitch) = pitch_within_range(&domain, first, centre_z, pitch_range_rad, rules)?;
 
     // Up axis of the palm in the slice, and its outward normal (away from the object).
     let up = Vector2::new(-pitch.sin(), pitch.cos());
@@ -191,6 +174,36 @@ pub fn place_palm_on(
         backed_off_mm,
         standoff_mm: 0.0,
     })
+}
+
+/// The palm's second contact and its pitch `[rad]` from `first` ([`second_contact`]) within the
+/// Pitch Range: beyond it the candidate is rejected, except under the leaning rules, which lean
+/// the palm at the range's limit on `first` alone and place no palm within the range.
+fn pitch_within_range(
+    domain: &[Point2<f64>],
+    first: Point2<f64>,
+    centre_z: f64,
+    pitch_range_rad: f64,
+    rules: RuleSet,
+) -> Result<(Option<Point2<f64>>, f64), PalmRejection> {
+    let (second, pitch) = second_contact(domain, first, centre_z);
+    if pitch.abs() > pitch_range_rad + 1e-12 {
+        if second.is_some() && domain.len() > 1 {
+            if rules != RuleSet::Leaning {
+                return Err(PalmRejection::PitchOutOfRange);
+            }
+            // A rounded profile curves away from its outermost point faster than the range
+            // lets the palm follow (an egg's or a star's shoulder): a palm turned less than the
+            // second contact needs reaches no point of the other half, and rests on the first.
+            Ok((None, pitch_range_rad.copysign(pitch)))
+        } else {
+            Ok((None, 0.0))
+        }
+    } else if rules == RuleSet::Leaning {
+        Err(PalmRejection::WithinPitchRange)
+    } else {
+        Ok((second, pitch))
+    }
 }
 
 /// Points this close to the axis `[mm]` count as on the object's right side: a vertex the

@@ -213,12 +213,11 @@ fn search_scheduled(
         };
         try_candidate(mesh, index, hand, &candidate, params, deviation, rules)
     };
-    // Candidates are tried in blocks on rayon's threads, each block's results then taken in
-    // search order: the grasps, the count tried and the rejections are the sequential search's
-    // (a candidate's outcome depends on nothing but the candidate). The first SEARCH_SEQUENTIAL
-    // go one at a time, so a grasp found early (a thesis object's within a few dozen) costs no
-    // more than before; then the blocks double from 2 up to SEARCH_BLOCK, and a long search
-    // wastes at most one block beyond its last grasp.
+    // Candidates are tried in blocks on rayon's threads, each block's results taken in search
+    // order: the grasps, the count tried and the rejections are the sequential search's (an
+    // outcome depends on the candidate alone). The first SEARCH_SEQUENTIAL go one at a time (a
+    // grasp found early costs no more), then blocks doubling from 2 up to SEARCH_BLOCK: a long
+    // search wastes at most one block beyond its last grasp.
     let mut start = 0;
     let mut block = 2.min(max_block.max(1));
     while start < candidates.len() {
