@@ -201,7 +201,7 @@ fn the_closing_order_checks_first_a_grasp_whose_closing_stays_near_its_plan() {
     assert_eq!(default["plan"]["grasp"], ordered["plan"]["grasp"]);
     assert_eq!(default["sim"]["fidelity"], ordered["sim"]["fidelity"]);
 
-    // At the default `order_reach` (64) the order picks on, none of the 16 having kept its
+    // At the default `order_reach` (128) the order picks on, none of the 16 having kept its
     // plan: one further pick keeps it in 4 of its 5 closings and is checked first; it slips
     // (the bowl turns in the hand), and the default search's second check is the nearest of
     // the 16, which holds as before.
