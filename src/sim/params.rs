@@ -440,11 +440,10 @@ fn is_default_order_reach(n: &usize) -> bool {
     *n == DEFAULT_ORDER_REACH
 }
 
-/// `order_reach`'s default: eight times `order_by_closing`'s. Against 64, the first candidate
-/// holds a little more often on three of eight object sets and a little less on one, for the
-/// further picks' closings on objects none of whose picks keeps its plan
-/// (docs/studies/2026-12-07-order-reach.md).
-pub const DEFAULT_ORDER_REACH: usize = 128;
+/// `order_reach`'s default: four times `order_by_closing`'s. 128 holds the first candidate a
+/// little more often on three of eight object sets and a little less on one, and costs a
+/// random-shape set's default batch 27 % more CPU (docs/studies/2026-12-07-order-reach.md).
+pub const DEFAULT_ORDER_REACH: usize = 64;
 
 /// The most candidates `order_reach` may pick.
 pub const MAX_ORDER_REACH: usize = 1024;
@@ -1152,7 +1151,7 @@ mod tests {
             pose_offset_mm: 2.0, pose_rotation_deg: 3.0, friction_range_pct: 15.0, \
             mass_range_pct: 15.0, torque_range_pct: 10.0, replay_sample: None, \
             choose: First, choose_min_lower_bound: 0.8, \
-            rest_joint_deg: 1.0, order_by_closing: 16, order_samples: 4, order_reach: 128 }"
+            rest_joint_deg: 1.0, order_by_closing: 16, order_samples: 4, order_reach: 64 }"
         );
         assert_eq!(
             format!("{:?}", non_default()),

@@ -201,7 +201,7 @@ fn the_closing_order_checks_first_a_grasp_whose_closing_stays_near_its_plan() {
     assert_eq!(default["plan"]["grasp"], ordered["plan"]["grasp"]);
     assert_eq!(default["sim"]["fidelity"], ordered["sim"]["fidelity"]);
 
-    // At the default `order_reach` (128) the order picks on, none of the 16 having kept its
+    // At the default `order_reach` (64) the order picks on, none of the 16 having kept its
     // plan: one further pick keeps it in 4 of its 5 closings and is checked first; it slips
     // (the bowl turns in the hand), and the default search's second check is the nearest of
     // the 16, which holds as before.
@@ -335,11 +335,11 @@ fn the_order_picks_on_until_a_closing_keeps_its_plan() {
 }
 
 #[test]
-fn the_order_picks_on_past_64_candidates_at_the_default_reach() {
+fn the_order_picks_on_past_64_candidates_at_order_reach_128() {
     // A torus, its tube 35 mm thick round a 55 mm hole. None of the first 64 picks keeps its
     // plan (the 16 listed leave it by 5.6 mm or more, against the 5 mm bound), so at
     // `order_reach = 64` the order takes the nearest of the 16, which holds in 5 of 8 samples.
-    // At the default (128) two of the picks from 65 to 128 keep their plan in 3 of their 5
+    // At `order_reach = 128` two of the picks from 65 to 128 keep their plan in 3 of their 5
     // closings, and the first of them holds in every sample.
     let dir = tempfile::tempdir().unwrap();
     let mesh = dir.path().join("torus.stl");
@@ -355,7 +355,7 @@ fn the_order_picks_on_past_64_candidates_at_the_default_reach() {
     let p64 = at_64["sim"]["robust"]["hold_probability"].as_f64().unwrap();
     assert!(p64 <= 0.625, "{p64}");
 
-    let reached = one_check(dir.path(), &mesh, "");
+    let reached = one_check(dir.path(), &mesh, "order_reach = 128");
     let further = further_picks(&reached, picks);
     assert_eq!(
         further.len() + 16,
